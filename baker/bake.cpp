@@ -1,0 +1,538 @@
+#include "bake.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <fstream>
+#include <limits>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include "normals.h"
+#include "padding.h"
+#include "rasterize.h"
+#include "raycast.h"
+
+namespace nmbake {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+constexpr int kTile = 16;            // texels per tile side
+constexpr int kMaxSamples = 1024;    // per texel
+constexpr int kMaxSide = 65536;      // texels
+// Tangent components this close to zero are written as exactly 0: a flat result is then
+// (128,128,255) and not a coin flip between 127 and 128 decided by float noise.
+constexpr double kSnap = 1e-6;
+
+std::uint64_t available_memory_bytes() {
+  std::ifstream in("/proc/meminfo");
+  std::string key;
+  std::uint64_t value = 0;
+  std::string unit;
+  while (in >> key >> value >> unit)
+    if (key == "MemAvailable:") return value * 1024;
+  return std::numeric_limits<std::uint64_t>::max();
+}
+
+// The scene in re-centred float coordinates, flat arrays for the hot loop.
+struct Prepared {
+  glm::dvec3 centre{0.0};
+  double diagonal = 0.0;
+  std::vector<glm::vec3> low_pos, cage_pos, high_pos;
+  std::vector<glm::vec3> ray_normal;  // per low-poly position: mean of its corners' normals
+  std::vector<glm::vec3> high_normals;
+  std::vector<std::uint32_t> high_normal_index;
+  TangentFrames frames;
+};
+
+void grow_box(glm::dvec3& lo, glm::dvec3& hi, const std::vector<glm::vec3>& pts) {
+  for (const glm::vec3& p : pts) {
+    lo = glm::min(lo, glm::dvec3(p));
+    hi = glm::max(hi, glm::dvec3(p));
+  }
+}
+
+std::vector<glm::vec3> recentre(const std::vector<glm::vec3>& pts, const glm::dvec3& c) {
+  std::vector<glm::vec3> out(pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i) out[i] = glm::vec3(glm::dvec3(pts[i]) - c);
+  return out;
+}
+
+// Ray normals: one per position, the normalized mean of the distinct normals its corners use, so
+// split normals (hard edges) open no gaps between the rays of neighbouring faces.
+std::vector<glm::vec3> position_averaged_normals(const Mesh& low, const TangentFrames& frames) {
+  const std::size_t np = low.positions.size();
+  // A position whose corners all use one normal keeps it bit for bit; one with several gets the
+  // normalized mean over its corners (a normal shared by more faces weighs more).
+  std::vector<glm::vec3> out(np, glm::vec3(0, 0, 1));
+  std::vector<std::uint8_t> state(np, 0);  // 0 unseen, 1 one normal so far, 2 several
+  for (std::size_t c = 0; c < low.position_index.size(); ++c) {
+    const std::uint32_t p = low.position_index[c];
+    if (state[p] == 0) {
+      state[p] = 1;
+      out[p] = frames.normal[c];
+    } else if (frames.normal[c] != out[p]) {
+      state[p] = 2;
+    }
+  }
+  std::vector<glm::dvec3> sum(np, glm::dvec3(0.0));
+  for (std::size_t c = 0; c < low.position_index.size(); ++c)
+    if (state[low.position_index[c]] == 2) sum[low.position_index[c]] += glm::dvec3(frames.normal[c]);
+  for (std::size_t p = 0; p < np; ++p) {
+    const double len = glm::length(sum[p]);
+    if (state[p] == 2 && len > 1e-12) out[p] = glm::vec3(sum[p] / len);
+  }
+  return out;
+}
+
+double quantile(std::vector<float>& v, double q) {
+  if (v.empty()) return 0.0;
+  const std::size_t k = std::min(v.size() - 1, std::size_t(q * double(v.size() - 1)));
+  std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(k), v.end());
+  return v[k];
+}
+
+template <typename Fn>
+void run_parallel(int threads, Fn&& worker) {
+  std::vector<std::thread> pool;
+  for (int i = 1; i < threads; ++i) pool.emplace_back(worker, i);
+  worker(0);
+  for (auto& t : pool) t.join();
+}
+
+}  // namespace
+
+std::vector<glm::dvec2> sample_offsets(int samples) {
+  std::vector<glm::dvec2> out;
+  if (samples <= 1) return {glm::dvec2(0.5, 0.5)};
+  const int k = int(std::lround(std::sqrt(double(samples))));
+  if (k * k == samples) {
+    for (int j = 0; j < k; ++j)
+      for (int i = 0; i < k; ++i) out.push_back({(i + 0.5) / k, (j + 0.5) / k});
+    return out;
+  }
+  for (int i = 0; i < samples; ++i) {
+    // Hammersley: x stratified in n strata, y the base-2 radical inverse, shifted off the edges.
+    std::uint32_t b = std::uint32_t(i);
+    b = (b << 16) | (b >> 16);
+    b = ((b & 0x55555555u) << 1) | ((b & 0xAAAAAAAAu) >> 1);
+    b = ((b & 0x33333333u) << 2) | ((b & 0xCCCCCCCCu) >> 2);
+    b = ((b & 0x0F0F0F0Fu) << 4) | ((b & 0xF0F0F0F0u) >> 4);
+    b = ((b & 0x00FF00FFu) << 8) | ((b & 0xFF00FF00u) >> 8);
+    double y = double(b) * (1.0 / 4294967296.0) + 0.5 / samples;
+    if (y >= 1.0) y -= 1.0;
+    out.push_back({(i + 0.5) / samples, y});
+  }
+  return out;
+}
+
+std::uint64_t estimate_bake_bytes(const BakeOptions& o) {
+  const std::uint64_t texels = std::uint64_t(std::max(o.width, 0)) * std::uint64_t(std::max(o.height, 0));
+  // map (3 floats) + coverage (1 byte) + padding transform (double + int) + optional miss mask.
+  std::uint64_t per_texel = 12 + 1 + (o.padding > 0 ? 12 : 0) + (o.miss_mask ? 4 : 0);
+  return texels * per_texel;
+}
+
+BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt) {
+  // Options.
+  if (opt.width < 1 || opt.height < 1)
+    throw UsageError("--size must be at least 1x1 (got " + std::to_string(opt.width) + "x" + std::to_string(opt.height) + ")");
+  if (opt.width > kMaxSide || opt.height > kMaxSide)
+    throw ResourceError("--size " + std::to_string(opt.width) + "x" + std::to_string(opt.height) +
+                        " refused: the largest supported side is " + std::to_string(kMaxSide) + " texels");
+  if (opt.samples < 1 || opt.samples > kMaxSamples)
+    throw UsageError("--samples must be between 1 and " + std::to_string(kMaxSamples) + " (got " + std::to_string(opt.samples) + ")");
+  if (opt.padding < 0) throw UsageError("--padding must not be negative");
+  if (!std::isfinite(opt.front) || !std::isfinite(opt.rear)) throw UsageError("--front and --rear must be finite");
+  if (!low.has_uvs()) throw InputError(low.source + ": the low-poly mesh has no UVs");
+  if (low.triangle_count() == 0) throw InputError(low.source + ": no faces");
+  if (high.triangle_count() == 0) throw InputError(high.source + ": no faces");
+  if (cage && (cage->triangle_count() != low.triangle_count() || cage->positions.size() != low.positions.size() ||
+               cage->position_index != low.position_index))
+    throw InputError(cage->source + ": the cage must have the low-poly's topology (" + std::to_string(cage->triangle_count()) +
+                     " triangles, " + std::to_string(cage->positions.size()) + " vertices; " + low.source + " has " +
+                     std::to_string(low.triangle_count()) + " and " + std::to_string(low.positions.size()) + ")");
+  {
+    const std::uint64_t need = estimate_bake_bytes(opt);
+    const std::uint64_t avail = available_memory_bytes();
+    if (need > avail)
+      throw ResourceError("--size " + std::to_string(opt.width) + "x" + std::to_string(opt.height) + " needs about " +
+                          std::to_string(need >> 20) + " MiB for its buffers but only " + std::to_string(avail >> 20) +
+                          " MiB are available");
+  }
+  const int threads = opt.threads > 0 ? opt.threads : std::max(1, int(std::thread::hardware_concurrency()));
+
+  BakeResult result;
+  BakeStats& st = result.stats;
+  st.low_triangles = low.triangle_count();
+  st.high_triangles = high.triangle_count();
+
+  // Prepare: tangent frames, re-centred coordinates, ray normals, high-poly normals.
+  auto t0 = Clock::now();
+  Prepared s;
+  s.frames = compute_tangent_frames(low);
+  st.degenerate_uv_triangles = s.frames.degenerate_uv_triangles;
+  st.degenerate_3d_triangles = s.frames.degenerate_3d_triangles;
+  st.corners_without_tangent = s.frames.corners_without_tangent;
+  {
+    glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+    grow_box(lo, hi, low.positions);
+    grow_box(lo, hi, high.positions);
+    if (cage) grow_box(lo, hi, cage->positions);
+    s.centre = 0.5 * (lo + hi);
+    s.diagonal = glm::length(hi - lo);
+    if (!(s.diagonal > 0.0)) s.diagonal = 1.0;
+  }
+  s.low_pos = recentre(low.positions, s.centre);
+  s.high_pos = recentre(high.positions, s.centre);
+  if (cage) s.cage_pos = recentre(cage->positions, s.centre);
+  s.ray_normal = position_averaged_normals(low, s.frames);
+  if (high.has_normals()) {
+    s.high_normals = high.normals;
+    s.high_normal_index = high.normal_index;
+  } else {
+    s.high_normals = compute_vertex_normals(high);
+    s.high_normal_index = high.position_index;
+    st.high_normals_computed = true;
+  }
+  for (std::size_t t = 0; t < low.triangle_count(); ++t)
+    for (int c = 0; c < 3; ++c) {
+      const glm::vec2 uv = low.corner_uv(t, c);
+      if (uv.x < 0.0f || uv.x > 1.0f || uv.y < 0.0f || uv.y > 1.0f) {
+        ++st.uv_outside_triangles;
+        break;
+      }
+    }
+  st.seconds_prepare = seconds_since(t0);
+
+  // BVH over the high-poly.
+  t0 = Clock::now();
+  raycast::Scene scene(&s.high_pos[0].x, s.high_pos.size(), high.position_index.data(), high.triangle_count(),
+                       raycast::BuildQuality::medium, opt.threads);
+  st.seconds_bvh = seconds_since(t0);
+
+  auto low_point = [&](std::size_t tri, const double b[3]) {
+    glm::dvec3 p(0.0);
+    for (int c = 0; c < 3; ++c) p += b[c] * glm::dvec3(s.low_pos[low.position_index[3 * tri + c]]);
+    return p;
+  };
+  auto low_ray_normal = [&](std::size_t tri, const double b[3]) {
+    glm::dvec3 n(0.0);
+    for (int c = 0; c < 3; ++c) n += b[c] * glm::dvec3(s.ray_normal[low.position_index[3 * tri + c]]);
+    const double len = glm::length(n);
+    if (len > 1e-12) return n / len;
+    // Opposite corner normals cancel: fall back to the face normal.
+    const glm::dvec3 p0(s.low_pos[low.position_index[3 * tri]]), p1(s.low_pos[low.position_index[3 * tri + 1]]),
+        p2(s.low_pos[low.position_index[3 * tri + 2]]);
+    const glm::dvec3 f = glm::cross(p1 - p0, p2 - p0);
+    const double fl = glm::length(f);
+    return fl > 0.0 ? f / fl : glm::dvec3(0, 0, 1);
+  };
+
+  // Ray distances: given, or measured by probing along the ray normals from points on the low-poly.
+  t0 = Clock::now();
+  st.front = opt.front;
+  st.rear = opt.rear;
+  if (!cage && (opt.front < 0.0f || opt.rear < 0.0f)) {
+    st.auto_distances = true;
+    const double reach = 0.1 * s.diagonal;  // farther than this is another part of the model
+    const std::size_t tris = low.triangle_count();
+    const std::size_t stride = std::max<std::size_t>(1, tris / 50000);
+    static const double probe_bary[4][3] = {{1 / 3.0, 1 / 3.0, 1 / 3.0}, {4 / 6.0, 1 / 6.0, 1 / 6.0},
+                                            {1 / 6.0, 4 / 6.0, 1 / 6.0}, {1 / 6.0, 1 / 6.0, 4 / 6.0}};
+    std::vector<raycast::Ray> rays;
+    for (std::size_t t = 0; t < tris; t += stride)
+      for (const auto& b : probe_bary) {
+        const glm::dvec3 p = low_point(t, b), n = low_ray_normal(t, b);
+        rays.push_back({glm::vec3(p), 0.0f, glm::vec3(n), float(reach)});
+        rays.push_back({glm::vec3(p), 0.0f, glm::vec3(-n), float(reach)});
+      }
+    std::vector<raycast::Hit> hits(rays.size());
+    const std::size_t pairs = rays.size() / 2;
+    std::atomic<std::size_t> next{0};
+    run_parallel(threads, [&](int) {
+      for (std::size_t i; (i = next.fetch_add(4096)) < pairs;) {
+        const std::size_t n = std::min<std::size_t>(4096, pairs - i);
+        scene.intersect(&rays[2 * i], &hits[2 * i], 2 * n);
+      }
+    });
+    std::vector<float> outside, inside;
+    for (std::size_t i = 0; i < pairs; ++i) {
+      const raycast::Hit& o = hits[2 * i];
+      const raycast::Hit& in = hits[2 * i + 1];
+      if (o.hit() && (!in.hit() || o.t <= in.t))
+        outside.push_back(o.t);
+      else if (in.hit())
+        inside.push_back(in.t);
+    }
+    // Cover all but the farthest 0.1% of probes, with a 25% margin and a floor for coincident meshes.
+    const double floor_dist = 1e-4 * s.diagonal;
+    const double front = 1.25 * quantile(outside, 0.999) + floor_dist;
+    const double rear = 1.25 * quantile(inside, 0.999) + floor_dist;
+    if (opt.front < 0.0f) st.front = float(front);
+    if (opt.rear < 0.0f) st.rear = float(rear);
+    std::size_t beyond = 0;
+    for (float d : outside) beyond += d > st.front;
+    for (float d : inside) beyond += d > st.rear;
+    st.auto_probe_beyond = pairs ? double(beyond) / double(pairs) : 0.0;
+  }
+  if (cage) {
+    if (st.front < 0.0f) st.front = 0.0f;
+    if (st.rear < 0.0f) st.rear = float(1e-4 * s.diagonal);
+  }
+  st.seconds_distances = seconds_since(t0);
+
+  // Trace: tiles of texels, each rasterized against the triangles binned to it, rays in packets.
+  t0 = Clock::now();
+  const int W = opt.width, H = opt.height;
+  const int tiles_x = (W + kTile - 1) / kTile, tiles_y = (H + kTile - 1) / kTile;
+  const std::size_t tile_count = std::size_t(tiles_x) * tiles_y;
+  std::vector<TexelTriangle> texel_tris(low.triangle_count());
+  std::vector<std::uint32_t> bin_start(tile_count + 1, 0);
+  for (std::size_t t = 0; t < low.triangle_count(); ++t) {
+    texel_tris[t] = setup_texel_triangle(low.corner_uv(t, 0), low.corner_uv(t, 1), low.corner_uv(t, 2), W, H);
+    const TexelTriangle& tt = texel_tris[t];
+    if (!tt.valid() || tt.xmax < tt.xmin || tt.ymax < tt.ymin) continue;
+    for (int ty = tt.ymin / kTile; ty <= tt.ymax / kTile; ++ty)
+      for (int tx = tt.xmin / kTile; tx <= tt.xmax / kTile; ++tx) ++bin_start[std::size_t(ty) * tiles_x + tx + 1];
+  }
+  for (std::size_t i = 0; i < tile_count; ++i) bin_start[i + 1] += bin_start[i];
+  std::vector<std::uint32_t> bin_tris(bin_start[tile_count]);
+  {
+    std::vector<std::uint32_t> fill(bin_start.begin(), bin_start.end() - 1);
+    for (std::size_t t = 0; t < low.triangle_count(); ++t) {
+      const TexelTriangle& tt = texel_tris[t];
+      if (!tt.valid() || tt.xmax < tt.xmin || tt.ymax < tt.ymin) continue;
+      for (int ty = tt.ymin / kTile; ty <= tt.ymax / kTile; ++ty)
+        for (int tx = tt.xmin / kTile; tx <= tt.xmax / kTile; ++tx)
+          bin_tris[fill[std::size_t(ty) * tiles_x + tx]++] = std::uint32_t(t);
+    }
+  }
+
+  result.map = Image(W, H, 3, 0.0f);
+  result.coverage.assign(std::size_t(W) * H, 0);
+  if (opt.miss_mask) result.miss_mask = Image(W, H, 1, 0.0f);
+  const std::vector<glm::dvec2> offsets = sample_offsets(opt.samples);
+  const int S = int(offsets.size());
+  const bool closest = opt.policy == RayPolicy::closest && !cage;
+  const int rays_per_sample = closest ? 2 : 1;
+
+  struct ThreadStats {
+    std::uint64_t rays = 0, hits = 0, misses = 0, covered = 0, overlaps = 0;
+    double dmin = std::numeric_limits<double>::infinity(), dmax = -std::numeric_limits<double>::infinity(), dsum = 0.0;
+  };
+  std::vector<ThreadStats> tstats(threads);
+  std::atomic<std::size_t> next_tile{0}, tiles_done{0};
+  std::atomic<bool> cancel{false};
+
+  auto worker = [&](int id) {
+    ThreadStats& ts = tstats[id];
+    struct Slot {
+      std::int32_t tri;
+      double b[3];
+    };
+    std::vector<Slot> slots(std::size_t(kTile) * kTile * S);
+    std::vector<raycast::Ray> rays;
+    std::vector<raycast::Hit> hits;
+    std::vector<std::uint32_t> slot_of_ray;
+    std::vector<double> signed_base;  // per ray: distance from P to the ray origin along the ray
+    std::vector<glm::dvec4> acc(std::size_t(kTile) * kTile);  // xyz sum, w = covered samples
+    std::vector<std::uint32_t> miss_count(std::size_t(kTile) * kTile);
+    for (std::size_t tile; !cancel.load(std::memory_order_relaxed) && (tile = next_tile.fetch_add(1)) < tile_count;) {
+      const int tx0 = int(tile % tiles_x) * kTile, ty0 = int(tile / tiles_x) * kTile;
+      const int tw = std::min(kTile, W - tx0), th = std::min(kTile, H - ty0);
+      const std::uint32_t b0 = bin_start[tile], b1 = bin_start[tile + 1];
+      if (b0 == b1) {
+        ++tiles_done;
+        continue;  // no triangle touches this tile: it costs nothing
+      }
+      for (Slot& sl : slots) sl.tri = -1;
+      // Rasterize: the lowest triangle index wins a sample covered twice (overlapping islands).
+      for (std::uint32_t bi = b0; bi < b1; ++bi) {
+        const std::uint32_t t = bin_tris[bi];
+        const TexelTriangle& tt = texel_tris[t];
+        const int x0 = std::max(tt.xmin, tx0), x1 = std::min(tt.xmax, tx0 + tw - 1);
+        const int y0 = std::max(tt.ymin, ty0), y1 = std::min(tt.ymax, ty0 + th - 1);
+        for (int y = y0; y <= y1; ++y)
+          for (int x = x0; x <= x1; ++x)
+            for (int k = 0; k < S; ++k) {
+              double b[3];
+              if (!covers(tt, sample_point(x, y, offsets[k].x, offsets[k].y), b)) continue;
+              Slot& sl = slots[(std::size_t(y - ty0) * kTile + (x - tx0)) * S + k];
+              if (sl.tri >= 0) {
+                ++ts.overlaps;
+                continue;
+              }
+              sl.tri = std::int32_t(t);
+              sl.b[0] = b[0];
+              sl.b[1] = b[1];
+              sl.b[2] = b[2];
+            }
+      }
+      // Rays for the covered samples.
+      rays.clear();
+      slot_of_ray.clear();
+      signed_base.clear();
+      for (std::uint32_t si = 0; si < slots.size(); ++si) {
+        const Slot& sl = slots[si];
+        if (sl.tri < 0) continue;
+        const glm::dvec3 p = low_point(std::size_t(sl.tri), sl.b);
+        const glm::dvec3 n = low_ray_normal(std::size_t(sl.tri), sl.b);
+        if (cage) {
+          glm::dvec3 pc(0.0);
+          for (int c = 0; c < 3; ++c) pc += sl.b[c] * glm::dvec3(s.cage_pos[low.position_index[3 * sl.tri + c]]);
+          glm::dvec3 d = p - pc;
+          double len = glm::length(d);
+          // A cage point on the low-poly gives no direction: use the ray normal from P + front*N.
+          if (!(len > 1e-9 * s.diagonal)) {
+            d = -n;
+            len = 0.0;
+            pc = p;
+          } else {
+            d /= len;
+          }
+          rays.push_back({glm::vec3(pc), 0.0f, glm::vec3(d), float(len + st.rear)});
+          signed_base.push_back(len);
+        } else if (closest) {
+          rays.push_back({glm::vec3(p), 0.0f, glm::vec3(n), st.front});
+          signed_base.push_back(0.0);
+          rays.push_back({glm::vec3(p), 0.0f, glm::vec3(-n), st.rear});
+          signed_base.push_back(0.0);
+        } else {
+          rays.push_back({glm::vec3(p + double(st.front) * n), 0.0f, glm::vec3(-n), st.front + st.rear});
+          signed_base.push_back(st.front);
+        }
+        slot_of_ray.push_back(si);
+      }
+      hits.resize(rays.size());
+      if (!rays.empty()) scene.intersect(rays.data(), hits.data(), rays.size());
+      ts.rays += rays.size();
+      // Shade: the high-poly normal at the hit, in the low-poly's tangent frame at P.
+      std::fill(acc.begin(), acc.end(), glm::dvec4(0.0));
+      std::fill(miss_count.begin(), miss_count.end(), 0u);
+      for (std::size_t r = 0; r < slot_of_ray.size(); ++r) {
+        const std::uint32_t si = slot_of_ray[r];
+        const Slot& sl = slots[si];
+        const std::size_t texel = si / S;
+        const raycast::Hit* h = &hits[r * rays_per_sample];
+        double dist = 0.0;
+        if (closest) {
+          const raycast::Hit& out = hits[2 * r];
+          const raycast::Hit& in = hits[2 * r + 1];
+          if (out.hit() && (!in.hit() || out.t <= in.t)) {
+            h = &out;
+            dist = out.t;
+          } else {
+            h = &in;
+            dist = -double(in.t);
+          }
+        } else {
+          dist = signed_base[r] - h->t;
+        }
+        const PixelFrame frame = interpolate_frame(s.frames, std::size_t(sl.tri), sl.b, opt.bitangent);
+        glm::dvec3 value;
+        ++ts.covered;
+        if (h->hit()) {
+          ++ts.hits;
+          ts.dmin = std::min(ts.dmin, dist);
+          ts.dmax = std::max(ts.dmax, dist);
+          ts.dsum += dist;
+          const std::size_t ht = h->triangle;
+          const double w[3] = {1.0 - double(h->u) - double(h->v), double(h->u), double(h->v)};
+          glm::dvec3 nh(0.0);
+          for (int c = 0; c < 3; ++c) nh += w[c] * glm::dvec3(s.high_normals[s.high_normal_index[3 * ht + c]]);
+          double len = glm::length(nh);
+          if (!(len > 1e-12)) {
+            const glm::dvec3 q0(s.high_pos[high.position_index[3 * ht]]), q1(s.high_pos[high.position_index[3 * ht + 1]]),
+                q2(s.high_pos[high.position_index[3 * ht + 2]]);
+            nh = glm::cross(q1 - q0, q2 - q0);
+            len = glm::length(nh);
+          }
+          nh = len > 0.0 ? nh / len : glm::normalize(frame.n);
+          value = opt.space == NormalSpace::tangent ? encode_tangent_normal(frame, nh) : nh;
+        } else {
+          ++ts.misses;
+          ++miss_count[texel];
+          const double nl = glm::length(frame.n);
+          value = opt.space == NormalSpace::tangent ? glm::dvec3(0, 0, 1) : (nl > 0 ? frame.n / nl : glm::dvec3(0, 0, 1));
+        }
+        acc[texel] += glm::dvec4(value, 1.0);
+      }
+      // Texels: renormalized mean of their covered samples.
+      for (int y = 0; y < th; ++y)
+        for (int x = 0; x < tw; ++x) {
+          const std::size_t lt = std::size_t(y) * kTile + x;
+          if (acc[lt].w == 0.0) continue;
+          glm::dvec3 v(acc[lt]);
+          const double len = glm::length(v);
+          v = len > 0.0 ? v / len : glm::dvec3(0, 0, 1);
+          if (opt.space == NormalSpace::tangent && opt.green_down) v.y = -v.y;
+          for (int c = 0; c < 3; ++c)
+            if (std::abs(v[c]) < kSnap) v[c] = 0.0;
+          const std::size_t gi = std::size_t(ty0 + y) * W + (tx0 + x);
+          float* px = result.map.at(tx0 + x, ty0 + y);
+          for (int c = 0; c < 3; ++c) px[c] = float(v[c] * 0.5 + 0.5);
+          result.coverage[gi] = 1;
+          if (opt.miss_mask) result.miss_mask.pixels[gi] = float(miss_count[lt]) / float(acc[lt].w);
+        }
+      ++tiles_done;
+    }
+  };
+
+  {
+    std::vector<std::thread> pool;
+    for (int i = 0; i < threads; ++i) pool.emplace_back(worker, i);
+    if (opt.progress) {
+      while (tiles_done.load() < tile_count && !cancel.load()) {
+        if (!opt.progress(double(tiles_done.load()) / double(tile_count))) cancel = true;
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      }
+    }
+    for (auto& t : pool) t.join();
+    if (cancel) throw Cancelled();
+    if (opt.progress) opt.progress(1.0);
+  }
+  ThreadStats total;
+  for (const ThreadStats& ts : tstats) {
+    total.rays += ts.rays;
+    total.hits += ts.hits;
+    total.misses += ts.misses;
+    total.covered += ts.covered;
+    total.overlaps += ts.overlaps;
+    total.dmin = std::min(total.dmin, ts.dmin);
+    total.dmax = std::max(total.dmax, ts.dmax);
+    total.dsum += ts.dsum;
+  }
+  st.rays = total.rays;
+  st.hits = total.hits;
+  st.misses = total.misses;
+  st.samples_covered = total.covered;
+  st.overlapping_samples = total.overlaps;
+  if (total.hits) {
+    st.hit_distance_min = total.dmin;
+    st.hit_distance_max = total.dmax;
+    st.hit_distance_mean = total.dsum / double(total.hits);
+  }
+  st.texels_total = std::size_t(W) * H;
+  for (std::uint8_t c : result.coverage) st.texels_covered += c;
+  st.coverage = double(st.texels_covered) / double(st.texels_total);
+  st.seconds_trace = seconds_since(t0);
+
+  // Padding. Background (never reached by padding) stays the flat normal.
+  t0 = Clock::now();
+  const float flat[3] = {0.5f, 0.5f, opt.space == NormalSpace::tangent ? 1.0f : 0.5f};
+  for (std::size_t i = 0; i < result.coverage.size(); ++i)
+    if (!result.coverage[i])
+      for (int c = 0; c < 3; ++c) result.map.pixels[3 * i + c] = flat[c];
+  st.texels_padded = pad_islands(result.map, result.coverage, opt.padding);
+  st.seconds_padding = seconds_since(t0);
+  return result;
+}
+
+}  // namespace nmbake

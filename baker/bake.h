@@ -1,0 +1,91 @@
+// bake_normal_map: the whole bake on in-memory meshes, from tangent frames to padded map.
+//
+// For every sample point of every texel covered by the low-poly's UV layout it finds the low-poly
+// point P and ray normal N, casts a ray onto the high-poly (policy below), interpolates the
+// high-poly normal at the hit with the hit's own barycentrics, and expresses it in the low-poly
+// tangent frame at P (the exact inverse of the renderer's decoding, tangent_frames.h). A texel's
+// value is the renormalized mean of its covered samples; uncovered texels are filled by padding.
+// Conventions: ../shared/docs/baking.md. Meshes are never rotated or scaled; internally all
+// coordinates are re-centred on the scene's bounding-box centre for precision.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "errors.h"
+#include "image.h"
+#include "mesh.h"
+#include "tangent_frames.h"
+
+namespace nmbake {
+
+enum class RayPolicy {
+  cage_first,  // start at P + front*N (or on the cage), travel inward to rear, first hit wins
+  closest,     // cast outward up to front and inward up to rear from P, nearest hit wins
+};
+
+enum class NormalSpace { tangent, object };
+
+struct BakeOptions {
+  int width = 2048;   // map width in texels
+  int height = 2048;  // map height in texels
+  int samples = 1;    // sample points per texel; 1 = the texel centre only (no AA loop)
+  float front = -1.0f;  // scene units the ray starts outside the low-poly; < 0 = auto (measured)
+  float rear = -1.0f;   // scene units the ray reaches inside the low-poly; < 0 = auto (measured)
+  RayPolicy policy = RayPolicy::cage_first;
+  NormalSpace space = NormalSpace::tangent;
+  bool green_down = false;  // DirectX "Y-" maps: negate the bitangent component
+  BitangentMode bitangent = BitangentMode::per_pixel;
+  int padding = 16;     // texels of edge padding around islands; 0 = none
+  int threads = 0;      // worker threads; 0 = all cores
+  bool miss_mask = false;  // fill BakeResult::miss_mask (share of missed samples per texel)
+  // Called from the calling thread with the fraction done in [0,1]; return false to cancel
+  // (bake_normal_map then throws Cancelled).
+  std::function<bool(double)> progress;
+};
+
+struct BakeStats {
+  float front = 0.0f, rear = 0.0f;  // distances used (scene units)
+  bool auto_distances = false;      // front/rear were measured, not given
+  double auto_probe_beyond = 0.0;   // share of probe points farther than the chosen distances
+  std::uint64_t rays = 0, hits = 0, misses = 0;  // misses/hits count samples, rays count casts
+  std::uint64_t samples_covered = 0;
+  std::uint64_t overlapping_samples = 0;  // samples covered by more than one UV triangle
+  std::size_t texels_total = 0, texels_covered = 0, texels_padded = 0;
+  double coverage = 0.0;  // texels_covered / texels_total
+  // Signed distance from the low-poly surface to the hit along the ray (positive: in front of /
+  // outside the low-poly), over all hits.
+  double hit_distance_min = 0.0, hit_distance_mean = 0.0, hit_distance_max = 0.0;
+  std::size_t low_triangles = 0, high_triangles = 0;
+  std::size_t degenerate_uv_triangles = 0, degenerate_3d_triangles = 0, corners_without_tangent = 0;
+  std::size_t uv_outside_triangles = 0;  // low-poly triangles with a UV outside [0,1]
+  bool high_normals_computed = false;
+  // Seconds per stage.
+  double seconds_prepare = 0, seconds_bvh = 0, seconds_distances = 0, seconds_trace = 0, seconds_padding = 0;
+};
+
+struct BakeResult {
+  Image map;                          // RGB, encoded c = n * 0.5 + 0.5
+  Image miss_mask;                    // 1 channel, share of missed samples (only with options.miss_mask)
+  std::vector<std::uint8_t> coverage;  // per texel: 1 = covered by the UV layout
+  BakeStats stats;
+};
+
+struct Cancelled : Error {
+  Cancelled() : Error(ExitCode::usage, "cancelled") {}
+};
+
+// Throws UsageError for absurd options, InputError for meshes that cannot be baked (no UVs, cage
+// topology mismatch), ResourceError when the buffers would not fit in memory, Cancelled.
+BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& options);
+
+// Bytes the bake will allocate for its images at this size (for the memory check and reports).
+std::uint64_t estimate_bake_bytes(const BakeOptions& options);
+
+// The sample offsets inside a texel for `samples` samples, in [0,1)^2: the centre for 1, a
+// regular grid for square counts, otherwise a stratified (Hammersley) set.
+std::vector<glm::dvec2> sample_offsets(int samples);
+
+}  // namespace nmbake

@@ -1,0 +1,232 @@
+#include "image_io.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cassert>
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <memory>
+#include <new>
+#include <system_error>
+
+#include <unistd.h>
+
+#include <OpenImageIO/imageio.h>
+
+#include "errors.h"
+
+namespace nmbake {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Formats we write, and the bit depths each can hold (32 = float, EXR 16 = half).
+struct FormatInfo {
+  const char* extension;
+  bool bits8, bits16, bits32;
+};
+constexpr FormatInfo kFormats[] = {
+    {".png", true, true, false},
+    {".tif", true, true, true},
+    {".tiff", true, true, true},
+    {".exr", false, true, true},
+};
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+const FormatInfo* find_format(const std::string& ext) {
+  for (const FormatInfo& f : kFormats)
+    if (ext == f.extension) return &f;
+  return nullptr;
+}
+
+// OpenImageIO messages may span lines; our errors are printed as one line.
+std::string one_line(std::string s) {
+  for (char& c : s)
+    if (c == '\n' || c == '\r') c = ' ';
+  while (!s.empty() && s.back() == ' ') s.pop_back();
+  return s.empty() ? std::string("unknown error") : s;
+}
+
+// value * scale rounded half away from zero, clamped to [0, scale]; NaN becomes 0.
+template <typename T>
+std::vector<T> quantize(const std::vector<float>& values, double scale) {
+  std::vector<T> out(values.size());
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    double v = std::round(static_cast<double>(values[i]) * scale);  // std::round: half away from 0
+    if (!(v > 0.0)) v = 0.0;
+    if (v > scale) v = scale;
+    out[i] = static_cast<T>(v);
+  }
+  return out;
+}
+
+std::string temp_path_for(const fs::path& target) {
+  static std::atomic<unsigned> counter{0};
+  std::string name = "." + target.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
+                     std::to_string(counter++) + target.extension().string();
+  return (target.parent_path() / name).string();
+}
+
+[[noreturn]] void fail_write(const std::string& path, const std::string& reason) {
+  throw OutputError(path + ": cannot write: " + reason);
+}
+
+}  // namespace
+
+int default_bits_for(const std::string& path) {
+  const std::string ext = lower_extension(path);
+  if (ext == ".tif" || ext == ".tiff") return 16;
+  if (ext == ".exr") return 32;
+  return 8;
+}
+
+void check_output_format(const std::string& path, int bits) {
+  const std::string ext = lower_extension(path);
+  const FormatInfo* f = find_format(ext);
+  if (!f)
+    throw UsageError(path + ": unsupported image format '" + ext +
+                     "' (use .png, .tif, .tiff or .exr)");
+  if (bits == 0) return;
+  bool ok = (bits == 8 && f->bits8) || (bits == 16 && f->bits16) || (bits == 32 && f->bits32);
+  if (!ok) {
+    std::string can;
+    if (f->bits8) can += "8";
+    if (f->bits16) can += std::string(can.empty() ? "" : ", ") + "16";
+    if (f->bits32) can += std::string(can.empty() ? "" : ", ") + "32";
+    throw UsageError(path + ": " + ext + " cannot hold " + std::to_string(bits) +
+                     "-bit values (supported: " + can + ")");
+  }
+}
+
+void write_image(const std::string& path, const Image& image, const WriteOptions& options) {
+  const int bits = options.bits ? options.bits : default_bits_for(path);
+  check_output_format(path, bits);
+  assert(image.pixels.size() == static_cast<std::size_t>(image.width) * image.height * image.channels);
+  if (image.width <= 0 || image.height <= 0 || image.channels <= 0)
+    fail_write(path, "empty image (" + std::to_string(image.width) + "x" +
+                         std::to_string(image.height) + "x" + std::to_string(image.channels) + ")");
+
+  // Check the folder first: OpenImageIO would only name the temporary file.
+  const fs::path target(path);
+  const fs::path folder = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec)) fail_write(path, "folder '" + folder.string() + "' does not exist");
+  if (::access(folder.c_str(), W_OK) != 0)
+    fail_write(path, "folder '" + folder.string() + "' is not writable (" + std::strerror(errno) + ")");
+
+  // Pixels in the stored type: integer formats are quantized here, float goes through as is
+  // (OpenImageIO converts float to half for EXR 16).
+  OIIO::TypeDesc stored = OIIO::TypeDesc::FLOAT;
+  OIIO::TypeDesc given = OIIO::TypeDesc::FLOAT;
+  std::vector<std::uint8_t> data8;
+  std::vector<std::uint16_t> data16;
+  const void* data = image.pixels.data();
+  if (bits == 8) {
+    data8 = quantize<std::uint8_t>(image.pixels, 255.0);
+    stored = given = OIIO::TypeDesc::UINT8;
+    data = data8.data();
+  } else if (bits == 16 && lower_extension(path) != ".exr") {
+    data16 = quantize<std::uint16_t>(image.pixels, 65535.0);
+    stored = given = OIIO::TypeDesc::UINT16;
+    data = data16.data();
+  } else if (bits == 16) {
+    stored = OIIO::TypeDesc::HALF;
+  }
+
+  OIIO::ImageSpec spec(image.width, image.height, image.channels, stored);
+  // Alpha is coverage, not premultiplication: keep colour values exactly as given.
+  spec.attribute("oiio:UnassociatedAlpha", 1);
+  for (const auto& [key, value] : options.metadata) spec.attribute(key, value);
+  // The TIFF writer drops attributes it does not know; keep them readable in the description tag.
+  const std::string ext = lower_extension(path);
+  if ((ext == ".tif" || ext == ".tiff") && !options.metadata.empty() &&
+      spec.get_string_attribute("ImageDescription").empty()) {
+    std::string description;
+    for (const auto& [key, value] : options.metadata)
+      description += (description.empty() ? "" : "; ") + key + "=" + value;
+    spec.attribute("ImageDescription", description);
+  }
+
+  // Create with the real path so the writer is chosen by its extension.
+  auto out = OIIO::ImageOutput::create(path);
+  if (!out) fail_write(path, one_line(OIIO::geterror()));
+
+  const std::string temp = temp_path_for(target);
+  auto discard = [&](const std::string& reason) {
+    std::error_code ignored;
+    fs::remove(temp, ignored);
+    fail_write(path, reason);
+  };
+  if (!out->open(temp, spec)) {
+    std::string reason = one_line(out->geterror());
+    out.reset();
+    discard(reason);
+  }
+  if (!out->write_image(given, data)) {
+    std::string reason = one_line(out->geterror());
+    out->close();
+    out.reset();
+    discard(reason);
+  }
+  if (!out->close()) {
+    std::string reason = one_line(out->geterror());
+    out.reset();
+    discard(reason);
+  }
+  out.reset();
+  if (std::rename(temp.c_str(), path.c_str()) != 0) {
+    std::string reason = std::strerror(errno);
+    if (fs::is_directory(target, ec)) reason = "a folder of that name exists";
+    discard(reason);
+  }
+}
+
+Image read_image(const std::string& path) {
+  auto fail = [&](const std::string& reason) -> Image {
+    throw InputError(path + ": cannot read image: " + reason);
+  };
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return fail("no such file");
+  if (fs::is_directory(path, ec)) return fail("it is a folder");
+
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);  // alpha is coverage: do not premultiply
+  auto in = OIIO::ImageInput::open(path, &config);
+  if (!in) return fail(one_line(OIIO::geterror()));
+
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.deep) return fail("deep images are not supported");
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth != 1)
+    return fail("unsupported size " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                "x" + std::to_string(spec.depth) + " with " + std::to_string(spec.nchannels) +
+                " channels");
+  const double count = double(spec.width) * spec.height * spec.nchannels;
+  if (count > double(std::numeric_limits<std::int32_t>::max()))
+    throw ResourceError(path + ": image too large (" + std::to_string(spec.width) + "x" +
+                        std::to_string(spec.height) + "x" + std::to_string(spec.nchannels) + ")");
+
+  Image image;
+  try {
+    image = Image(spec.width, spec.height, spec.nchannels);
+  } catch (const std::bad_alloc&) {
+    throw ResourceError(path + ": out of memory reading a " + std::to_string(spec.width) + "x" +
+                        std::to_string(spec.height) + " image");
+  }
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data()))
+    return fail(one_line(in->geterror()));
+  in->close();
+  return image;
+}
+
+}  // namespace nmbake

@@ -1,0 +1,33 @@
+// Reading and writing images through OpenImageIO: the only code that includes OpenImageIO.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "image.h"
+
+namespace nmbake {
+
+// Bit depth implied by a file name: .png -> 8, .tif/.tiff -> 16, .exr -> 32 (float), others 8.
+int default_bits_for(const std::string& path);
+
+// Throws UsageError when the extension is not one OpenImageIO can write, or the format cannot hold
+// `bits` (8, 16 or 32; 32 means float: EXR and TIFF only; EXR with 16 is half float).
+void check_output_format(const std::string& path, int bits);
+
+struct WriteOptions {
+  int bits = 0;  // 8, 16 or 32 (float); 0 = default_bits_for(path)
+  std::vector<std::pair<std::string, std::string>> metadata;  // written as string attributes
+};
+
+// Writes `image` (values in [0,1] for integer formats, rounded to nearest) to a temporary file in
+// the same folder and renames it into place, so `path` is either the old file or the complete new
+// one. Throws OutputError (file named) when it cannot be written.
+void write_image(const std::string& path, const Image& image, const WriteOptions& options = {});
+
+// Reads any format OpenImageIO reads, converted to float (integer formats scaled to [0,1]).
+// Throws InputError naming the file when it cannot be read.
+Image read_image(const std::string& path);
+
+}  // namespace nmbake

@@ -1,0 +1,266 @@
+// nmbake: the command line. Parses arguments and wires the stages together; nothing else.
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <new>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include <CLI/CLI.hpp>
+
+#include "bake.h"
+#include "errors.h"
+#include "image_io.h"
+#include "mesh_io.h"
+#include "report.h"
+
+namespace {
+
+using namespace nmbake;
+using Clock = std::chrono::steady_clock;
+
+std::atomic<bool> g_interrupted{false};
+extern "C" void on_sigint(int) { g_interrupted = true; }
+
+const char* kExitCodes =
+    "Exit codes:\n"
+    "  0  success\n"
+    "  1  bad command line\n"
+    "  2  unreadable or invalid input\n"
+    "  3  output could not be written\n"
+    "  4  out of memory or refused size\n"
+    "  130 interrupted (no output written)\n";
+
+struct Args {
+  std::string low, high, output, cage, miss_mask, report;
+  std::string size = "2048";
+  int samples = 1;
+  double front = -1.0, rear = -1.0;
+  std::string policy = "cage-first", space = "tangent", green = "up", bitangent = "pixel";
+  int bits = 0;
+  int padding = 16;
+  int threads = 0;
+  bool quiet = false;
+};
+
+void parse_size(const std::string& text, int& w, int& h) {
+  auto parse_side = [&](const std::string& s) -> long long {
+    if (s.empty() || s.size() > 12 || s.find_first_not_of("0123456789") != std::string::npos)
+      throw UsageError("--size: expected N or WxH with whole numbers, got '" + text + "'");
+    return std::stoll(s);
+  };
+  const auto x = text.find_first_of("xX");
+  const long long a = parse_side(x == std::string::npos ? text : text.substr(0, x));
+  const long long b = x == std::string::npos ? a : parse_side(text.substr(x + 1));
+  if (a < 1 || b < 1) throw UsageError("--size must be at least 1 texel per side, got '" + text + "'");
+  if (a > 65536 || b > 65536)
+    throw ResourceError("--size " + text + " refused: the largest supported side is 65536 texels");
+  w = int(a);
+  h = int(b);
+}
+
+std::string human(double v) {
+  char buf[32];
+  if (v >= 1e9) std::snprintf(buf, sizeof buf, "%.2fG", v / 1e9);
+  else if (v >= 1e6) std::snprintf(buf, sizeof buf, "%.2fM", v / 1e6);
+  else if (v >= 1e3) std::snprintf(buf, sizeof buf, "%.1fk", v / 1e3);
+  else std::snprintf(buf, sizeof buf, "%.0f", v);
+  return buf;
+}
+
+// Fails early, before a long bake, when the output cannot be created where asked.
+void check_output_path(const std::string& path, const char* what) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) throw OutputError(path + ": cannot write " + what + ": it is a directory");
+  fs::path dir = fs::path(path).parent_path();
+  if (dir.empty()) dir = ".";
+  if (!fs::is_directory(dir, ec)) throw OutputError(path + ": cannot write " + what + ": folder " + dir.string() + " does not exist");
+  if (::access(dir.c_str(), W_OK) != 0) throw OutputError(path + ": cannot write " + what + ": folder " + dir.string() + " is not writable");
+}
+
+class ProgressBar {
+ public:
+  explicit ProgressBar(bool enabled) : enabled_(enabled) {}
+  bool update(double f) {
+    if (g_interrupted) return false;
+    if (!enabled_) return true;
+    const int pct = int(f * 100.0);
+    if (pct == last_) return true;
+    last_ = pct;
+    const int width = 40, filled = int(f * width);
+    std::fprintf(stderr, "\rbaking [%s%s] %3d%%", std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(), pct);
+    if (pct >= 100) std::fprintf(stderr, "\r%*s\r", width + 16, "");
+    std::fflush(stderr);
+    return true;
+  }
+
+ private:
+  bool enabled_;
+  int last_ = -1;
+};
+
+int run(int argc, char** argv) {
+  Args a;
+  CLI::App app{"nmbake: bake a tangent-space normal map from a high-poly mesh onto a low-poly mesh with UVs.", "nmbake"};
+  app.footer(std::string("\nInputs: OBJ, PLY (ascii/binary), OFF, STL. The low-poly must have UVs.\n"
+                         "Maps use the OpenGL convention (green = +bitangent, \"Y+\") unless --green down;\n"
+                         "tangent frames follow MikkTSpace (Blender, glTF, Substance, Unity, Unreal).\n\n") + kExitCodes);
+  app.get_formatter()->column_width(34);
+  app.add_option("low", a.low, "Low-poly mesh with UVs")->required();
+  app.add_option("high", a.high, "High-poly mesh (UVs not needed)")->required();
+  app.add_option("-o,--output", a.output, "Output map: .png (8-bit), .tif (16-bit), .exr (float)")->required();
+  app.add_option("--size", a.size, "Map size N or WxH in texels (default 2048)");
+  app.add_option("--samples", a.samples, "Sample points per texel, 1-1024 (default 1)");
+  app.add_option("--front", a.front, "Ray start distance outside the low-poly, scene units (default: measured)");
+  app.add_option("--rear", a.rear, "Ray reach inside the low-poly, scene units (default: measured)");
+  app.add_option("--cage", a.cage, "Cage mesh with the low-poly's topology: rays go from cage to low-poly");
+  app.add_option("--policy", a.policy, "cage-first (default) or closest")->check(CLI::IsMember({"cage-first", "closest"}));
+  app.add_option("--space", a.space, "tangent (default) or object")->check(CLI::IsMember({"tangent", "object"}));
+  app.add_option("--green", a.green, "up = OpenGL/Blender/glTF (default), down = DirectX/Unreal")->check(CLI::IsMember({"up", "down"}));
+  app.add_option("--bitangent", a.bitangent, "pixel = B from interpolated N,T (MikkTSpace, default); vertex = interpolated B")
+      ->check(CLI::IsMember({"pixel", "vertex"}));
+  app.add_option("--bits", a.bits, "8, 16 or 32 (float); default from the extension")->check(CLI::IsMember({8, 16, 32}));
+  app.add_option("--padding", a.padding, "Edge padding around UV islands in texels (default 16)");
+  app.add_option("--miss-mask", a.miss_mask, "Write an image of the share of missed rays per texel");
+  app.add_option("--report", a.report, "Write a JSON report of options, timings and counts");
+  app.add_option("--threads", a.threads, "Worker threads (default: all cores)");
+  app.add_flag("--quiet", a.quiet, "No progress bar and no summary line");
+  app.set_version_flag("--version", std::string("nmbake ") + NMBAKE_VERSION);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    throw UsageError(e.what());
+  }
+
+  const auto start = Clock::now();
+  BakeOptions o;
+  parse_size(a.size, o.width, o.height);
+  if (a.samples < 1 || a.samples > 1024) throw UsageError("--samples must be between 1 and 1024, got " + std::to_string(a.samples));
+  if (a.padding < 0 || a.padding > 65536) throw UsageError("--padding must be between 0 and 65536, got " + std::to_string(a.padding));
+  if (a.threads < 0 || a.threads > 1024) throw UsageError("--threads must be between 0 and 1024, got " + std::to_string(a.threads));
+  auto check_distance = [](double d, const char* name) {
+    if (d != -1.0 && !(d >= 0.0 && d < 1e30)) throw UsageError(std::string(name) + " must be a distance >= 0 in scene units");
+  };
+  check_distance(a.front, "--front");
+  check_distance(a.rear, "--rear");
+  if (a.space == "object" && a.green == "down") throw UsageError("--green down applies to tangent-space maps only");
+  o.samples = a.samples;
+  o.front = float(a.front);
+  o.rear = float(a.rear);
+  o.policy = a.policy == "closest" ? RayPolicy::closest : RayPolicy::cage_first;
+  o.space = a.space == "object" ? NormalSpace::object : NormalSpace::tangent;
+  o.green_down = a.green == "down";
+  o.bitangent = a.bitangent == "vertex" ? BitangentMode::per_vertex : BitangentMode::per_pixel;
+  o.padding = a.padding;
+  o.threads = a.threads;
+  o.miss_mask = !a.miss_mask.empty();
+  const int bits = a.bits ? a.bits : default_bits_for(a.output);
+  check_output_path(a.output, "the map");
+  if (!a.miss_mask.empty()) check_output_path(a.miss_mask, "the miss mask");
+  if (!a.report.empty()) check_output_path(a.report, "the report");
+  check_output_format(a.output, bits);
+  if (!a.miss_mask.empty()) check_output_format(a.miss_mask, default_bits_for(a.miss_mask));
+
+  std::signal(SIGINT, on_sigint);
+  const bool tty = !a.quiet && ::isatty(STDERR_FILENO);
+
+  // Load.
+  RunInfo run;
+  run.low_path = a.low;
+  run.high_path = a.high;
+  run.cage_path = a.cage;
+  run.output_path = a.output;
+  run.miss_mask_path = a.miss_mask;
+  run.bits = bits;
+  auto t0 = Clock::now();
+  LoadOptions low_opts;
+  low_opts.require_uvs = true;
+  Mesh low = load_mesh(a.low, low_opts, &run.low_info);
+  Mesh high = load_mesh(a.high, {}, &run.high_info);
+  Mesh cage;
+  if (!a.cage.empty()) cage = load_mesh(a.cage, {}, &run.cage_info);
+  run.seconds_load = std::chrono::duration<double>(Clock::now() - t0).count();
+  if (g_interrupted) throw Cancelled();
+
+  ProgressBar bar(tty);
+  o.progress = [&](double f) { return bar.update(f); };
+  BakeResult r = bake_normal_map(low, high, a.cage.empty() ? nullptr : &cage, o);
+  const BakeStats& s = r.stats;
+  if (s.auto_distances && !a.quiet)
+    std::fprintf(stderr, "nmbake: ray distances measured: --front %.6g --rear %.6g (%.2f%% of probes lie beyond)\n", s.front, s.rear,
+                 100.0 * s.auto_probe_beyond);
+  if (!a.quiet && s.uv_outside_triangles)
+    std::fprintf(stderr, "nmbake: warning: %s: %zu triangles have UVs outside [0,1]; only the part inside the map is baked\n",
+                 a.low.c_str(), s.uv_outside_triangles);
+  if (!a.quiet && s.overlapping_samples)
+    std::fprintf(stderr, "nmbake: warning: %s: UV islands overlap (%llu samples covered twice; the lower face number wins)\n",
+                 a.low.c_str(), (unsigned long long)s.overlapping_samples);
+  if (g_interrupted) throw Cancelled();
+
+  // Write.
+  t0 = Clock::now();
+  WriteOptions wo;
+  wo.bits = bits;
+  wo.metadata = {{"nmbake:space", to_string(o.space)},
+                 {"nmbake:green", o.green_down ? "down" : "up"},
+                 {"nmbake:tangent_basis", "mikktspace"},
+                 {"nmbake:version", NMBAKE_VERSION},
+                 {"ImageDescription", std::string(o.space == NormalSpace::object ? "object-space normal map" : "tangent-space normal map, ") +
+                                          (o.space == NormalSpace::object ? "" : (o.green_down ? "DirectX (Y-)" : "OpenGL (Y+)")) +
+                                          ", baked by nmbake"}};
+  write_image(a.output, r.map, wo);
+  if (!a.miss_mask.empty()) {
+    WriteOptions mo;
+    mo.bits = default_bits_for(a.miss_mask);
+    write_image(a.miss_mask, r.miss_mask, mo);
+  }
+  run.seconds_write = std::chrono::duration<double>(Clock::now() - t0).count();
+  run.seconds_total = std::chrono::duration<double>(Clock::now() - start).count();
+  run.peak_memory_bytes = peak_memory_bytes();
+  run.threads_used = a.threads > 0 ? unsigned(a.threads) : std::max(1u, std::thread::hardware_concurrency());
+  if (!a.report.empty()) write_text_atomically(a.report, make_report(o, s, run).dump(2) + "\n");
+
+  if (!a.quiet) {
+    std::printf(
+        "nmbake: wrote %s (%dx%d, %d-bit, %s%s): samples %d, rays %s, misses %llu (%.2f%%), coverage %.1f%%, "
+        "seconds: load %.2f prepare %.2f bvh %.2f distances %.2f trace %.2f padding %.2f write %.2f total %.2f\n",
+        a.output.c_str(), o.width, o.height, bits, to_string(o.space),
+        o.space == NormalSpace::tangent ? (o.green_down ? ", green down" : ", green up") : "", o.samples, human(double(s.rays)).c_str(),
+        (unsigned long long)s.misses, s.samples_covered ? 100.0 * double(s.misses) / double(s.samples_covered) : 0.0, 100.0 * s.coverage,
+        run.seconds_load, s.seconds_prepare, s.seconds_bvh, s.seconds_distances, s.seconds_trace, s.seconds_padding, run.seconds_write,
+        run.seconds_total);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const nmbake::Cancelled&) {
+    std::fprintf(stderr, "error: interrupted; no output written\n");
+    return 130;
+  } catch (const nmbake::Error& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return int(e.code());
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "error: out of memory\n");
+    return int(nmbake::ExitCode::memory);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 2;
+  }
+}

@@ -1,0 +1,62 @@
+// The in-memory triangle mesh every stage works on: flat arrays, no OpenMesh types.
+//
+// Coordinates are object space exactly as in the file (never rotated or rescaled). Attributes are
+// indexed per corner, like OBJ: corner c of triangle t uses positions[position_index[3t+c]],
+// normals[normal_index[3t+c]] and uvs[uv_index[3t+c]], so split normals (hard edges) and UV seams
+// are kept. Triangles are counter-clockwise seen from the front. UVs follow the OBJ convention:
+// v = 0 at the bottom of the image, v = 1 at the top.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace nmbake {
+
+struct Mesh {
+  std::string source;  // file name, used in messages ("low.obj: face 3 ...")
+
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> normals;  // unit length when present
+  std::vector<glm::vec2> uvs;
+
+  std::vector<std::uint32_t> position_index;  // 3 per triangle
+  std::vector<std::uint32_t> normal_index;    // 3 per triangle, or empty when the mesh has no normals
+  std::vector<std::uint32_t> uv_index;        // 3 per triangle, or empty when the mesh has no UVs
+
+  // Face number in the file for each triangle (a polygon's fan triangles share it), for messages.
+  std::vector<std::uint32_t> source_face;
+
+  std::size_t triangle_count() const { return position_index.size() / 3; }
+  bool has_normals() const { return !normal_index.empty(); }
+  bool has_uvs() const { return !uv_index.empty(); }
+
+  glm::vec3 corner_position(std::size_t tri, int corner) const {
+    return positions[position_index[3 * tri + corner]];
+  }
+  glm::vec2 corner_uv(std::size_t tri, int corner) const { return uvs[uv_index[3 * tri + corner]]; }
+  glm::vec3 corner_normal(std::size_t tri, int corner) const {
+    return normals[normal_index[3 * tri + corner]];
+  }
+};
+
+// What loading found and repaired, for the report.
+struct MeshLoadInfo {
+  std::size_t file_faces = 0;           // faces as written in the file
+  std::size_t polygons_triangulated = 0;  // faces with more than 3 corners, fanned into triangles
+  std::size_t normals_renormalized = 0;   // file normals that were not unit length
+  std::size_t zero_normals = 0;           // file normals of length ~0 (replaced by computed ones)
+  std::string format;                     // "obj", "ply-binary", "ply-ascii", "off", "stl"
+  // The file's normals (or UVs) were discarded because only some faces had them, or (normals) one
+  // had length ~0; normal_index (uv_index) is then empty and normals get computed later.
+  bool normals_dropped = false;
+  bool uvs_dropped = false;
+  std::size_t faces_without_normals = 0;     // counted when only some faces had normals
+  std::size_t faces_without_uvs = 0;         // counted when only some faces had UVs
+  std::size_t degenerate_faces_dropped = 0;  // STL facets whose corners welded together (OpenMesh drops them)
+};
+
+}  // namespace nmbake

@@ -1,0 +1,23 @@
+// Loading meshes from OBJ, PLY (ascii and binary), OFF and STL. The only code that includes
+// OpenMesh.
+//
+// Every error in the file throws InputError with the file name and the element, e.g.
+// "high.ply: vertex 17 has a non-finite coordinate" or "low.obj: line 812: face index 9001 out of
+// range (8000 vertices)". Polygons are fanned into triangles. Nothing is rescaled.
+#pragma once
+
+#include <string>
+
+#include "mesh.h"
+
+namespace nmbake {
+
+struct LoadOptions {
+  bool require_uvs = false;  // throw "<file>: face N has no UVs" when any face lacks them
+};
+
+// Reads `path`. Throws InputError on a missing, empty, unreadable or invalid file (no faces,
+// non-finite coordinates, indices out of range, truncated binary data, ...).
+Mesh load_mesh(const std::string& path, const LoadOptions& options = {}, MeshLoadInfo* info = nullptr);
+
+}  // namespace nmbake

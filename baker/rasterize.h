@@ -1,0 +1,42 @@
+// Rasterization of a mesh's UV layout at texel sample points.
+//
+// Texel (x, y) of a W x H image has its centre at u = (x + 0.5) / W, v = 1 - (y + 0.5) / H
+// (row 0 is the top, v = 1). A sample at offset (ox, oy) in [0,1)^2 inside the texel lies at
+// u = (x + ox) / W, v = 1 - (y + oy) / H. Coverage uses exact edge functions in double precision
+// with a tie rule that gives a point on an edge shared by two triangles to exactly one of them,
+// so shared UV edges leave no cracks and count nothing twice. UV-degenerate triangles (zero area)
+// cover nothing. Where UV islands overlap, the triangle with the lowest index wins.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "mesh.h"
+
+namespace nmbake {
+
+// Edge setup of one triangle in texel space (x right, y down, in texels).
+struct TexelTriangle {
+  glm::dvec2 p[3];        // corners in texel space
+  double area2 = 0.0;     // twice the signed area in texel space (0: degenerate, covers nothing)
+  int xmin = 0, xmax = -1, ymin = 0, ymax = -1;  // inclusive texel bounding box, clipped to image
+  bool valid() const { return area2 != 0.0; }
+};
+
+TexelTriangle setup_texel_triangle(glm::vec2 uv0, glm::vec2 uv1, glm::vec2 uv2, int width, int height);
+
+// True when sample point q (texel space) is covered; then bary receives the weights of corners
+// 0, 1, 2 (they sum to 1 and are each in [0,1]).
+bool covers(const TexelTriangle& tri, glm::dvec2 q, double bary[3]);
+
+// Texel-space position of sample (ox, oy) of texel (x, y).
+inline glm::dvec2 sample_point(int x, int y, double ox, double oy) { return {x + ox, y + oy}; }
+
+// Per texel (row-major from the top), the index of the triangle covering its centre, or -1.
+// `overlaps` (optional) receives the number of texel centres covered by more than one triangle.
+std::vector<std::int32_t> rasterize_texel_triangles(const Mesh& mesh, int width, int height,
+                                                    std::size_t* overlaps = nullptr);
+
+}  // namespace nmbake

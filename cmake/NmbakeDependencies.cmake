@@ -1,0 +1,24 @@
+# Every dependency is a Debian 12 package; scripts/setup.sh installs them.
+macro(nmbake_require _pkg _deb)
+  find_package(${_pkg} ${ARGN} QUIET)
+  if(NOT ${_pkg}_FOUND)
+    message(FATAL_ERROR "nmbake: ${_pkg} not found. Install the Debian package '${_deb}' (scripts/setup.sh does this).")
+  endif()
+endmacro()
+
+nmbake_require(embree libembree-dev 3.13)
+nmbake_require(OpenMesh libopenmesh-dev)
+# Debian's OpenImageIOConfig.cmake names /usr/include/opencv4 as an include folder even when
+# OpenCV is not installed, which breaks every target linking it; use its pkg-config file instead.
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(OIIO QUIET IMPORTED_TARGET OpenImageIO)
+if(NOT OIIO_FOUND)
+  message(FATAL_ERROR "nmbake: OpenImageIO not found. Install the Debian package 'libopenimageio-dev' (scripts/setup.sh does this).")
+endif()
+add_library(nmbake_oiio INTERFACE)
+add_library(nmbake::oiio ALIAS nmbake_oiio)
+target_link_libraries(nmbake_oiio INTERFACE PkgConfig::OIIO)
+nmbake_require(glm libglm-dev)
+nmbake_require(nlohmann_json nlohmann-json3-dev)
+nmbake_require(CLI11 libcli11-dev)
+find_package(Threads REQUIRED)

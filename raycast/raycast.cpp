@@ -1,0 +1,151 @@
+#include "raycast.h"
+
+#include <embree3/rtcore.h>
+
+#include <algorithm>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+namespace nmbake::raycast {
+
+namespace {
+
+void throw_on_error(void* /*user*/, RTCError code, const char* message) {
+  throw std::runtime_error(std::string("embree: error ") + std::to_string(int(code)) + ": " +
+                           (message ? message : ""));
+}
+
+RTCBuildQuality to_embree(BuildQuality q) {
+  switch (q) {
+    case BuildQuality::low: return RTC_BUILD_QUALITY_LOW;
+    case BuildQuality::high: return RTC_BUILD_QUALITY_HIGH;
+    default: return RTC_BUILD_QUALITY_MEDIUM;
+  }
+}
+
+// Embree reports errors through the callback; after a failed call the callback has already thrown,
+// but device creation happens before any callback exists, so check it by hand.
+void check_device(RTCDevice device) {
+  if (!device) throw std::runtime_error("embree: cannot create a device (error " +
+                                        std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
+}
+
+}  // namespace
+
+struct Scene::Impl {
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  std::size_t triangles = 0;
+
+  ~Impl() {
+    if (scene) rtcReleaseScene(scene);
+    if (device) rtcReleaseDevice(device);
+  }
+};
+
+Scene::Scene(const float* positions, std::size_t vertex_count, const std::uint32_t* indices,
+             std::size_t triangle_count, BuildQuality quality, int threads)
+    : impl_(std::make_unique<Impl>()) {
+  std::string config = threads > 0 ? "threads=" + std::to_string(threads) : std::string();
+  impl_->device = rtcNewDevice(config.empty() ? nullptr : config.c_str());
+  check_device(impl_->device);
+  rtcSetDeviceErrorFunction(impl_->device, throw_on_error, nullptr);
+  impl_->triangles = triangle_count;
+
+  impl_->scene = rtcNewScene(impl_->device);
+  // Robust: coincident and touching triangles must not lose hits to fast approximations.
+  rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
+  rtcSetSceneBuildQuality(impl_->scene, to_embree(quality));
+
+  RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+  rtcSetGeometryBuildQuality(geom, to_embree(quality));
+  // Embree reads vertices with 16-byte loads: its own buffers carry the padding it needs.
+  auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                         3 * sizeof(float), vertex_count));
+  std::memcpy(vb, positions, vertex_count * 3 * sizeof(float));
+  auto* ib = static_cast<std::uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                 3 * sizeof(std::uint32_t), triangle_count));
+  std::memcpy(ib, indices, triangle_count * 3 * sizeof(std::uint32_t));
+  rtcCommitGeometry(geom);
+  rtcAttachGeometry(impl_->scene, geom);
+  rtcReleaseGeometry(geom);
+  rtcCommitScene(impl_->scene);
+}
+
+Scene::~Scene() = default;
+
+std::size_t Scene::triangle_count() const { return impl_->triangles; }
+
+Hit Scene::intersect(const Ray& ray) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit rh;
+  rh.ray.org_x = ray.origin.x;
+  rh.ray.org_y = ray.origin.y;
+  rh.ray.org_z = ray.origin.z;
+  rh.ray.tnear = ray.tnear;
+  rh.ray.dir_x = ray.direction.x;
+  rh.ray.dir_y = ray.direction.y;
+  rh.ray.dir_z = ray.direction.z;
+  rh.ray.time = 0.0f;
+  rh.ray.tfar = ray.tfar;
+  rh.ray.mask = 0xffffffffu;
+  rh.ray.id = 0;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(impl_->scene, &context, &rh);
+  Hit h;
+  if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
+    h.triangle = rh.hit.primID;
+    h.t = rh.ray.tfar;
+    h.u = rh.hit.u;
+    h.v = rh.hit.v;
+  }
+  return h;
+}
+
+void Scene::intersect(const Ray* rays, Hit* hits, std::size_t count) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  alignas(32) RTCRayHit8 rh;
+  alignas(32) int valid[8];
+  for (std::size_t base = 0; base < count; base += 8) {
+    const std::size_t n = std::min<std::size_t>(8, count - base);
+    for (std::size_t k = 0; k < 8; ++k) {
+      const Ray& r = rays[base + std::min(k, n - 1)];
+      valid[k] = k < n ? -1 : 0;
+      rh.ray.org_x[k] = r.origin.x;
+      rh.ray.org_y[k] = r.origin.y;
+      rh.ray.org_z[k] = r.origin.z;
+      rh.ray.tnear[k] = r.tnear;
+      rh.ray.dir_x[k] = r.direction.x;
+      rh.ray.dir_y[k] = r.direction.y;
+      rh.ray.dir_z[k] = r.direction.z;
+      rh.ray.time[k] = 0.0f;
+      rh.ray.tfar[k] = r.tfar;
+      rh.ray.mask[k] = 0xffffffffu;
+      rh.ray.id[k] = unsigned(k);
+      rh.ray.flags[k] = 0;
+      rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect8(valid, impl_->scene, &context, &rh);
+    for (std::size_t k = 0; k < n; ++k) {
+      Hit& h = hits[base + k];
+      if (rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID) {
+        h.triangle = rh.hit.primID[k];
+        h.t = rh.ray.tfar[k];
+        h.u = rh.hit.u[k];
+        h.v = rh.hit.v[k];
+      } else {
+        h = Hit{};
+      }
+    }
+  }
+}
+
+}  // namespace nmbake::raycast

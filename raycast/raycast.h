@@ -1,0 +1,73 @@
+// Ray casting against a triangle mesh: the only code that talks to Embree.
+//
+// Scene owns an Embree device and scene (RAII, non-copyable); Embree errors become
+// std::runtime_error. Positions are copied into Embree's own buffers, so the caller's arrays may
+// go away after construction. Hit barycentrics follow Embree: the hit point is
+// (1 - u - v) * p0 + u * p1 + v * p2 for triangle (p0, p1, p2).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <memory>
+
+#include <glm/glm.hpp>
+
+namespace nmbake::raycast {
+
+struct Ray {
+  glm::vec3 origin{0.0f};
+  float tnear = 0.0f;
+  glm::vec3 direction{0.0f, 0.0f, 1.0f};  // need not be unit; t is in units of |direction|
+  float tfar = std::numeric_limits<float>::infinity();
+};
+
+constexpr std::uint32_t no_hit = 0xffffffffu;
+
+struct Hit {
+  std::uint32_t triangle = no_hit;  // index of the triangle hit, or no_hit
+  float t = 0.0f;                   // ray parameter of the hit
+  float u = 0.0f, v = 0.0f;         // barycentrics of corners 1 and 2
+  bool hit() const { return triangle != no_hit; }
+};
+
+enum class BuildQuality { low, medium, high };
+
+class Scene {
+ public:
+  // positions: vertex_count xyz triples; indices: triangle_count index triples.
+  Scene(const float* positions, std::size_t vertex_count, const std::uint32_t* indices,
+        std::size_t triangle_count, BuildQuality quality = BuildQuality::medium,
+        int threads = 0 /* 0 = all cores */);
+  ~Scene();
+  Scene(const Scene&) = delete;
+  Scene& operator=(const Scene&) = delete;
+
+  // First hit in (tnear, tfar), or no hit. Thread-safe.
+  Hit intersect(const Ray& ray) const;
+  // `count` independent rays, traced as 8-wide packets (rays need not be coherent). Thread-safe.
+  void intersect(const Ray* rays, Hit* hits, std::size_t count) const;
+
+  std::size_t triangle_count() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Brute-force reference: tests every triangle with a watertight double-precision test. For tests
+// only (O(n) per ray).
+class ReferenceIntersector {
+ public:
+  ReferenceIntersector(const float* positions, std::size_t vertex_count, const std::uint32_t* indices,
+                       std::size_t triangle_count);
+  Hit intersect(const Ray& ray) const;
+
+ private:
+  const float* positions_;
+  std::size_t vertex_count_;
+  const std::uint32_t* indices_;
+  std::size_t triangle_count_;
+};
+
+}  // namespace nmbake::raycast

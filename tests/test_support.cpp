@@ -1,0 +1,96 @@
+#include "test_support.h"
+
+#include <cmath>
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
+namespace nmbake::test {
+
+std::string data_path(const std::string& relative) { return std::string(NMBAKE_DATA_DIR) + "/" + relative; }
+
+std::string shared_data_path(const std::string& relative) {
+  return std::string(NMBAKE_SHARED_DATA_DIR) + "/" + relative;
+}
+
+bool exists(const std::string& path) { return std::filesystem::exists(path); }
+
+std::string scratch_dir() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  std::string name = info ? std::string(info->test_suite_name()) + "." + info->name() : "scratch";
+  for (char& c : name)
+    if (c == '/') c = '_';
+  std::filesystem::path dir = std::filesystem::path(NMBAKE_BINARY_DIR) / "test-scratch" / name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
+
+Mesh make_grid(int nx, int ny, float x0, float x1, float y0, float y1) {
+  Mesh m;
+  m.source = "grid";
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i) {
+      float s = float(i) / float(nx), t = float(j) / float(ny);
+      m.positions.push_back({x0 + (x1 - x0) * s, y0 + (y1 - y0) * t, 0.0f});
+      m.uvs.push_back({s, t});
+    }
+  m.normals.push_back({0, 0, 1});
+  auto id = [&](int i, int j) { return std::uint32_t(j * (nx + 1) + i); };
+  std::uint32_t face = 0;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i, ++face) {
+      std::uint32_t a = id(i, j), b = id(i + 1, j), c = id(i + 1, j + 1), d = id(i, j + 1);
+      for (std::uint32_t v : {a, b, c, a, c, d}) {
+        m.position_index.push_back(v);
+        m.uv_index.push_back(v);
+        m.normal_index.push_back(0);
+      }
+      m.source_face.push_back(face);
+      m.source_face.push_back(face);
+    }
+  return m;
+}
+
+Mesh make_torus(int nu, int nv, float R, float r) {
+  Mesh m;
+  m.source = "torus";
+  const double pi = 3.14159265358979323846;
+  for (int j = 0; j <= nv; ++j)
+    for (int i = 0; i <= nu; ++i) {
+      const double a = 2 * pi * (i % nu) / nu, b = 2 * pi * (j % nv) / nv;
+      const glm::dvec3 n(std::cos(b) * std::cos(a), std::cos(b) * std::sin(a), std::sin(b));
+      const glm::dvec3 c(R * std::cos(a), R * std::sin(a), 0.0);
+      m.positions.push_back(glm::vec3(c + double(r) * n));
+      m.normals.push_back(glm::vec3(n));
+      m.uvs.push_back({float(i) / float(nu), float(j) / float(nv)});
+    }
+  auto id = [&](int i, int j) { return std::uint32_t(j * (nu + 1) + i); };
+  std::uint32_t face = 0;
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i, ++face) {
+      const std::uint32_t a = id(i, j), b = id(i + 1, j), c = id(i + 1, j + 1), d = id(i, j + 1);
+      for (std::uint32_t v : {a, b, c, a, c, d}) {
+        m.position_index.push_back(v);
+        m.uv_index.push_back(v);
+        m.normal_index.push_back(v);
+      }
+      m.source_face.push_back(face);
+      m.source_face.push_back(face);
+    }
+  return m;
+}
+
+double angle_deg(const glm::dvec3& a, const glm::dvec3& b) {
+  const double la = glm::length(a), lb = glm::length(b);
+  if (la == 0.0 || lb == 0.0) return 0.0;
+  return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b)) * 180.0 / 3.14159265358979323846;
+}
+
+glm::dvec3 decode_rgb(const float* c) {
+  const glm::dvec3 v(2.0 * c[0] - 1.0, 2.0 * c[1] - 1.0, 2.0 * c[2] - 1.0);
+  const double len = glm::length(v);
+  return len > 0.0 ? v / len : v;
+}
+
+}  // namespace nmbake::test

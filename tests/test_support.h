@@ -1,0 +1,48 @@
+// Helpers shared by the test programs: data paths, scratch folders, procedural meshes.
+#pragma once
+
+#include <string>
+
+#include "mesh.h"
+
+namespace nmbake::test {
+
+std::string data_path(const std::string& relative);         // <repo>/data/<relative>
+std::string shared_data_path(const std::string& relative);  // <repo>/../shared/data/<relative>
+bool exists(const std::string& path);
+
+// A fresh empty folder under the build tree, named after the running test.
+std::string scratch_dir();
+
+// A planar grid of nx x ny quads (two triangles each) covering [x0,x1] x [y0,y1] at z = 0,
+// normals +Z, UVs mapping the grid onto [0,1]^2 (u along x, v along y).
+Mesh make_grid(int nx, int ny, float x0 = -1, float x1 = 1, float y0 = -1, float y1 = 1);
+
+// A torus around +Z (major radius R, minor r) with nu x nv quads, analytic normals and UVs
+// u = around the major circle, v = around the tube; seam vertices are bit-identical in position
+// and normal but carry their own UVs.
+Mesh make_torus(int nu, int nv, float R = 1.0f, float r = 0.35f);
+
+// A grid of nx x ny quads over [-1,1]^2 with z = height(x, y) and the given per-vertex normals
+// (normal(x, y) must return a unit vector); UVs map [-1,1]^2 onto [0,1]^2.
+template <typename H, typename N>
+Mesh make_height_field(int nx, int ny, H height, N normal) {
+  Mesh m = make_grid(nx, ny);
+  m.normals.clear();
+  for (std::size_t i = 0; i < m.positions.size(); ++i) {
+    glm::vec3& p = m.positions[i];
+    const double x = p.x, y = p.y;
+    p.z = float(height(x, y));
+    m.normals.push_back(glm::vec3(normal(x, y)));
+  }
+  m.normal_index = m.position_index;
+  return m;
+}
+
+// Angle in degrees between two directions (0 when either is zero).
+double angle_deg(const glm::dvec3& a, const glm::dvec3& b);
+
+// Decodes an encoded map value c in [0,1]^3 to a unit tangent-space vector.
+glm::dvec3 decode_rgb(const float* c);
+
+}  // namespace nmbake::test

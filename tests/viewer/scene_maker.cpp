@@ -1,0 +1,94 @@
+#include "scene_maker.h"
+
+#include <cmath>
+#include <fstream>
+#include <stdexcept>
+
+#include <glm/glm.hpp>
+
+#include "image.h"
+#include "image_io.h"
+
+namespace nmview::test {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+glm::dvec3 sphere_direction(int i, int j, int segments, int rings) {
+  const double theta = kPi * i / rings, phi = 2.0 * kPi * j / segments;
+  return {std::sin(theta) * std::sin(phi), std::cos(theta), std::sin(theta) * std::cos(phi)};
+}
+
+// Faces of the (segments+1) x (rings+1) vertex grid with 1-based OBJ indices, skipping the pole
+// triangles whose two corners are the same point.
+void write_faces(std::ofstream& out, int segments, int rings, bool with_attributes) {
+  auto id = [&](int i, int j) { return i * (segments + 1) + j + 1; };
+  auto corner = [&](int v) {
+    return with_attributes ? std::to_string(v) + "/" + std::to_string(v) + "/" + std::to_string(v) : std::to_string(v);
+  };
+  for (int i = 0; i < rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      const int a = id(i, j), b = id(i + 1, j), c = id(i + 1, j + 1), d = id(i, j + 1);
+      if (i != rings - 1) out << "f " << corner(a) << " " << corner(b) << " " << corner(c) << "\n";
+      if (i != 0) out << "f " << corner(a) << " " << corner(c) << " " << corner(d) << "\n";
+    }
+}
+
+void write_map(const std::string& path, int width, int height, double amplitude) {
+  nmbake::Image map(width, height, 3);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      // Texel centre (baking.md): u = (x + 0.5) / W, v = 1 - (y + 0.5) / H.
+      const double u = (x + 0.5) / width, v = 1.0 - (y + 0.5) / height;
+      const double dhdu = 2 * kPi * 8 * std::cos(2 * kPi * 8 * u) * std::sin(2 * kPi * 4 * v);
+      const double dhdv = 2 * kPi * 4 * std::sin(2 * kPi * 8 * u) * std::cos(2 * kPi * 4 * v);
+      const glm::dvec3 n = glm::normalize(glm::dvec3(-amplitude * dhdu, -amplitude * dhdv, 1.0));
+      float* p = map.at(x, y);
+      for (int c = 0; c < 3; ++c) p[c] = float(n[c] * 0.5 + 0.5);
+    }
+  nmbake::write_image(path, map);
+}
+
+}  // namespace
+
+void write_uv_sphere(const std::string& path, int segments, int rings) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error("cannot write " + path);
+  out.precision(9);
+  for (int i = 0; i <= rings; ++i)
+    for (int j = 0; j <= segments; ++j) {
+      const glm::dvec3 d = sphere_direction(i, j, segments, rings);
+      out << "v " << d.x << " " << d.y << " " << d.z << "\n";
+      out << "vt " << double(j) / segments << " " << 1.0 - double(i) / rings << "\n";
+      out << "vn " << d.x << " " << d.y << " " << d.z << "\n";
+    }
+  write_faces(out, segments, rings, true);
+}
+
+void write_bumpy_sphere(const std::string& path, int segments, int rings) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error("cannot write " + path);
+  out.precision(9);
+  for (int i = 0; i <= rings; ++i)
+    for (int j = 0; j <= segments; ++j) {
+      const glm::dvec3 d = sphere_direction(i, j, segments, rings);
+      const double r = 1.0 + 0.01 * (std::sin(9 * d.x) + std::sin(9 * d.y) + std::sin(9 * d.z));
+      out << "v " << r * d.x << " " << r * d.y << " " << r * d.z << "\n";
+    }
+  write_faces(out, segments, rings, false);
+}
+
+void write_wave_map(const std::string& path, int width, int height) { write_map(path, width, height, 0.01); }
+
+void write_flat_map(const std::string& path, int width, int height) {
+  nmbake::Image map(width, height, 3);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      float* p = map.at(x, y);
+      p[0] = p[1] = 128.0f / 255.0f;
+      p[2] = 1.0f;
+    }
+  nmbake::write_image(path, map);
+}
+
+}  // namespace nmview::test

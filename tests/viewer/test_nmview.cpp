@@ -1,0 +1,313 @@
+// Runs the real nmview (and nmbake for the maps) headless, as CI does: DISPLAY and
+// WAYLAND_DISPLAY unset, LIBGL_ALWAYS_SOFTWARE=1 so that EGL surfaceless renders with llvmpipe even
+// on a machine with a GPU.
+//
+// Golden screenshots live in data/viewer/. NMBAKE_REGENERATE=1 rewrites them (the test then
+// reports itself skipped). On a mismatch the actual image and a difference image (|a-b| x 8) are
+// left in the test's scratch folder and named in the failure.
+//
+// Tolerance of the golden comparison, per 8-bit channel: mean |a-b| <= 0.5 and at most 0.5 % of
+// the pixels off by more than 16. Software rendering is deterministic on one machine, but another
+// Mesa/LLVM version may round shading by a unit or two (FMA contraction, different vector widths)
+// and move a silhouette or wireframe edge by a pixel (rasterization and MSAA sample positions), so
+// few pixels may move a lot and many may move a little; a real rendering change (a wrong sign, a
+// flipped map, a moved light or camera) moves far more than that.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include "image.h"
+#include "image_io.h"
+#include "scene_maker.h"
+#include "test_support.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using nmbake::test::scratch_dir;
+
+struct Result {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void headless_environment() {
+  unsetenv("DISPLAY");
+  unsetenv("WAYLAND_DISPLAY");
+  setenv("LIBGL_ALWAYS_SOFTWARE", "1", 1);
+}
+
+Result run(const std::string& dir, const std::string& program, const std::string& args) {
+  headless_environment();
+  const std::string out = dir + "/stdout.txt", err = dir + "/stderr.txt";
+  const std::string command = quote(program) + " " + args + " >" + quote(out) + " 2>" + quote(err) + " </dev/null";
+  int status = std::system(command.c_str());
+  Result r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+Result nmview(const std::string& dir, const std::string& args) { return run(dir, NMVIEW_EXE, args); }
+
+void bake(const std::string& dir, const std::string& low, const std::string& high, const std::string& map) {
+  Result r = run(dir, NMBAKE_EXE, quote(low) + " " + quote(high) + " -o " + quote(map) + " --size 512 --quiet");
+  ASSERT_EQ(r.exit_code, 0) << "nmbake failed:\n" << r.out << r.err;
+}
+
+struct Summary {
+  double psnr = 0, rmse = 1, within2 = 0;
+};
+
+// The last stdout line of --compare: "psnr=<dB> rmse=<0..1> within2=<fraction>".
+Summary parse_summary(const std::string& out) {
+  std::string text = out;
+  while (!text.empty() && text.back() == '\n') text.pop_back();
+  const std::string last = text.substr(text.rfind('\n') == std::string::npos ? 0 : text.rfind('\n') + 1);
+  char psnr[32] = {};
+  Summary s;
+  EXPECT_EQ(std::sscanf(last.c_str(), "psnr=%31s rmse=%lf within2=%lf", psnr, &s.rmse, &s.within2), 3)
+      << "last line: " << last;
+  s.psnr = std::strtod(psnr, nullptr);
+  return s;
+}
+
+struct Sphere {
+  std::string low, high, map;
+};
+
+Sphere make_sphere_scene(const std::string& dir) {
+  Sphere s{dir + "/sphere_low.obj", dir + "/sphere_high.obj", dir + "/wave_map.png"};
+  nmview::test::write_uv_sphere(s.low, 32, 16);
+  nmview::test::write_bumpy_sphere(s.high, 128, 64);
+  nmview::test::write_wave_map(s.map, 256, 128);
+  return s;
+}
+
+// 8-bit channel values of an image file (RGB).
+std::vector<int> read_rgb8(const std::string& path, int& width, int& height) {
+  nmbake::Image image = nmbake::read_image(path);
+  width = image.width;
+  height = image.height;
+  std::vector<int> v;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x)
+      for (int c = 0; c < 3; ++c) v.push_back(int(std::lround(image.at(x, y)[std::min(c, image.channels - 1)] * 255.0f)));
+  return v;
+}
+
+void expect_matches_golden(const std::string& actual, const std::string& golden_name) {
+  const std::string golden = nmbake::test::data_path("viewer/" + golden_name);
+  if (const char* regen = std::getenv("NMBAKE_REGENERATE"); regen && std::string(regen) == "1") {
+    fs::create_directories(fs::path(golden).parent_path());
+    fs::copy_file(actual, golden, fs::copy_options::overwrite_existing);
+    GTEST_SKIP() << "regenerated " << golden;
+  }
+  ASSERT_TRUE(fs::exists(golden)) << golden << " is missing; run the test with NMBAKE_REGENERATE=1 to create it";
+  int aw = 0, ah = 0, gw = 0, gh = 0;
+  const std::vector<int> a = read_rgb8(actual, aw, ah), g = read_rgb8(golden, gw, gh);
+  ASSERT_EQ(aw, gw);
+  ASSERT_EQ(ah, gh);
+
+  double sum = 0;
+  std::size_t far_pixels = 0;
+  nmbake::Image diff(aw, ah, 3);
+  for (std::size_t p = 0; p < std::size_t(aw) * std::size_t(ah); ++p) {
+    int worst = 0;
+    for (std::size_t c = 0; c < 3; ++c) {
+      int d = std::abs(a[3 * p + c] - g[3 * p + c]);
+      sum += d;
+      worst = std::max(worst, d);
+      diff.pixels[3 * p + c] = std::min(1.0f, float(d) * 8.0f / 255.0f);
+    }
+    if (worst > 16) ++far_pixels;
+  }
+  const double mean = sum / (3.0 * aw * ah);
+  const double far_share = double(far_pixels) / (double(aw) * ah);
+  const bool ok = mean <= 0.5 && far_share <= 0.005;
+  std::string diff_path = actual.substr(0, actual.size() - 4) + "-diff.png";
+  if (!ok) nmbake::write_image(diff_path, diff);
+  EXPECT_TRUE(ok) << actual << " differs from " << golden << ": mean |diff| " << mean << " (limit 0.5), "
+                  << 100.0 * far_share << " % of pixels off by > 16 (limit 0.5 %); difference image x8: " << diff_path
+                  << "; if the change is intended, rerun with NMBAKE_REGENERATE=1";
+}
+
+TEST(NmviewGolden, SphereWithWaveMap) {
+  const std::string dir = scratch_dir();
+  const Sphere s = make_sphere_scene(dir);
+  const std::string shot = dir + "/sphere.png";
+  Result r = nmview(dir, quote(s.low) + " " + quote(s.map) + " " + quote(s.high) + " --screenshot " + quote(shot) +
+                             " --size 480x240 --view 30,20 --light -30,30");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("EGL"), std::string::npos) << r.err;
+  std::cout << r.err;
+  expect_matches_golden(shot, "golden_sphere.png");
+}
+
+TEST(NmviewGolden, SphereWithToggles) {
+  const std::string dir = scratch_dir();
+  const Sphere s = make_sphere_scene(dir);
+  const std::string shot = dir + "/sphere_toggles.png";
+  Result r = nmview(dir, quote(s.low) + " " + quote(s.map) + " " + quote(s.high) + " --screenshot " + quote(shot) +
+                             " --size 720x240 --view -60,35 --light 20,10 --show wire,diff,tangent");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  expect_matches_golden(shot, "golden_sphere_toggles.png");
+}
+
+TEST(NmviewGolden, SphereWithoutMap) {
+  const std::string dir = scratch_dir();
+  const Sphere s = make_sphere_scene(dir);
+  const std::string shot = dir + "/sphere_nomap.png";
+  Result r = nmview(dir, quote(s.low) + " " + quote(s.map) + " " + quote(s.high) + " --screenshot " + quote(shot) +
+                             " --size 480x240 --no-map");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  expect_matches_golden(shot, "golden_sphere_nomap.png");
+}
+
+// A low-poly baked from itself decodes to its own shading: both panes agree.
+void expect_self_bake_matches(const std::string& dir, const std::string& low) {
+  const std::string map = dir + "/self.png";
+  bake(dir, low, low, map);
+  if (::testing::Test::HasFatalFailure()) return;
+  Result r = nmview(dir, quote(low) + " " + quote(map) + " " + quote(low) + " --compare --size 800x400 --screenshot " +
+                             quote(dir + "/worst.png"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Summary s = parse_summary(r.out);
+  std::cout << "self-check " << low << ": " << r.out.substr(r.out.rfind("psnr="));
+  EXPECT_GE(s.psnr, 45.0);
+  EXPECT_LE(s.rmse, 0.006);
+  EXPECT_GE(s.within2, 0.99);
+  EXPECT_TRUE(fs::exists(dir + "/worst.png"));
+}
+
+TEST(NmviewSelfCheck, SphereBakedFromItself) {
+  const std::string dir = scratch_dir();
+  expect_self_bake_matches(dir, make_sphere_scene(dir).low);
+}
+
+TEST(NmviewSelfCheck, TorusLowBakedFromItself) {
+  const std::string low = nmbake::test::shared_data_path("sculpts/torus_demo/low.obj");
+  if (!nmbake::test::exists(low)) GTEST_SKIP() << low << " is absent (../shared not checked out)";
+  expect_self_bake_matches(scratch_dir(), low);
+}
+
+// On a real sculpt the baked map must bring the low-poly's appearance clearly closer to the
+// high-poly's than the bare low-poly.
+TEST(NmviewSculpt, TorusDemoMapImprovesAppearance) {
+  const std::string low = nmbake::test::shared_data_path("sculpts/torus_demo/low.obj");
+  const std::string high = nmbake::test::shared_data_path("sculpts/torus_demo/high.ply");
+  if (!nmbake::test::exists(low) || !nmbake::test::exists(high))
+    GTEST_SKIP() << "sculpts/torus_demo is absent (../shared not checked out)";
+  const std::string dir = scratch_dir(), map = dir + "/torus_map.png";
+  bake(dir, low, high, map);
+  if (::testing::Test::HasFatalFailure()) return;
+  const std::string args = quote(low) + " " + quote(map) + " " + quote(high) + " --compare --size 800x400";
+  Result on = nmview(dir, args + " --screenshot " + quote(dir + "/worst_map_on.png"));
+  ASSERT_EQ(on.exit_code, 0) << on.err;
+  const Summary with_map = parse_summary(on.out);
+  Result off = nmview(dir, args + " --no-map --screenshot " + quote(dir + "/worst_map_off.png"));
+  ASSERT_EQ(off.exit_code, 0) << off.err;
+  const Summary without_map = parse_summary(off.out);
+  std::cout << "torus_demo map on:  psnr=" << with_map.psnr << " rmse=" << with_map.rmse
+            << " within2=" << with_map.within2 << "\n"
+            << "torus_demo map off: psnr=" << without_map.psnr << " rmse=" << without_map.rmse
+            << " within2=" << without_map.within2 << "\n";
+  EXPECT_GE(with_map.psnr, without_map.psnr + 3.0);
+  EXPECT_GT(with_map.within2, without_map.within2);
+}
+
+// --- bad input: the baker's errors, one line, its exit codes -----------------------------------
+
+void expect_error(const Result& r, int code, const std::string& fragment) {
+  EXPECT_EQ(r.exit_code, code) << r.err;
+  EXPECT_EQ(r.err.rfind("error: ", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find(fragment), std::string::npos) << "expected '" << fragment << "' in: " << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+}
+
+TEST(NmviewErrors, MissingMap) {
+  const std::string dir = scratch_dir();
+  const Sphere s = make_sphere_scene(dir);
+  expect_error(nmview(dir, quote(s.low) + " " + quote(dir + "/none.png") + " " + quote(s.high) + " --screenshot " +
+                               quote(dir + "/x.png")),
+               2, "none.png");
+}
+
+TEST(NmviewErrors, MapThatIsNotAnImage) {
+  const std::string dir = scratch_dir();
+  const Sphere s = make_sphere_scene(dir);
+  std::ofstream(dir + "/text.png") << "this is not an image\n";
+  expect_error(nmview(dir, quote(s.low) + " " + quote(dir + "/text.png") + " " + quote(s.high) + " --compare"), 2,
+               "text.png");
+}
+
+TEST(NmviewErrors, GreyMapIsRejected) {
+  const std::string dir = scratch_dir();
+  const Sphere s = make_sphere_scene(dir);
+  nmbake::write_image(dir + "/grey.png", nmbake::Image(16, 16, 1, 0.5f));
+  expect_error(nmview(dir, quote(s.low) + " " + quote(dir + "/grey.png") + " " + quote(s.high) + " --compare"), 2,
+               "needs RGB");
+}
+
+TEST(NmviewErrors, LowPolyWithoutUvs) {
+  const std::string dir = scratch_dir();
+  const Sphere s = make_sphere_scene(dir);
+  expect_error(nmview(dir, quote(s.high) + " " + quote(s.map) + " " + quote(s.high) + " --compare"), 2, "UV");
+}
+
+TEST(NmviewErrors, MissingHighPoly) {
+  const std::string dir = scratch_dir();
+  const Sphere s = make_sphere_scene(dir);
+  expect_error(nmview(dir, quote(s.low) + " " + quote(s.map) + " " + quote(dir + "/nope.ply") + " --compare"), 2,
+               "nope.ply");
+}
+
+TEST(NmviewErrors, BadFlags) {
+  const std::string dir = scratch_dir();
+  const Sphere s = make_sphere_scene(dir);
+  const std::string inputs = quote(s.low) + " " + quote(s.map) + " " + quote(s.high);
+  expect_error(nmview(dir, inputs + " --size 1600by800 --compare"), 1, "--size");
+  expect_error(nmview(dir, inputs + " --view 30 --compare"), 1, "--view");
+  expect_error(nmview(dir, inputs + " --light a,b --compare"), 1, "--light");
+  expect_error(nmview(dir, inputs + " --frobnicate"), 1, "frobnicate");
+  expect_error(nmview(dir, quote(s.low) + " " + quote(s.map)), 1, "high");
+}
+
+TEST(NmviewErrors, WindowWithoutDisplayIsReportedNotCrashed) {
+  const std::string dir = scratch_dir();
+  const Sphere s = make_sphere_scene(dir);
+  expect_error(nmview(dir, quote(s.low) + " " + quote(s.map) + " " + quote(s.high)), 3, "--screenshot");
+}
+
+TEST(NmviewInputs, MapOfAnySizeIsFine) {
+  const std::string dir = scratch_dir();
+  const Sphere s = make_sphere_scene(dir);
+  nmview::test::write_flat_map(dir + "/odd.png", 37, 19);
+  Result r = nmview(dir, quote(s.low) + " " + quote(dir + "/odd.png") + " " + quote(s.low) + " --compare --size 200x100");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_GE(parse_summary(r.out).within2, 0.99);
+}
+
+}  // namespace

@@ -1,0 +1,196 @@
+// Known answers for the viewer's CPU parts: vertex merging, camera, metrics, font, layout.
+#include <cmath>
+#include <set>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <gtest/gtest.h>
+
+#include "font.h"
+#include "metrics.h"
+#include "renderer.h"
+#include "tangent_frames.h"
+#include "test_support.h"
+#include "vertex_data.h"
+#include "view.h"
+
+namespace {
+
+using namespace nmview;
+
+TEST(VertexData, LowVerticesKeepEveryCornerExactly) {
+  nmbake::Mesh grid = nmbake::test::make_grid(3, 2);
+  const nmbake::TangentFrames frames = nmbake::compute_tangent_frames(grid);
+  const glm::vec3 centre(0.5f, -0.25f, 0.0f);
+  const LowVertices v = build_low_vertices(grid, frames, centre);
+  ASSERT_EQ(v.indices.size(), grid.position_index.size());
+  // A flat grid has one frame per position: corners merge to the 4 x 3 grid points.
+  EXPECT_EQ(v.vertices.size(), 12u);
+  for (std::size_t c = 0; c < v.indices.size(); ++c) {
+    const LowVertex& x = v.vertices[v.indices[c]];
+    EXPECT_EQ(x.position, grid.positions[grid.position_index[c]] - centre) << c;
+    EXPECT_EQ(x.normal, frames.normal[c]) << c;
+    EXPECT_EQ(x.tangent, frames.tangent[c]) << c;
+    EXPECT_EQ(x.uv, grid.uvs[grid.uv_index[c]]) << c;
+  }
+}
+
+TEST(VertexData, HighVerticesFastPathAndMergedPath) {
+  nmbake::Mesh grid = nmbake::test::make_grid(2, 2);  // one shared normal: normal_index != position_index
+  const HighVertices merged = build_high_vertices(grid, glm::vec3(0.0f));
+  EXPECT_EQ(merged.vertices.size(), 9u);
+  grid.normals.assign(grid.positions.size(), glm::vec3(0, 0, 1));
+  grid.normal_index = grid.position_index;
+  const HighVertices direct = build_high_vertices(grid, glm::vec3(0.0f));
+  EXPECT_EQ(direct.vertices.size(), grid.positions.size());
+  EXPECT_EQ(direct.indices, grid.position_index);
+  for (std::size_t c = 0; c < merged.indices.size(); ++c)
+    EXPECT_EQ(merged.vertices[merged.indices[c]].position, direct.vertices[direct.indices[c]].position);
+}
+
+TEST(VertexData, BoundsAreTheUnionOfUsedPositions) {
+  nmbake::Mesh grid = nmbake::test::make_grid(1, 1, -2, 4, -1, 1);
+  grid.positions.push_back({100, 100, 100});  // unused
+  const Bounds b = mesh_bounds(grid);
+  EXPECT_EQ(b.min, glm::vec3(-2, -1, 0));
+  EXPECT_EQ(b.max, glm::vec3(4, 1, 0));
+  EXPECT_EQ(b.centre(), glm::vec3(1, 0, 0));
+  EXPECT_FLOAT_EQ(b.radius(), 0.5f * std::sqrt(40.0f));
+}
+
+TEST(View, CameraLooksAtTheCentreFromTheOrbitDirection) {
+  for (float az : {0.0f, 30.0f, -135.0f})
+    for (float el : {-90.0f, -20.0f, 0.0f, 45.0f, 90.0f}) {
+      const CameraMatrices m = camera_matrices({az, el, 1.0f}, {0.0f, 0.0f}, 2.0f, 1.5f);
+      const glm::vec3 dir = direction_from_angles(az, el);
+      EXPECT_NEAR(glm::length(glm::normalize(m.eye) - dir), 0.0f, 1e-5f) << az << "," << el;
+      // A light at (0, 0) shines from the eye.
+      EXPECT_NEAR(glm::length(m.light_dir - dir), 0.0f, 1e-5f) << az << "," << el;
+      // The centre projects to the middle of the pane, inside the depth range.
+      const glm::vec4 clip = m.projection * m.view * glm::vec4(0, 0, 0, 1);
+      EXPECT_NEAR(clip.x / clip.w, 0.0f, 1e-5f);
+      EXPECT_NEAR(clip.y / clip.w, 0.0f, 1e-5f);
+      EXPECT_LT(std::abs(clip.z / clip.w), 1.0f);
+    }
+}
+
+TEST(View, BoundingSphereFitsThePane) {
+  for (float aspect : {0.5f, 1.0f, 2.0f}) {
+    const CameraMatrices m = camera_matrices({10.0f, 20.0f, 1.0f}, {}, 3.0f, aspect);
+    // Points on the sphere along the eye's right and up axes stay inside the clip square.
+    const glm::mat3 r = glm::transpose(glm::mat3(m.view));
+    for (glm::vec3 axis : {r[0], -r[0], r[1], -r[1]}) {
+      const glm::vec4 clip = m.projection * m.view * glm::vec4(3.0f * axis, 1.0f);
+      EXPECT_LT(std::abs(clip.x / clip.w), 1.0f) << aspect;
+      EXPECT_LT(std::abs(clip.y / clip.w), 1.0f) << aspect;
+    }
+  }
+}
+
+TEST(View, LightAzimuthIsRelativeToTheView) {
+  // Positive light azimuth comes from the viewer's right.
+  const CameraMatrices m = camera_matrices({0.0f, 0.0f, 1.0f}, {90.0f, 0.0f}, 1.0f, 1.0f);
+  const glm::vec3 right = glm::transpose(glm::mat3(m.view))[0];
+  EXPECT_NEAR(glm::dot(m.light_dir, right), 1.0f, 1e-5f);
+}
+
+TEST(View, CompareViewsAreEightAroundPlusTopAndBottom) {
+  const std::vector<OrbitView> views = compare_views();
+  ASSERT_EQ(views.size(), 10u);
+  std::set<int> azimuths;
+  for (int i = 0; i < 8; ++i) azimuths.insert(int(views[std::size_t(i)].azimuth));
+  EXPECT_EQ(azimuths.size(), 8u);
+  EXPECT_EQ(views[8].elevation, 90.0f);
+  EXPECT_EQ(views[9].elevation, -90.0f);
+}
+
+Rgba8Image solid(int w, int h, std::uint8_t value, std::uint8_t alpha) {
+  Rgba8Image im{w, h, std::vector<std::uint8_t>(std::size_t(w) * h * 4, value)};
+  for (std::size_t i = 3; i < im.pixels.size(); i += 4) im.pixels[i] = alpha;
+  return im;
+}
+
+TEST(Metrics, IdenticalImagesHaveZeroError) {
+  const Rgba8Image a = solid(4, 3, 100, 255);
+  const DifferenceStats s = compare_images(a, a);
+  EXPECT_EQ(s.object_pixels, 12u);
+  EXPECT_EQ(s.rmse(), 0.0);
+  EXPECT_TRUE(std::isinf(s.psnr()));
+  EXPECT_EQ(s.within2(), 1.0);
+}
+
+TEST(Metrics, OnlyObjectPixelsCount) {
+  Rgba8Image a = solid(2, 2, 0, 0), b = solid(2, 2, 0, 0);
+  // Pixel 0 covered by a only (white vs black background), pixel 1 by both with a difference of
+  // 2 in one channel, pixels 2 and 3 background in both (differences there are ignored).
+  a.pixels[0] = a.pixels[1] = a.pixels[2] = 255, a.pixels[3] = 255;
+  a.pixels[4] = 10, a.pixels[7] = 255;
+  b.pixels[4] = 12, b.pixels[7] = 255;
+  a.pixels[8] = 200;
+  const DifferenceStats s = compare_images(a, b);
+  EXPECT_EQ(s.object_pixels, 2u);
+  EXPECT_EQ(s.within2_pixels, 1u);
+  const double expected = std::sqrt((3.0 * 255 * 255 + 2.0 * 2) / (255.0 * 255) / 6.0);
+  EXPECT_NEAR(s.rmse(), expected, 1e-12);
+  EXPECT_NEAR(s.psnr(), 20.0 * std::log10(1.0 / expected), 1e-9);
+}
+
+TEST(Metrics, PooledStatsAddUp) {
+  DifferenceStats a, b;
+  a.object_pixels = 10, a.within2_pixels = 5, a.sum_squared = 0.3;
+  b.object_pixels = 30, b.within2_pixels = 30, b.sum_squared = 0.0;
+  a.add(b);
+  EXPECT_EQ(a.within2(), 35.0 / 40.0);
+  EXPECT_NEAR(a.rmse(), std::sqrt(0.3 / 120.0), 1e-12);
+  EXPECT_EQ(DifferenceStats{}.rmse(), 0.0);
+}
+
+TEST(Font, EveryPrintedCharacterHasAGlyph) {
+  const std::string all = "ABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789,.+-:=/()%?";
+  for (char c : all) {
+    int set = 0;
+    for (int y = 0; y < kGlyphHeight; ++y)
+      for (int x = 0; x < kGlyphWidth; ++x) set += glyph_pixel(c, x, y);
+    EXPECT_GT(set, 0) << c;
+  }
+  for (int y = 0; y < kGlyphHeight; ++y)
+    for (int x = 0; x < kGlyphWidth; ++x) {
+      EXPECT_FALSE(glyph_pixel(' ', x, y));
+      EXPECT_EQ(glyph_pixel('a', x, y), glyph_pixel('A', x, y));
+      EXPECT_EQ(glyph_pixel('~', x, y), glyph_pixel('?', x, y));
+    }
+}
+
+TEST(Font, TextBecomesSquaresInsideItsBox) {
+  std::vector<glm::vec2> tris;
+  append_text_triangles("1,0", {10, 20}, 2.0f, tris);
+  EXPECT_EQ(tris.size() % 6, 0u);
+  EXPECT_FALSE(tris.empty());
+  const float width = text_width("1,0", 2.0f);
+  EXPECT_EQ(width, (3 * kCellWidth - 1) * 2.0f);
+  for (glm::vec2 p : tris) {
+    EXPECT_GE(p.x, 10.0f);
+    EXPECT_LE(p.x, 10.0f + width);
+    EXPECT_GE(p.y, 20.0f);
+    EXPECT_LE(p.y, 20.0f + kGlyphHeight * 2.0f);
+  }
+}
+
+TEST(Layout, PanesHaveEqualWidthsSideBySide) {
+  for (bool difference : {false, true}) {
+    const std::vector<Rect> panes = pane_layout(1601, 800, difference);
+    ASSERT_EQ(panes.size(), difference ? 3u : 2u);
+    for (std::size_t i = 0; i < panes.size(); ++i) {
+      EXPECT_EQ(panes[i].width, panes[0].width);
+      EXPECT_EQ(panes[i].height, 800);
+      if (i > 0) {
+        EXPECT_EQ(panes[i].x, panes[i - 1].x + panes[i - 1].width);
+      }
+    }
+    EXPECT_LE(panes.back().x + panes.back().width, 1601);
+  }
+  EXPECT_EQ(with_thousands(98304), "98,304");
+  EXPECT_EQ(with_thousands(1234567), "1,234,567");
+  EXPECT_EQ(with_thousands(12), "12");
+}
+
+}  // namespace

@@ -1,0 +1,21 @@
+// The interactive window: one orbit camera and one light drive both panes.
+#pragma once
+
+#include "scene.h"
+#include "renderer.h"
+#include "view.h"
+
+namespace nmview {
+
+struct InteractiveOptions {
+  int width = 1600, height = 800;  // window size in screen units
+  OrbitView view;                  // initial camera, restored by R
+  Light light;                     // initial light, restored by R
+  Toggles toggles;
+};
+
+// Opens the window and runs until it is closed (Esc or Q). Throws nmbake::Error
+// (ExitCode::output) when no window can be opened (no display).
+void run_interactive(const Scene& scene, const InteractiveOptions& options);
+
+}  // namespace nmview

@@ -1,0 +1,164 @@
+// nmview: the low-poly with its baked normal map beside the high-poly, one camera, one light.
+//
+//   nmview LOW.obj normal.png HIGH.ply                 window: left low + map, right high
+//   nmview LOW.obj normal.png HIGH.ply --screenshot cmp.png --size 1600x800 --view 30,20
+//   nmview LOW.obj normal.png HIGH.ply --compare       appearance difference over fixed views
+//
+// main only parses arguments and wires the stages together; errors print "error: <what>" and
+// exit with the baker's codes (errors.h).
+#include <cmath>
+#include <iostream>
+#include <new>
+#include <sstream>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "compare.h"
+#include "errors.h"
+#include "gl_context.h"
+#include "interactive.h"
+#include "renderer.h"
+#include "scene.h"
+
+namespace {
+
+struct Options {
+  std::string low, map, high;
+  std::string screenshot;
+  std::string size = "1600x800";
+  std::string view = "30,20";
+  std::string light = "-30,30";
+  std::string show;
+  bool no_map = false;
+  bool compare = false;
+};
+
+// "A,B" of two finite numbers.
+void parse_pair(const std::string& flag, const std::string& text, float& a, float& b) {
+  std::istringstream in(text);
+  char comma = 0;
+  double x = 0, y = 0;
+  if (!(in >> x >> comma >> y) || comma != ',' || !(in >> std::ws).eof() || !std::isfinite(x) || !std::isfinite(y))
+    throw nmbake::UsageError(flag + ": expected AZ,EL in degrees (e.g. 30,20), got '" + text + "'");
+  a = float(x);
+  b = float(y);
+}
+
+void parse_size(const std::string& text, int& width, int& height) {
+  std::istringstream in(text);
+  char x = 0;
+  long w = 0, h = 0;
+  if (!(in >> w >> x >> h) || (x != 'x' && x != 'X') || !(in >> std::ws).eof() || w < 16 || h < 16 || w > 16384 ||
+      h > 16384)
+    throw nmbake::UsageError("--size: expected WxH with 16..16384 pixels each (e.g. 1600x800), got '" + text + "'");
+  width = int(w);
+  height = int(h);
+}
+
+void parse_show(const std::string& text, nmview::Toggles& toggles) {
+  std::istringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    if (item == "wire") toggles.wireframe = true;
+    else if (item == "diff") toggles.difference = true;
+    else if (item == "tangent") toggles.tangent_colours = true;
+    else if (item == "specular") toggles.specular = 0.3f;
+    else if (item == "nolabels") toggles.labels = false;
+    else if (!item.empty())
+      throw nmbake::UsageError("--show: unknown item '" + item + "' (wire, diff, tangent, specular, nolabels)");
+  }
+}
+
+int run(const Options& o) {
+  nmview::InteractiveOptions io;
+  parse_size(o.size, io.width, io.height);
+  parse_pair("--view", o.view, io.view.azimuth, io.view.elevation);
+  parse_pair("--light", o.light, io.light.azimuth, io.light.elevation);
+  parse_show(o.show, io.toggles);
+  io.toggles.map = !o.no_map;
+
+  const nmview::Scene scene = nmview::load_scene(o.low, o.map, o.high, std::cerr);
+
+  if (!o.compare && o.screenshot.empty()) {
+    nmview::run_interactive(scene, io);
+    return 0;
+  }
+
+  nmview::HeadlessContext context;
+  std::cerr << "nmview: " << context.description() << "\n";
+  nmview::Renderer renderer(scene.low, scene.high, scene.map, scene.radius);
+
+  if (o.compare) {
+    // Each view is measured at the size of one pane of the --size window.
+    const int pane_width = io.width / 2, pane_height = io.height;
+    nmview::Toggles measure;
+    measure.map = io.toggles.map;
+    const nmview::CompareResult result = nmview::run_compare(renderer, pane_width, pane_height, io.light, measure);
+
+    // The worst view as low | high | difference, at the same pane size.
+    const std::string path = o.screenshot.empty() ? "nmview-compare-worst.png" : o.screenshot;
+    nmview::Toggles show = measure;
+    show.difference = true;
+    nmview::Framebuffer target(3 * pane_width, pane_height);
+    renderer.render(target.id(), 3 * pane_width, pane_height, result.views[result.worst].view, io.light, show);
+    nmview::write_screenshot(path, nmview::Renderer::read_framebuffer(target.id(), 3 * pane_width, pane_height));
+    std::cerr << "nmview: worst view written to " << path << "\n";
+    nmview::print_compare(result, std::cout);
+    return 0;
+  }
+
+  nmview::Framebuffer target(io.width, io.height);
+  renderer.render(target.id(), io.width, io.height, io.view, io.light, io.toggles);
+  nmview::write_screenshot(o.screenshot, nmview::Renderer::read_framebuffer(target.id(), io.width, io.height));
+  std::cerr << "nmview: wrote " << o.screenshot << " (" << io.width << "x" << io.height << ")\n";
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"nmview: the low-poly with its baked tangent-space normal map beside the high-poly, "
+               "lit alike from one camera"};
+  Options o;
+  app.add_option("low", o.low, "Low-poly mesh with UVs (OBJ, PLY, OFF, STL), as given to nmbake")->required();
+  app.add_option("map", o.map, "Tangent-space normal map baked for it (any size)")->required();
+  app.add_option("high", o.high, "High-poly mesh (its normals, else computed ones)")->required();
+  app.add_option("--screenshot", o.screenshot,
+                 "Render without a display to FILE and exit (with --compare: the worst view's difference image)");
+  app.add_option("--size", o.size, "Window or image size WxH in pixels (both panes together)")->capture_default_str();
+  app.add_option("--view", o.view, "Camera azimuth,elevation in degrees (Y up; 0,0 looks from +Z)")
+      ->capture_default_str();
+  app.add_option("--light", o.light,
+                 "Light azimuth,elevation in degrees relative to the view direction (0,0 = from the eye)")
+      ->capture_default_str();
+  app.add_flag("--no-map", o.no_map, "Left pane without the normal map (the low-poly's bare shading)");
+  app.add_flag("--compare", o.compare,
+               "Render both models from 10 fixed views and print the difference over the object's pixels; "
+               "last line: psnr=<dB> rmse=<0..1> within2=<fraction>");
+  app.add_option("--show", o.show, "Start with toggles on: wire,diff,tangent,specular,nolabels");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "error: " << e.what() << " (see --help)\n";
+    return int(nmbake::ExitCode::usage);
+  }
+
+  try {
+    return run(o);
+  } catch (const nmbake::Error& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return int(e.code());
+  } catch (const std::bad_alloc&) {
+    std::cerr << "error: out of memory\n";
+    return int(nmbake::ExitCode::memory);
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return int(nmbake::ExitCode::output);
+  }
+}

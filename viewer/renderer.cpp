@@ -1,0 +1,402 @@
+#include "renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include <epoxy/gl.h>
+
+#include "errors.h"
+#include "font.h"
+#include "shaders.h"
+
+namespace nmview {
+namespace {
+
+[[noreturn]] void fail(const std::string& what) { throw nmbake::Error(nmbake::ExitCode::output, what); }
+
+GLuint compile(GLenum type, const std::string& source, const char* name) {
+  GLuint shader = glCreateShader(type);
+  const char* text = source.c_str();
+  glShaderSource(shader, 1, &text, nullptr);
+  glCompileShader(shader);
+  GLint ok = 0;
+  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    char log[2048] = {};
+    glGetShaderInfoLog(shader, sizeof(log), nullptr, log);
+    glDeleteShader(shader);
+    fail(std::string("shader ") + name + " does not compile: " + log);
+  }
+  return shader;
+}
+
+GLuint link(const char* vertex, const char* fragment, const char* name, bool lighting = false) {
+  const std::string header = "#version 330 core\n";
+  GLuint vs = compile(GL_VERTEX_SHADER, header + vertex, name);
+  GLuint fs = compile(GL_FRAGMENT_SHADER, header + (lighting ? shaders::kLighting : "") + fragment, name);
+  GLuint program = glCreateProgram();
+  glAttachShader(program, vs);
+  glAttachShader(program, fs);
+  glLinkProgram(program);
+  glDeleteShader(vs);
+  glDeleteShader(fs);
+  GLint ok = 0;
+  glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    char log[2048] = {};
+    glGetProgramInfoLog(program, sizeof(log), nullptr, log);
+    glDeleteProgram(program);
+    fail(std::string("shader program ") + name + " does not link: " + log);
+  }
+  return program;
+}
+
+GLint uniform(GLuint program, const char* name) { return glGetUniformLocation(program, name); }
+
+// Uploads vertices and indices once; `attributes` lists (location, float count) in vertex order.
+template <class V>
+void upload(const IndexedVertices<V>& data, std::initializer_list<std::pair<GLuint, GLint>> attributes,
+            GLuint& vao, GLuint& vbo, GLuint& ebo) {
+  glGenVertexArrays(1, &vao);
+  glBindVertexArray(vao);
+  glGenBuffers(1, &vbo);
+  glBindBuffer(GL_ARRAY_BUFFER, vbo);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(data.vertices.size() * sizeof(V)), data.vertices.data(), GL_STATIC_DRAW);
+  glGenBuffers(1, &ebo);
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ebo);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(data.indices.size() * sizeof(std::uint32_t)), data.indices.data(),
+               GL_STATIC_DRAW);
+  std::size_t offset = 0;
+  for (auto [location, count] : attributes) {
+    glEnableVertexAttribArray(location);
+    glVertexAttribPointer(location, count, GL_FLOAT, GL_FALSE, GLsizei(sizeof(V)),
+                          reinterpret_cast<const void*>(offset));
+    offset += std::size_t(count) * sizeof(float);
+  }
+  glBindVertexArray(0);
+}
+
+void set_camera(GLuint program, const CameraMatrices& camera) {
+  glm::mat4 vp = camera.projection * camera.view;
+  glUniformMatrix4fv(uniform(program, "u_view_projection"), 1, GL_FALSE, &vp[0][0]);
+  GLint light = uniform(program, "u_light_dir");
+  if (light >= 0) glUniform3fv(light, 1, &camera.light_dir[0]);
+  GLint eye = uniform(program, "u_eye");
+  if (eye >= 0) glUniform3fv(eye, 1, &camera.eye[0]);
+}
+
+}  // namespace
+
+std::string with_thousands(std::size_t n) {
+  std::string digits = std::to_string(n), out;
+  for (std::size_t i = 0; i < digits.size(); ++i) {
+    if (i > 0 && (digits.size() - i) % 3 == 0) out += ',';
+    out += digits[i];
+  }
+  return out;
+}
+
+Framebuffer::Framebuffer(int width, int height) {
+  glGenFramebuffers(1, &fbo_);
+  glGenRenderbuffers(1, &color_);
+  glBindRenderbuffer(GL_RENDERBUFFER, color_);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, width, height);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color_);
+  bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  if (!complete) fail("cannot create a " + std::to_string(width) + "x" + std::to_string(height) + " framebuffer");
+}
+
+Framebuffer::~Framebuffer() {
+  glDeleteFramebuffers(1, &fbo_);
+  glDeleteRenderbuffers(1, &color_);
+}
+
+std::vector<Rect> pane_layout(int width, int height, bool difference) {
+  // Equal widths (the pane textures are shared); leftover columns split between the two sides.
+  const int count = difference ? 3 : 2;
+  const int pane_width = std::max(width / count, 1);
+  const int left = (width - pane_width * count) / 2;
+  std::vector<Rect> panes;
+  for (int i = 0; i < count; ++i) panes.push_back({left + i * pane_width, 0, pane_width, height});
+  return panes;
+}
+
+Renderer::Renderer(const LowVertices& low, const HighVertices& high, const nmbake::Image& map, float radius)
+    : radius_(radius) {
+  low_program_ = link(shaders::kLowVertex, shaders::kLowFragment, "low", true);
+  high_program_ = link(shaders::kHighVertex, shaders::kHighFragment, "high", true);
+  wire_program_ = link(shaders::kWireVertex, shaders::kFlatFragment, "wire");
+  background_program_ = link(shaders::kFullscreenVertex, shaders::kBackgroundFragment, "background");
+  pane_program_ = link(shaders::kFullscreenVertex, shaders::kPaneFragment, "pane");
+  difference_program_ = link(shaders::kFullscreenVertex, shaders::kDifferenceFragment, "difference");
+  text_program_ = link(shaders::kTextVertex, shaders::kFlatFragment, "text");
+
+  upload(low, {{0, 3}, {1, 3}, {2, 4}, {3, 2}}, low_.vao, low_.vbo, low_.ebo);
+  low_.index_count = low.indices.size();
+  upload(high, {{0, 3}, {1, 3}}, high_.vao, high_.vbo, high_.ebo);
+  high_.index_count = high.indices.size();
+
+  // The map: RGB, rows flipped so that texture t = mesh v (image row 0 is v = 1). 16-bit storage
+  // keeps 16-bit maps exact; 8-bit maps are exact in it too.
+  GLint max_size = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+  if (map.width > max_size || map.height > max_size)
+    fail("the normal map is " + std::to_string(map.width) + "x" + std::to_string(map.height) +
+         ", larger than this OpenGL's texture limit " + std::to_string(max_size));
+  std::vector<float> rgb(std::size_t(map.width) * std::size_t(map.height) * 3);
+  for (int y = 0; y < map.height; ++y)
+    for (int x = 0; x < map.width; ++x) {
+      const float* src = map.at(x, map.height - 1 - y);
+      float* dst = &rgb[(std::size_t(y) * std::size_t(map.width) + std::size_t(x)) * 3];
+      dst[0] = src[0];
+      dst[1] = src[1];
+      dst[2] = src[2];
+    }
+  glGenTextures(1, &map_texture_);
+  glBindTexture(GL_TEXTURE_2D, map_texture_);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB16, map.width, map.height, 0, GL_RGB, GL_FLOAT, rgb.data());
+  glGenerateMipmap(GL_TEXTURE_2D);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+
+  glGenVertexArrays(1, &empty_vao_);
+  glGenVertexArrays(1, &text_vao_);
+  glGenBuffers(1, &text_vbo_);
+  glBindVertexArray(text_vao_);
+  glBindBuffer(GL_ARRAY_BUFFER, text_vbo_);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, sizeof(glm::vec2), nullptr);
+  glBindVertexArray(0);
+
+  GLint max_samples = 1;
+  glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
+  samples_ = std::clamp(max_samples, 1, 4);
+  if (GLenum error = glGetError(); error != GL_NO_ERROR)
+    fail("OpenGL error " + std::to_string(error) + " while uploading the meshes (out of GPU memory?)");
+}
+
+Renderer::~Renderer() {
+  for (Pane& p : panes_) {
+    glDeleteFramebuffers(1, &p.msaa_fbo);
+    glDeleteRenderbuffers(1, &p.msaa_color);
+    glDeleteRenderbuffers(1, &p.msaa_depth);
+    glDeleteFramebuffers(1, &p.fbo);
+    glDeleteTextures(1, &p.texture);
+  }
+  for (Model* m : {&low_, &high_}) {
+    glDeleteVertexArrays(1, &m->vao);
+    glDeleteBuffers(1, &m->vbo);
+    glDeleteBuffers(1, &m->ebo);
+  }
+  glDeleteTextures(1, &map_texture_);
+  glDeleteVertexArrays(1, &empty_vao_);
+  glDeleteVertexArrays(1, &text_vao_);
+  glDeleteBuffers(1, &text_vbo_);
+  for (GLuint p : {low_program_, high_program_, wire_program_, background_program_, pane_program_,
+                   difference_program_, text_program_})
+    glDeleteProgram(p);
+}
+
+void Renderer::ensure_pane_size(int width, int height) {
+  width = std::max(width, 1);
+  height = std::max(height, 1);
+  if (width == pane_width_ && height == pane_height_) return;
+  pane_width_ = width;
+  pane_height_ = height;
+  for (Pane& p : panes_) {
+    if (!p.msaa_fbo) {
+      glGenFramebuffers(1, &p.msaa_fbo);
+      glGenRenderbuffers(1, &p.msaa_color);
+      glGenRenderbuffers(1, &p.msaa_depth);
+      glGenFramebuffers(1, &p.fbo);
+      glGenTextures(1, &p.texture);
+    }
+    glBindRenderbuffer(GL_RENDERBUFFER, p.msaa_color);
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples_, GL_RGBA8, width, height);
+    glBindRenderbuffer(GL_RENDERBUFFER, p.msaa_depth);
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples_, GL_DEPTH_COMPONENT24, width, height);
+    glBindFramebuffer(GL_FRAMEBUFFER, p.msaa_fbo);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, p.msaa_color);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, p.msaa_depth);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+      fail("cannot create a " + std::to_string(width) + "x" + std::to_string(height) + " multisampled framebuffer");
+
+    glBindTexture(GL_TEXTURE_2D, p.texture);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glBindFramebuffer(GL_FRAMEBUFFER, p.fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, p.texture, 0);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+      fail("cannot create a " + std::to_string(width) + "x" + std::to_string(height) + " framebuffer");
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+void Renderer::draw_model(int which, const CameraMatrices& camera, const Toggles& toggles) {
+  const Model& model = which == 0 ? low_ : high_;
+  GLuint program = which == 0 ? low_program_ : high_program_;
+  glUseProgram(program);
+  set_camera(program, camera);
+  glUniform1f(uniform(program, "u_specular"), toggles.specular);
+  if (which == 0) {
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, map_texture_);
+    glUniform1i(uniform(program, "u_map"), 0);
+    glUniform1i(uniform(program, "u_mode"), toggles.tangent_colours ? 2 : toggles.map ? 0 : 1);
+  }
+  glBindVertexArray(model.vao);
+  // The filled pass is pushed back a little so the wireframe lines win the depth test.
+  if (toggles.wireframe) {
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(1.0f, 1.0f);
+  }
+  glDrawElements(GL_TRIANGLES, GLsizei(model.index_count), GL_UNSIGNED_INT, nullptr);
+  glDisable(GL_POLYGON_OFFSET_FILL);
+  if (toggles.wireframe) {
+    glUseProgram(wire_program_);
+    set_camera(wire_program_, camera);
+    // Half-transparent lines so a dense mesh stays readable; destination alpha (coverage) is kept.
+    glUniform4f(uniform(wire_program_, "u_color"), 0.0f, 0.08f, 0.35f, 0.45f);
+    glEnable(GL_BLEND);
+    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
+    glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
+    glDepthFunc(GL_LEQUAL);
+    glDrawElements(GL_TRIANGLES, GLsizei(model.index_count), GL_UNSIGNED_INT, nullptr);
+    glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_BLEND);
+  }
+  glBindVertexArray(0);
+}
+
+void Renderer::render_panes(int width, int height, const OrbitView& view, const Light& light,
+                            const Toggles& toggles) {
+  ensure_pane_size(width, height);
+  const CameraMatrices camera = camera_matrices(view, light, radius_, float(pane_width_) / float(pane_height_));
+  glDisable(GL_BLEND);
+  glDisable(GL_CULL_FACE);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  for (int which = 0; which < 2; ++which) {
+    Pane& p = panes_[which];
+    glBindFramebuffer(GL_FRAMEBUFFER, p.msaa_fbo);
+    glViewport(0, 0, pane_width_, pane_height_);
+    glClearColor(0, 0, 0, 0);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    draw_model(which, camera, toggles);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, p.msaa_fbo);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, p.fbo);
+    glBlitFramebuffer(0, 0, pane_width_, pane_height_, 0, 0, pane_width_, pane_height_, GL_COLOR_BUFFER_BIT,
+                      GL_NEAREST);
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glDisable(GL_DEPTH_TEST);
+}
+
+Rgba8Image Renderer::read_pane(int which) const {
+  return read_framebuffer(panes_[which].fbo, pane_width_, pane_height_);
+}
+
+Rgba8Image Renderer::read_framebuffer(unsigned target, int width, int height) {
+  Rgba8Image image{width, height, std::vector<std::uint8_t>(std::size_t(width) * std::size_t(height) * 4)};
+  std::vector<std::uint8_t> rows(image.pixels.size());
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, target);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, rows.data());
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+  const std::size_t stride = std::size_t(width) * 4;
+  for (int y = 0; y < height; ++y)
+    std::copy_n(&rows[std::size_t(height - 1 - y) * stride], stride, &image.pixels[std::size_t(y) * stride]);
+  return image;
+}
+
+void Renderer::draw_text(const std::string& text, float x, float y, float scale, int target_width,
+                         int target_height) {
+  std::vector<glm::vec2> triangles;
+  append_text_triangles(text, {x, y}, scale, triangles);
+  if (triangles.empty()) return;
+  glUseProgram(text_program_);
+  glUniform2f(uniform(text_program_, "u_target_size"), float(target_width), float(target_height));
+  glBindVertexArray(text_vao_);
+  glBindBuffer(GL_ARRAY_BUFFER, text_vbo_);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(triangles.size() * sizeof(glm::vec2)), triangles.data(), GL_STREAM_DRAW);
+  // A dark shadow one font pixel down-right, then the text.
+  glUniform2f(uniform(text_program_, "u_offset"), scale, scale);
+  glUniform4f(uniform(text_program_, "u_color"), 0.0f, 0.0f, 0.0f, 1.0f);
+  glDrawArrays(GL_TRIANGLES, 0, GLsizei(triangles.size()));
+  glUniform2f(uniform(text_program_, "u_offset"), 0.0f, 0.0f);
+  glUniform4f(uniform(text_program_, "u_color"), 0.95f, 0.95f, 0.95f, 1.0f);
+  glDrawArrays(GL_TRIANGLES, 0, GLsizei(triangles.size()));
+  glBindVertexArray(0);
+}
+
+void Renderer::render(unsigned target, int width, int height, const OrbitView& view, const Light& light,
+                      const Toggles& toggles, const std::vector<std::string>& help) {
+  const std::vector<Rect> layout = pane_layout(width, height, toggles.difference);
+  render_panes(layout[0].width, layout[0].height, view, light, toggles);
+
+  glBindFramebuffer(GL_FRAMEBUFFER, target);
+  glViewport(0, 0, width, height);
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_BLEND);
+  glBindVertexArray(empty_vao_);
+  glUseProgram(background_program_);
+  glUniform1f(uniform(background_program_, "u_height"), float(height));
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+
+  // Panes are premultiplied over black with alpha = coverage: blend them over the background.
+  glEnable(GL_BLEND);
+  glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  for (std::size_t i = 0; i < layout.size(); ++i) {
+    const Rect& r = layout[i];
+    glViewport(r.x, r.y, r.width, r.height);
+    glActiveTexture(GL_TEXTURE0);
+    GLuint program = i < 2 ? pane_program_ : difference_program_;
+    glUseProgram(program);
+    glUniform2i(uniform(program, "u_origin"), r.x, r.y);
+    if (i < 2) {
+      glBindTexture(GL_TEXTURE_2D, panes_[i].texture);
+      glUniform1i(uniform(program, "u_pane"), 0);
+    } else {
+      glBindTexture(GL_TEXTURE_2D, panes_[0].texture);
+      glActiveTexture(GL_TEXTURE1);
+      glBindTexture(GL_TEXTURE_2D, panes_[1].texture);
+      glUniform1i(uniform(program, "u_left"), 0);
+      glUniform1i(uniform(program, "u_right"), 1);
+      glUniform1f(uniform(program, "u_gain"), kDifferenceGain);
+    }
+    glBindVertexArray(empty_vao_);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+  }
+  glActiveTexture(GL_TEXTURE0);
+  glDisable(GL_BLEND);
+
+  glViewport(0, 0, width, height);
+  const float scale = std::max(1.0f, std::floor(float(height) / 400.0f));
+  const float margin = 4.0f * scale;
+  if (toggles.labels) {
+    std::string left = toggles.tangent_colours ? "LOW: MAP IN TANGENT-SPACE COLOURS"
+                       : toggles.map           ? "LOW + NORMAL MAP"
+                                               : "LOW, NO MAP";
+    std::vector<std::string> titles = {left + "   " + with_thousands(low_triangles()) + " TRIS",
+                                       "HIGH   " + with_thousands(high_triangles()) + " TRIS"};
+    if (toggles.difference) titles.push_back("DIFFERENCE X" + std::to_string(int(kDifferenceGain)));
+    for (std::size_t i = 0; i < layout.size(); ++i)
+      draw_text(titles[i], float(layout[i].x) + margin, margin, scale, width, height);
+  }
+  for (std::size_t i = 0; i < help.size(); ++i) {
+    float y = float(height) - margin - float(help.size() - i) * kCellHeight * scale;
+    draw_text(help[i], margin, y, scale, width, height);
+  }
+  glBindVertexArray(0);
+  glUseProgram(0);
+}
+
+}  // namespace nmview

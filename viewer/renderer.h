@@ -1,0 +1,105 @@
+// Draws the comparison: the low-poly with its normal map and the high-poly, side by side, from
+// one camera and one light. Needs a current OpenGL 3.3 core context (gl_context.h).
+//
+// The meshes and the map are uploaded once at construction (vertex and index buffers, a mip-mapped
+// texture); a frame only sets uniforms and issues a fixed number of draw calls. Each model is
+// drawn into its own offscreen pane (4x multisampled, resolved to an RGBA8 texture cleared to
+// transparent black, so alpha is the coverage mask), then the panes are composited side by side
+// over a background, with an optional difference pane and text labels.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "image.h"
+#include "metrics.h"
+#include "vertex_data.h"
+#include "view.h"
+
+namespace nmview {
+
+struct Toggles {
+  bool map = true;               // left pane decodes the normal map; off: the low-poly's bare shading
+  bool wireframe = false;        // triangle edges over both models
+  bool tangent_colours = false;  // left pane shows the map's RGB (tangent-space colours) unlit
+  bool difference = false;       // a third pane: |left - right| x kDifferenceGain as a heat colour
+  bool labels = true;            // pane titles with triangle counts
+  float specular = 0.0f;         // Blinn specular weight, 0 = off
+};
+
+constexpr float kDifferenceGain = 8.0f;
+
+// Pixel rectangle, origin at the lower left (GL convention).
+struct Rect {
+  int x = 0, y = 0, width = 0, height = 0;
+};
+
+// Side-by-side layout of a `width` x `height` target: 2 panes, or 3 with the difference pane.
+std::vector<Rect> pane_layout(int width, int height, bool difference);
+
+class Renderer {
+ public:
+  // `map` has at least 3 channels (RGB encoded normals). Throws nmbake::Error (ExitCode::output)
+  // when a shader does not compile or the map is larger than the GL texture limit.
+  Renderer(const LowVertices& low, const HighVertices& high, const nmbake::Image& map, float radius);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // A whole frame into framebuffer `target` (0 = the window) of `width` x `height` pixels.
+  // `help` lines are printed at the bottom left.
+  void render(unsigned target, int width, int height, const OrbitView& view, const Light& light,
+              const Toggles& toggles, const std::vector<std::string>& help = {});
+
+  // Just the two panes at `width` x `height` each, for measuring; then read_pane(0 = low, 1 = high).
+  void render_panes(int width, int height, const OrbitView& view, const Light& light, const Toggles& toggles);
+  Rgba8Image read_pane(int which) const;
+
+  // Reads framebuffer `target` (row 0 at the top).
+  static Rgba8Image read_framebuffer(unsigned target, int width, int height);
+
+  std::size_t low_triangles() const { return low_.index_count / 3; }
+  std::size_t high_triangles() const { return high_.index_count / 3; }
+
+ private:
+  struct Model {
+    unsigned vao = 0, vbo = 0, ebo = 0;
+    std::size_t index_count = 0;
+  };
+  struct Pane {
+    unsigned msaa_fbo = 0, msaa_color = 0, msaa_depth = 0;
+    unsigned fbo = 0, texture = 0;  // resolved RGBA8
+  };
+
+  void ensure_pane_size(int width, int height);
+  void draw_model(int which, const CameraMatrices& camera, const Toggles& toggles);
+  void draw_text(const std::string& text, float x, float y, float scale, int target_width, int target_height);
+
+  Model low_, high_;
+  unsigned map_texture_ = 0;
+  unsigned low_program_ = 0, high_program_ = 0, wire_program_ = 0;
+  unsigned background_program_ = 0, pane_program_ = 0, difference_program_ = 0, text_program_ = 0;
+  unsigned empty_vao_ = 0, text_vao_ = 0, text_vbo_ = 0;
+  Pane panes_[2];
+  int pane_width_ = 0, pane_height_ = 0, samples_ = 1;
+  float radius_ = 1.0f;
+};
+
+// An offscreen RGBA8 framebuffer for headless frames.
+class Framebuffer {
+ public:
+  Framebuffer(int width, int height);  // throws nmbake::Error (ExitCode::output) when incomplete
+  ~Framebuffer();
+  Framebuffer(const Framebuffer&) = delete;
+  Framebuffer& operator=(const Framebuffer&) = delete;
+  unsigned id() const { return fbo_; }
+
+ private:
+  unsigned fbo_ = 0, color_ = 0;
+};
+
+// "98,304"
+std::string with_thousands(std::size_t n);
+
+}  // namespace nmview

@@ -1,0 +1,66 @@
+#include "scene.h"
+
+#include <algorithm>
+
+#include "errors.h"
+#include "image_io.h"
+#include "mesh_io.h"
+#include "normals.h"
+#include "tangent_frames.h"
+
+namespace nmview {
+
+Scene load_scene(const std::string& low_path, const std::string& map_path, const std::string& high_path,
+                 std::ostream& log) {
+  Scene scene;
+  scene.low_name = low_path;
+  scene.map_name = map_path;
+  scene.high_name = high_path;
+
+  // Inputs are read in command-line order so the first bad one is the one reported.
+  nmbake::LoadOptions low_options;
+  low_options.require_uvs = true;
+  nmbake::Mesh low = nmbake::load_mesh(low_path, low_options);
+
+  scene.map = nmbake::read_image(map_path);
+  if (scene.map.channels < 3)
+    throw nmbake::InputError(map_path + ": has " + std::to_string(scene.map.channels) +
+                             " channel(s); a tangent-space normal map needs RGB");
+  if (scene.map.width <= 0 || scene.map.height <= 0) throw nmbake::InputError(map_path + ": empty image");
+  double blue = 0.0;
+  for (int y = 0; y < scene.map.height; ++y)
+    for (int x = 0; x < scene.map.width; ++x) blue += scene.map.at(x, y)[2];
+  blue /= double(scene.map.width) * double(scene.map.height);
+  if (blue < 0.5)
+    log << "nmview: warning: " << map_path << ": mean blue " << blue
+        << " < 0.5, so most normals point into the surface; is this a tangent-space normal map?\n";
+
+  nmbake::Mesh high = nmbake::load_mesh(high_path);
+  if (nmbake::ensure_normals(high))
+    log << "nmview: " << high_path << " has no normals; using angle-weighted vertex normals\n";
+
+  scene.bounds = mesh_bounds(low);
+  scene.bounds.extend(mesh_bounds(high));
+  const glm::vec3 centre = scene.bounds.centre();
+  // The camera frames the sphere around the box centre through the farthest vertex: tighter than
+  // the box's half diagonal for round or flat shapes.
+  for (const nmbake::Mesh* mesh : {&low, &high})
+    for (std::uint32_t i : mesh->position_index)
+      scene.radius = std::max(scene.radius, glm::length(mesh->positions[i] - centre));
+
+  const nmbake::TangentFrames frames = nmbake::compute_tangent_frames(low);
+  scene.low = build_low_vertices(low, frames, centre);
+  scene.high = build_high_vertices(high, centre);
+  scene.low_triangles = low.triangle_count();
+  scene.high_triangles = high.triangle_count();
+  return scene;
+}
+
+void write_screenshot(const std::string& path, const Rgba8Image& image) {
+  nmbake::Image rgb(image.width, image.height, 3);
+  for (std::size_t i = 0; i < std::size_t(image.width) * std::size_t(image.height); ++i)
+    for (int c = 0; c < 3; ++c) rgb.pixels[3 * i + std::size_t(c)] = float(image.pixels[4 * i + std::size_t(c)]) / 255.0f;
+  nmbake::write_image(path, rgb);
+}
+
+}  // namespace nmview

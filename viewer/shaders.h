@@ -1,0 +1,170 @@
+// GLSL 3.30 core sources of nmview. Both panes share one lighting function, so the only
+// difference between them is the normal fed to it.
+#pragma once
+
+namespace nmview::shaders {
+
+// Lambert with a little ambient on a grey albedo, optional Blinn specular (0 by default so
+// software rendering stays stable). Linear values, written to the framebuffer as they are (no
+// sRGB encoding), with alpha 1 as the coverage mask. One-sided: a normal facing away from the
+// light gets the ambient term only, on both panes alike.
+inline const char* kLighting = R"(
+uniform vec3 u_light_dir;   // unit, towards the light, scene space
+uniform vec3 u_eye;         // camera position, scene space
+uniform float u_specular;   // Blinn specular weight, 0 = off
+const float kAlbedo = 0.8;
+const float kAmbient = 0.1;
+vec3 shade(vec3 n, vec3 position) {
+  float diffuse = max(dot(n, u_light_dir), 0.0);
+  float value = kAlbedo * (kAmbient + (1.0 - kAmbient) * diffuse);
+  if (u_specular > 0.0 && diffuse > 0.0) {
+    vec3 h = normalize(normalize(u_eye - position) + u_light_dir);
+    value += u_specular * pow(max(dot(n, h), 0.0), 64.0);
+  }
+  return vec3(value);
+}
+)";
+
+inline const char* kLowVertex = R"(
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in vec4 a_tangent;
+layout(location = 3) in vec2 a_uv;
+uniform mat4 u_view_projection;
+out vec3 v_position;
+out vec3 v_normal;
+out vec4 v_tangent;
+out vec2 v_uv;
+void main() {
+  v_position = a_position;
+  v_normal = a_normal;
+  v_tangent = a_tangent;
+  v_uv = a_uv;
+  gl_Position = u_view_projection * vec4(a_position, 1.0);
+}
+)";
+
+// The renderer side of tangent_frames.h, verbatim: N and T interpolated and not normalized,
+// B = sign * cross(N, T) per pixel, n = normalize(t.x*T + t.y*B + t.z*N) with t = texel*2-1.
+// The sign is tangent.w interpolated like N and T, as nmbake::interpolate_frame does (it is +1 or
+// -1 on every triangle whose corners agree, i.e. all but some UV-degenerate ones). Perspective-
+// correct interpolation gives the same barycentrics the baker uses on the triangle.
+// The map texture's rows are uploaded bottom-up, so texture coordinates are the mesh UVs as they
+// are (v = 1 is the image's top row).
+inline const char* kLowFragment = R"(
+in vec3 v_position;
+in vec3 v_normal;
+in vec4 v_tangent;
+in vec2 v_uv;
+uniform sampler2D u_map;
+uniform int u_mode;  // 0 = lit with the map, 1 = lit with the bare interpolated normal, 2 = map colours
+out vec4 frag_color;
+void main() {
+  vec3 N = v_normal;
+  vec3 T = v_tangent.xyz;
+  vec3 texel = texture(u_map, v_uv).rgb;
+  if (u_mode == 2) {
+    frag_color = vec4(texel, 1.0);
+    return;
+  }
+  vec3 n;
+  if (u_mode == 0) {
+    vec3 B = v_tangent.w * cross(N, T);
+    vec3 t = texel * 2.0 - 1.0;
+    n = normalize(t.x * T + t.y * B + t.z * N);
+  } else {
+    n = normalize(N);
+  }
+  frag_color = vec4(shade(n, v_position), 1.0);
+}
+)";
+
+inline const char* kHighVertex = R"(
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+uniform mat4 u_view_projection;
+out vec3 v_position;
+out vec3 v_normal;
+void main() {
+  v_position = a_position;
+  v_normal = a_normal;
+  gl_Position = u_view_projection * vec4(a_position, 1.0);
+}
+)";
+
+inline const char* kHighFragment = R"(
+in vec3 v_position;
+in vec3 v_normal;
+out vec4 frag_color;
+void main() { frag_color = vec4(shade(normalize(v_normal), v_position), 1.0); }
+)";
+
+// Wireframe overlay: the triangles again as lines, in one flat colour.
+inline const char* kWireVertex = R"(
+layout(location = 0) in vec3 a_position;
+uniform mat4 u_view_projection;
+void main() { gl_Position = u_view_projection * vec4(a_position, 1.0); }
+)";
+
+inline const char* kFlatFragment = R"(
+uniform vec4 u_color;
+out vec4 frag_color;
+void main() { frag_color = u_color; }
+)";
+
+// A triangle covering the viewport; the fragment shaders read gl_FragCoord.
+inline const char* kFullscreenVertex = R"(
+void main() {
+  vec2 p = vec2(float((gl_VertexID & 1) << 2) - 1.0, float((gl_VertexID & 2) << 1) - 1.0);
+  gl_Position = vec4(p, 0.0, 1.0);
+}
+)";
+
+inline const char* kBackgroundFragment = R"(
+uniform float u_height;
+out vec4 frag_color;
+void main() {
+  float s = gl_FragCoord.y / max(u_height, 1.0);
+  frag_color = vec4(vec3(mix(0.13, 0.30, s)), 1.0);
+}
+)";
+
+// A pane texture (premultiplied over black, alpha = coverage) copied texel for texel.
+inline const char* kPaneFragment = R"(
+uniform sampler2D u_pane;
+uniform ivec2 u_origin;  // the pane's lower-left corner in the target, pixels
+out vec4 frag_color;
+void main() { frag_color = texelFetch(u_pane, ivec2(gl_FragCoord.xy) - u_origin, 0); }
+)";
+
+// |left - right| over the object's pixels (covered by either pane), largest channel times
+// u_gain, as a heat colour: black, red, yellow, white.
+inline const char* kDifferenceFragment = R"(
+uniform sampler2D u_left;
+uniform sampler2D u_right;
+uniform ivec2 u_origin;
+uniform float u_gain;
+out vec4 frag_color;
+void main() {
+  ivec2 p = ivec2(gl_FragCoord.xy) - u_origin;
+  vec4 a = texelFetch(u_left, p, 0);
+  vec4 b = texelFetch(u_right, p, 0);
+  if (a.a == 0.0 && b.a == 0.0) discard;
+  vec3 d = abs(a.rgb - b.rgb);
+  float v = clamp(max(d.r, max(d.g, d.b)) * u_gain, 0.0, 1.0);
+  frag_color = vec4(clamp(3.0 * v, 0.0, 1.0), clamp(3.0 * v - 1.0, 0.0, 1.0), clamp(3.0 * v - 2.0, 0.0, 1.0), 1.0);
+}
+)";
+
+// Text squares in window pixels, y down.
+inline const char* kTextVertex = R"(
+layout(location = 0) in vec2 a_pixel;
+uniform vec2 u_target_size;
+uniform vec2 u_offset;
+void main() {
+  vec2 p = (a_pixel + u_offset) / u_target_size;
+  gl_Position = vec4(p.x * 2.0 - 1.0, 1.0 - p.y * 2.0, 0.0, 1.0);
+}
+)";
+
+}  // namespace nmview::shaders
