@@ -40,14 +40,20 @@ std::uint64_t available_memory_bytes() {
   return std::numeric_limits<std::uint64_t>::max();
 }
 
+// What the trace loop reads of one low-poly triangle, in one place: re-centred corner positions,
+// ray normals, and the tangent frame's corner normals and tangents.
+struct LowTriangle {
+  glm::vec3 p[3], ray_n[3], n[3];
+  glm::vec4 t[3];
+};
+
 // The scene in re-centred float coordinates, flat arrays for the hot loop.
 struct Prepared {
   glm::dvec3 centre{0.0};
   double diagonal = 0.0;
   std::vector<glm::vec3> low_pos, cage_pos, high_pos;
   std::vector<glm::vec3> ray_normal;  // per low-poly position: mean of its corners' normals
-  std::vector<glm::vec3> high_normals;
-  std::vector<std::uint32_t> high_normal_index;
+  std::vector<glm::vec3> high_corner_normals;  // 3 per high-poly triangle: one cache line per hit
   TangentFrames frames;
 };
 
@@ -193,13 +199,16 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   s.high_pos = recentre(high.positions, s.centre);
   if (cage) s.cage_pos = recentre(cage->positions, s.centre);
   s.ray_normal = position_averaged_normals(low, s.frames);
-  if (high.has_normals()) {
-    s.high_normals = high.normals;
-    s.high_normal_index = high.normal_index;
-  } else {
-    s.high_normals = compute_vertex_normals(high);
-    s.high_normal_index = high.position_index;
-    st.high_normals_computed = true;
+  {
+    std::vector<glm::vec3> computed;
+    if (!high.has_normals()) {
+      computed = compute_vertex_normals(high);
+      st.high_normals_computed = true;
+    }
+    const std::vector<glm::vec3>& normals = high.has_normals() ? high.normals : computed;
+    const std::vector<std::uint32_t>& index = high.has_normals() ? high.normal_index : high.position_index;
+    s.high_corner_normals.resize(index.size());
+    for (std::size_t c = 0; c < index.size(); ++c) s.high_corner_normals[c] = normals[index[c]];
   }
   for (std::size_t t = 0; t < low.triangle_count(); ++t)
     for (int c = 0; c < 3; ++c) {
@@ -217,20 +226,26 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
                        raycast::BuildQuality::medium, opt.threads);
   st.seconds_bvh = seconds_since(t0);
 
+  std::vector<LowTriangle> low_tris(low.triangle_count());
+  for (std::size_t t = 0; t < low.triangle_count(); ++t)
+    for (int c = 0; c < 3; ++c) {
+      const std::uint32_t pi = low.position_index[3 * t + c];
+      low_tris[t].p[c] = s.low_pos[pi];
+      low_tris[t].ray_n[c] = s.ray_normal[pi];
+      low_tris[t].n[c] = s.frames.normal[3 * t + c];
+      low_tris[t].t[c] = s.frames.tangent[3 * t + c];
+    }
   auto low_point = [&](std::size_t tri, const double b[3]) {
-    glm::dvec3 p(0.0);
-    for (int c = 0; c < 3; ++c) p += b[c] * glm::dvec3(s.low_pos[low.position_index[3 * tri + c]]);
-    return p;
+    const LowTriangle& lt = low_tris[tri];
+    return b[0] * glm::dvec3(lt.p[0]) + b[1] * glm::dvec3(lt.p[1]) + b[2] * glm::dvec3(lt.p[2]);
   };
   auto low_ray_normal = [&](std::size_t tri, const double b[3]) {
-    glm::dvec3 n(0.0);
-    for (int c = 0; c < 3; ++c) n += b[c] * glm::dvec3(s.ray_normal[low.position_index[3 * tri + c]]);
-    const double len = glm::length(n);
-    if (len > 1e-12) return n / len;
+    const LowTriangle& lt = low_tris[tri];
+    const glm::dvec3 n = b[0] * glm::dvec3(lt.ray_n[0]) + b[1] * glm::dvec3(lt.ray_n[1]) + b[2] * glm::dvec3(lt.ray_n[2]);
+    const double len2 = glm::dot(n, n);
+    if (len2 > 1e-24) return n / std::sqrt(len2);
     // Opposite corner normals cancel: fall back to the face normal.
-    const glm::dvec3 p0(s.low_pos[low.position_index[3 * tri]]), p1(s.low_pos[low.position_index[3 * tri + 1]]),
-        p2(s.low_pos[low.position_index[3 * tri + 2]]);
-    const glm::dvec3 f = glm::cross(p1 - p0, p2 - p0);
+    const glm::dvec3 f = glm::cross(glm::dvec3(lt.p[1]) - glm::dvec3(lt.p[0]), glm::dvec3(lt.p[2]) - glm::dvec3(lt.p[0]));
     const double fl = glm::length(f);
     return fl > 0.0 ? f / fl : glm::dvec3(0, 0, 1);
   };
@@ -323,13 +338,15 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   const bool closest = opt.policy == RayPolicy::closest && !cage;
   const int rays_per_sample = closest ? 2 : 1;
 
-  struct ThreadStats {
+  // One cache line each: the counters change per sample, and shared lines would serialize threads.
+  struct alignas(64) ThreadStats {
     std::uint64_t rays = 0, hits = 0, misses = 0, covered = 0, overlaps = 0;
     double dmin = std::numeric_limits<double>::infinity(), dmax = -std::numeric_limits<double>::infinity(), dsum = 0.0;
   };
   std::vector<ThreadStats> tstats(threads);
   std::atomic<std::size_t> next_tile{0}, tiles_done{0};
   std::atomic<bool> cancel{false};
+  std::mutex record_mutex;
 
   auto worker = [&](int id) {
     ThreadStats& ts = tstats[id];
@@ -412,6 +429,10 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
       }
       hits.resize(rays.size());
       if (!rays.empty()) scene.intersect(rays.data(), hits.data(), rays.size());
+      if (opt.record_rays) {
+        std::lock_guard<std::mutex> lock(record_mutex);
+        opt.record_rays->insert(opt.record_rays->end(), rays.begin(), rays.end());
+      }
       ts.rays += rays.size();
       // Shade: the high-poly normal at the hit, in the low-poly's tangent frame at P.
       std::fill(acc.begin(), acc.end(), glm::dvec4(0.0));
@@ -435,7 +456,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
         } else {
           dist = signed_base[r] - h->t;
         }
-        const PixelFrame frame = interpolate_frame(s.frames, std::size_t(sl.tri), sl.b, opt.bitangent);
+        const PixelFrame frame = interpolate_frame(low_tris[sl.tri].n, low_tris[sl.tri].t, sl.b, opt.bitangent);
         glm::dvec3 value;
         ++ts.covered;
         if (h->hit()) {
@@ -446,7 +467,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
           const std::size_t ht = h->triangle;
           const double w[3] = {1.0 - double(h->u) - double(h->v), double(h->u), double(h->v)};
           glm::dvec3 nh(0.0);
-          for (int c = 0; c < 3; ++c) nh += w[c] * glm::dvec3(s.high_normals[s.high_normal_index[3 * ht + c]]);
+          for (int c = 0; c < 3; ++c) nh += w[c] * glm::dvec3(s.high_corner_normals[3 * ht + c]);
           double len = glm::length(nh);
           if (!(len > 1e-12)) {
             const glm::dvec3 q0(s.high_pos[high.position_index[3 * ht]]), q1(s.high_pos[high.position_index[3 * ht + 1]]),

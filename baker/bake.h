@@ -17,6 +17,7 @@
 #include "errors.h"
 #include "image.h"
 #include "mesh.h"
+#include "raycast.h"
 #include "tangent_frames.h"
 
 namespace nmbake {
@@ -41,6 +42,8 @@ struct BakeOptions {
   int padding = 16;     // texels of edge padding around islands; 0 = none
   int threads = 0;      // worker threads; 0 = all cores
   bool miss_mask = false;  // fill BakeResult::miss_mask (share of missed samples per texel)
+  // For the bench: when set, receives a copy of every ray the trace stage cast (order unspecified).
+  std::vector<raycast::Ray>* record_rays = nullptr;
   // Called from the calling thread with the fraction done in [0,1]; return false to cancel
   // (bake_normal_map then throws Cancelled).
   std::function<bool(double)> progress;

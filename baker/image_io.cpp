@@ -127,6 +127,7 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
 
   // Pixels in the stored type: integer formats are quantized here, float goes through as is
   // (OpenImageIO converts float to half for EXR 16).
+  const std::string ext = lower_extension(path);
   OIIO::TypeDesc stored = OIIO::TypeDesc::FLOAT;
   OIIO::TypeDesc given = OIIO::TypeDesc::FLOAT;
   std::vector<std::uint8_t> data8;
@@ -136,7 +137,7 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
     data8 = quantize<std::uint8_t>(image.pixels, 255.0);
     stored = given = OIIO::TypeDesc::UINT8;
     data = data8.data();
-  } else if (bits == 16 && lower_extension(path) != ".exr") {
+  } else if (bits == 16 && ext != ".exr") {
     data16 = quantize<std::uint16_t>(image.pixels, 65535.0);
     stored = given = OIIO::TypeDesc::UINT16;
     data = data16.data();
@@ -148,8 +149,11 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
   // Alpha is coverage, not premultiplication: keep colour values exactly as given.
   spec.attribute("oiio:UnassociatedAlpha", 1);
   for (const auto& [key, value] : options.metadata) spec.attribute(key, value);
+  // Measured on a 2048^2 map: PNG at zlib level 6 took 3.3 s, level 1 0.6 s (file ~10% larger);
+  // EXR zip shrank float normals by 1% in 2.3 s, uncompressed takes 0.1 s.
+  if (ext == ".png") spec.attribute("png:compressionLevel", 1);
+  if (ext == ".exr") spec.attribute("compression", "none");
   // The TIFF writer drops attributes it does not know; keep them readable in the description tag.
-  const std::string ext = lower_extension(path);
   if ((ext == ".tif" || ext == ".tiff") && !options.metadata.empty() &&
       spec.get_string_attribute("ImageDescription").empty()) {
     std::string description;
@@ -173,17 +177,20 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
     out.reset();
     discard(reason);
   }
-  if (!out->write_image(given, data)) {
+  if (!out->write_image(given, data) || out->has_error()) {
     std::string reason = one_line(out->geterror());
     out->close();
     out.reset();
     discard(reason);
   }
+  // Only close()'s result counts: with Debian 12's libtiff every TIFF close records a harmless
+  // "failed TIFFWriteCustomDirectory() of the Exif data" and still writes a good file.
   if (!out->close()) {
     std::string reason = one_line(out->geterror());
     out.reset();
     discard(reason);
   }
+  out->geterror();  // drop that message
   out.reset();
   if (std::rename(temp.c_str(), path.c_str()) != 0) {
     std::string reason = std::strerror(errno);
@@ -223,7 +230,9 @@ Image read_image(const std::string& path) {
     throw ResourceError(path + ": out of memory reading a " + std::to_string(spec.width) + "x" +
                         std::to_string(spec.height) + " image");
   }
-  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data()))
+  // The TIFF reader reports a truncated strip through has_error() yet returns true.
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data()) ||
+      in->has_error())
     return fail(one_line(in->geterror()));
   in->close();
   return image;

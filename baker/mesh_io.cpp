@@ -92,8 +92,7 @@ bool is_whitespace_only(std::string_view bytes) {
 // A byte-order mark, or ASCII characters interleaved with zero bytes.
 bool looks_like_utf16(std::string_view b) {
   auto byte = [&](std::size_t i) { return static_cast<unsigned char>(b[i]); };
-  if (b.size() >= 2 && ((byte(0) == 0xFE && byte(1) == 0xFF) || (byte(0) == 0xFF && byte(1) == 0xFE)))
-    return true;
+  if (b.size() >= 2 && ((byte(0) == 0xFE && byte(1) == 0xFF) || (byte(0) == 0xFF && byte(1) == 0xFE))) return true;
   if (b.size() < 4) return false;
   bool big_endian = byte(0) == 0 && byte(1) != 0 && byte(2) == 0 && byte(3) != 0;
   bool little_endian = byte(0) != 0 && byte(1) == 0 && byte(2) != 0 && byte(3) == 0;
@@ -103,14 +102,6 @@ bool looks_like_utf16(std::string_view b) {
 std::string_view skip_utf8_bom(std::string_view text) {
   if (text.size() >= 3 && text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
   return text;
-}
-
-// Binary STL is the only binary format whose first bytes are arbitrary.
-bool is_binary_stl_size(std::string_view bytes) {
-  if (bytes.size() < 84) return false;
-  std::uint32_t count = 0;
-  std::memcpy(&count, bytes.data() + 80, 4);  // little-endian on every platform we build for
-  return bytes.size() == 84 + 50 * std::uint64_t(count);
 }
 
 ParsedMesh parse_by_extension(const std::string& path, const std::string& ext, std::string_view bytes) {
@@ -193,7 +184,8 @@ Mesh load_mesh(const std::string& path, const LoadOptions& options, MeshLoadInfo
                      "; supported: .obj .ply .off .stl");
     std::string bytes = read_file(path);
     if (bytes.empty() || is_whitespace_only(bytes)) fail(path, "file is empty");
-    if (!(ext == "stl" && is_binary_stl_size(bytes)) && looks_like_utf16(bytes))
+    // Binary STL is the only binary format whose first bytes are arbitrary.
+    if (!(ext == "stl" && mesh_io_detail::is_binary_stl(bytes)) && looks_like_utf16(bytes))
       fail(path, "looks like UTF-16 text; save it as UTF-8");
     return finish_mesh(parse_by_extension(path, ext, bytes), path, options, out_info);
   } catch (const std::bad_alloc&) {

@@ -48,6 +48,9 @@ ParsedMesh parse_ply(const std::string& path, std::string_view bytes);
 ParsedMesh parse_off(const std::string& path, std::string_view text);
 ParsedMesh parse_stl(const std::string& path, std::string_view bytes);
 
+// True when the size matches a binary STL's facet count (84 + 50 bytes per facet).
+bool is_binary_stl(std::string_view bytes);
+
 // (position, uv, normal) indices of one corner.
 using Corner = std::array<std::uint32_t, 3>;
 

@@ -41,8 +41,7 @@ class ObjParser {
   [[noreturn]] void fail_line(const std::string& problem) const {
     fail(path_, "line " + std::to_string(line_) + ": " + problem);
   }
-  float read_value(std::string_view line, std::size_t& pos, Attribute element, bool required,
-                   bool& present) const;
+  float read_value(std::string_view line, std::size_t& pos, Attribute element, bool required, bool& present) const;
   void parse_vertex(std::string_view line, std::size_t pos);
   void parse_uv(std::string_view line, std::size_t pos);
   void parse_normal(std::string_view line, std::size_t pos);
@@ -114,8 +113,8 @@ void ObjParser::parse_normal(std::string_view line, std::size_t pos) {
 // OBJ numbers from 1; negative numbers count back from the last one defined so far.
 std::uint32_t ObjParser::resolve_index(std::string_view text, Attribute attribute) {
   long long value = 0;
-  if (!parse_int(text, value)) fail_line("face has a malformed " + std::string(kAttributeNames[attribute]) +
-                                         " index " + quote(text));
+  if (!parse_int(text, value))
+    fail_line("face has a malformed " + std::string(kAttributeNames[attribute]) + " index " + quote(text));
   const char* name = kAttributeNames[attribute];
   if (value == 0) fail_line(std::string("face refers to ") + name + " 0 (OBJ numbers them from 1)");
   long long count = static_cast<long long>(attribute_count(out_.mesh, attribute));
@@ -221,8 +220,8 @@ bool strip_continuation(std::string_view& line) {
 
 ParsedMesh parse_obj(const std::string& path, std::string_view text) {
   if (const void* nul = std::memchr(text.data(), '\0', text.size()))
-    fail(path, "contains a zero byte at offset " +
-                   std::to_string(static_cast<const char*>(nul) - text.data()) + "; not an OBJ text file");
+    fail(path, "contains a zero byte at offset " + std::to_string(static_cast<const char*>(nul) - text.data()) +
+                   "; not an OBJ text file");
 
   ParsedMesh out;
   out.format = "obj";

@@ -6,21 +6,20 @@
 // stores nothing), OpenMesh then reads it into a flat importer of ours (no halfedge structure, so no
 // face is dropped or split for being non-manifold), anything OpenMesh writes to omerr() becomes an
 // InputError, and the element counts it delivers are compared with the file's.
-#include <OpenMesh/Core/IO/Options.hh>
-#include <OpenMesh/Core/IO/importer/BaseImporter.hh>
-#include <OpenMesh/Core/IO/reader/OFFReader.hh>
-#include <OpenMesh/Core/IO/reader/STLReader.hh>
-#include <OpenMesh/Core/System/omstream.hh>
-
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <iostream>
 #include <mutex>
 #include <sstream>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include <OpenMesh/Core/IO/Options.hh>
+#include <OpenMesh/Core/IO/importer/BaseImporter.hh>
+#include <OpenMesh/Core/IO/reader/OFFReader.hh>
+#include <OpenMesh/Core/IO/reader/STLReader.hh>
+#include <OpenMesh/Core/System/omstream.hh>
 
 #include "mesh_io_detail.h"
 
@@ -30,13 +29,13 @@ namespace {
 using OpenMesh::EdgeHandle;
 using OpenMesh::FaceHandle;
 using OpenMesh::HalfedgeHandle;
-using OpenMesh::VertexHandle;
 using OpenMesh::Vec2f;
 using OpenMesh::Vec3d;
 using OpenMesh::Vec3f;
 using OpenMesh::Vec3uc;
 using OpenMesh::Vec4f;
 using OpenMesh::Vec4uc;
+using OpenMesh::VertexHandle;
 using StatusInfo = OpenMesh::Attributes::StatusInfo;
 
 // Collects what a reader delivers straight into a ParsedMesh. Problems are remembered (the first
@@ -160,19 +159,20 @@ class FlatImporter : public OpenMesh::IO::BaseImporter {
 };
 
 // OpenMesh's readers are singletons with per-read state and report through the global omerr(), so
-// one read at a time; while it runs, omerr() goes to a string instead of stderr.
+// one read at a time; while it runs, omerr() writes into a string instead of stderr.
 std::mutex openmesh_mutex;
 
+// Swaps omerr()'s stream buffer rather than using mostream::connect/disconnect: disconnect() drops
+// the target object it allocated in connect() without deleting it, a leak per load under ASan.
 class OmerrCapture {
  public:
-  OmerrCapture() : had_cerr_(omerr().disconnect(std::cerr)) { omerr().connect(text_); }
-  ~OmerrCapture() {
-    omerr().flush();
-    omerr().disconnect(text_);
-    if (had_cerr_) omerr().connect(std::cerr);
-  }
-  std::string text() {
-    omerr().flush();
+  OmerrCapture() : previous_(omerr().rdbuf(text_.rdbuf())) {}
+  ~OmerrCapture() { omerr().rdbuf(previous_); }
+  OmerrCapture(const OmerrCapture&) = delete;
+  OmerrCapture& operator=(const OmerrCapture&) = delete;
+
+  // What OpenMesh wrote, on one line.
+  std::string text() const {
     std::string s = text_.str();
     while (!s.empty() && is_space(s.back())) s.pop_back();
     for (char& c : s)
@@ -182,7 +182,7 @@ class OmerrCapture {
 
  private:
   std::ostringstream text_;
-  bool had_cerr_;
+  std::streambuf* previous_;
 };
 
 // Runs `read` (an OpenMesh reader call) into `out` and turns everything it leaves unsaid into errors.
@@ -249,19 +249,15 @@ std::string check_off(const std::string& path, std::string_view text, std::size_
   std::size_t p = 0;
   std::string_view magic = next_token(line, p);
   if (!is_off_magic(magic)) fail(path, "not an OFF file (it does not start with 'OFF')");
-  if (magic.find_first_of("4n") != std::string_view::npos) fail(path, quote(magic) + " (4D or n-D OFF) is not supported");
+  if (magic.find_first_of("4n") != std::string_view::npos)
+    fail(path, quote(magic) + " (4D or n-D OFF) is not supported");
   std::string_view word = next_token(line, p);
   if (word == "BINARY") fail(path, "binary OFF is not supported; save it as ASCII OFF or as PLY");
 
-  // The counts may follow the magic on its line.
-  std::string_view counts_line = line.substr(p);
+  // The counts follow on the magic's line or on the next one.
+  std::string_view counts_line = line.substr(p - word.size());
+  if (word.empty() && !lines.next(counts_line)) fail(path, "file ends before the vertex and face counts");
   std::size_t cp = 0;
-  if (word.empty()) {
-    if (!lines.next(counts_line)) fail(path, "file ends before the vertex and face counts");
-  } else {
-    cp = 0;
-    counts_line = line.substr(p - word.size());
-  }
   long long counts[2] = {0, 0};
   for (long long& c : counts) {
     std::string_view token = next_token(counts_line, cp);
@@ -273,22 +269,26 @@ std::string check_off(const std::string& path, std::string_view text, std::size_
   vertex_count = static_cast<std::size_t>(counts[0]);
   face_count = static_cast<std::size_t>(counts[1]);
 
-  std::string clean = std::string(magic) + "\n" + std::to_string(vertex_count) + " " + std::to_string(face_count) + " 0\n";
+  std::string clean =
+      std::string(magic) + "\n" + std::to_string(vertex_count) + " " + std::to_string(face_count) + " 0\n";
   auto at_line = [&] { return "line " + std::to_string(lines.line_number()) + ": "; };
   for (std::size_t v = 0; v < vertex_count; ++v) {
-    if (!lines.next(line)) fail(path, "truncated: file ends in vertex " + std::to_string(v) + " of " + std::to_string(vertex_count));
+    if (!lines.next(line))
+      fail(path, "truncated: file ends in vertex " + std::to_string(v) + " of " + std::to_string(vertex_count));
     std::size_t q = 0;
     for (int axis = 0; axis < 3; ++axis) {
       std::string_view token = next_token(line, q);
       float value = 0;
       if (token.empty()) fail(path, at_line() + "vertex " + std::to_string(v) + " has fewer than 3 coordinates");
-      if (!parse_real(token, value)) fail(path, at_line() + "vertex " + std::to_string(v) + " has a malformed number " + quote(token));
+      if (!parse_real(token, value))
+        fail(path, at_line() + "vertex " + std::to_string(v) + " has a malformed number " + quote(token));
       if (!std::isfinite(value)) fail(path, at_line() + "vertex " + std::to_string(v) + " has a non-finite coordinate");
     }
     clean.append(line).push_back('\n');
   }
   for (std::size_t f = 0; f < face_count; ++f) {
-    if (!lines.next(line)) fail(path, "truncated: file ends in face " + std::to_string(f) + " of " + std::to_string(face_count));
+    if (!lines.next(line))
+      fail(path, "truncated: file ends in face " + std::to_string(f) + " of " + std::to_string(face_count));
     const std::string face = "face " + std::to_string(f);
     std::size_t q = 0;
     std::string_view token = next_token(line, q);
@@ -315,10 +315,6 @@ std::uint32_t binary_stl_count(std::string_view bytes) {
   std::uint32_t count = 0;
   std::memcpy(&count, bytes.data() + 80, 4);  // little-endian, as is every platform we build for
   return count;
-}
-
-bool is_binary_stl(std::string_view bytes) {
-  return bytes.size() >= 84 && bytes.size() == 84 + 50 * std::uint64_t(binary_stl_count(bytes));
 }
 
 void check_binary_stl(const std::string& path, std::string_view bytes) {
@@ -367,6 +363,10 @@ std::size_t check_ascii_stl(const std::string& path, std::string_view text) {
 
 }  // namespace
 
+bool is_binary_stl(std::string_view bytes) {
+  return bytes.size() >= 84 && bytes.size() == 84 + 50 * std::uint64_t(binary_stl_count(bytes));
+}
+
 ParsedMesh parse_off(const std::string& path, std::string_view text) {
   ParsedMesh out;
   out.format = "off";
@@ -407,12 +407,12 @@ ParsedMesh parse_stl(const std::string& path, std::string_view bytes) {
   }
   if (facets == 0) return out;  // load_mesh reports "no faces"
   std::istringstream stream{std::string(bytes)};
-  read_with_openmesh(path, out, [&](FlatImporter& importer) {
-    return OpenMesh::IO::STLReader().read(stream, importer, options);
-  });
+  read_with_openmesh(path, out,
+                     [&](FlatImporter& importer) { return OpenMesh::IO::STLReader().read(stream, importer, options); });
   // OpenMesh welds coincident vertices and drops facets left with a repeated corner.
   if (out.file_faces > facets)
-    fail(path, "OpenMesh read " + std::to_string(out.file_faces) + " facets but the file has " + std::to_string(facets));
+    fail(path,
+         "OpenMesh read " + std::to_string(out.file_faces) + " facets but the file has " + std::to_string(facets));
   out.degenerate_faces_dropped = facets - out.file_faces;
   out.file_faces = facets;
   return out;

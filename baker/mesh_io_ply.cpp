@@ -66,13 +66,12 @@ bool parse_scalar_name(std::string_view name, Scalar& t) {
     const char* text;
     Scalar type;
   };
-  static const Name names[] = {
-      {"char", Scalar::int8},     {"int8", Scalar::int8},       {"uchar", Scalar::uint8},
-      {"uint8", Scalar::uint8},   {"short", Scalar::int16},     {"int16", Scalar::int16},
-      {"ushort", Scalar::uint16}, {"uint16", Scalar::uint16},   {"int", Scalar::int32},
-      {"int32", Scalar::int32},   {"uint", Scalar::uint32},     {"uint32", Scalar::uint32},
-      {"float", Scalar::float32}, {"float32", Scalar::float32}, {"double", Scalar::float64},
-      {"float64", Scalar::float64}};
+  static const Name names[] = {{"char", Scalar::int8},      {"int8", Scalar::int8},       {"uchar", Scalar::uint8},
+                               {"uint8", Scalar::uint8},    {"short", Scalar::int16},     {"int16", Scalar::int16},
+                               {"ushort", Scalar::uint16},  {"uint16", Scalar::uint16},   {"int", Scalar::int32},
+                               {"int32", Scalar::int32},    {"uint", Scalar::uint32},     {"uint32", Scalar::uint32},
+                               {"float", Scalar::float32},  {"float32", Scalar::float32}, {"double", Scalar::float64},
+                               {"float64", Scalar::float64}};
   for (const Name& n : names)
     if (name == n.text) {
       t = n.type;
@@ -105,18 +104,22 @@ Header parse_header(const std::string& path, std::string_view bytes) {
     if (keyword == "end_header") break;
     if (keyword == "format") {
       std::string_view name = next_token(line, p);
-      if (name == "ascii") header.encoding = Encoding::ascii;
-      else if (name == "binary_little_endian") header.encoding = Encoding::binary_little_endian;
-      else if (name == "binary_big_endian") header.encoding = Encoding::binary_big_endian;
-      else header_fail("unknown format " + quote(name));
+      if (name == "ascii") {
+        header.encoding = Encoding::ascii;
+      } else if (name == "binary_little_endian") {
+        header.encoding = Encoding::binary_little_endian;
+      } else if (name == "binary_big_endian") {
+        header.encoding = Encoding::binary_big_endian;
+      } else {
+        header_fail("unknown format " + quote(name));
+      }
       have_format = true;
     } else if (keyword == "element") {
       Element element;
       element.name = std::string(next_token(line, p));
       std::string_view count_text = next_token(line, p);
       long long count = 0;
-      if (element.name.empty() || !parse_int(count_text, count))
-        header_fail("element line needs a name and a count");
+      if (element.name.empty() || !parse_int(count_text, count)) header_fail("element line needs a name and a count");
       if (count < 0) fail(path, "element " + element.name + " has a negative count " + std::to_string(count));
       element.count = static_cast<std::uint64_t>(count);
       header.elements.push_back(std::move(element));
@@ -185,7 +188,8 @@ Role vertex_role(const std::string& name, const Element& vertex) {
   if (name == "ny") return kNy;
   if (name == "nz") return kNz;
   // The first complete UV pair in this order wins.
-  static const char* const pairs[][2] = {{"s", "t"}, {"u", "v"}, {"texture_u", "texture_v"}, {"texture_s", "texture_t"}};
+  static const char* const pairs[][2] = {
+      {"s", "t"}, {"u", "v"}, {"texture_u", "texture_v"}, {"texture_s", "texture_t"}};
   for (const auto& pair : pairs) {
     if (!has(pair[0]) || !has(pair[1])) continue;
     if (name == pair[0]) return kU;
@@ -224,11 +228,19 @@ double load_scalar(const char* p, Scalar t, bool swap) {
   return 0.0;
 }
 
+// A value for a message: integers without a fraction, anything else (NaN included) as is.
+std::string number_text(double v) {
+  if (std::fabs(v) < 1e15 && v == std::floor(v)) return std::to_string(static_cast<long long>(v));
+  return std::to_string(v);
+}
+
 // Both encodings behind one interface: values come out as doubles (exact for every PLY integer).
 class DataReader {
  public:
   DataReader(const std::string& path, const Header& header, std::string_view bytes)
-      : path_(path), encoding_(header.encoding), data_(bytes.substr(header.data_offset)),
+      : path_(path),
+        encoding_(header.encoding),
+        data_(bytes.substr(header.data_offset)),
         swap_(header.encoding != Encoding::ascii &&
               (header.encoding == Encoding::binary_little_endian) != kHostLittleEndian) {}
 
@@ -244,16 +256,6 @@ class DataReader {
     pos_ += size;
     return value;
   }
-  // Reads `n` binary values of type T (the file's type) into `out`; false for ascii data or types
-  // that differ, where the caller falls back to read().
-  template <typename T>
-  bool read_binary_run(Scalar t, std::size_t n, T* out) {
-    if (encoding_ == Encoding::ascii || scalar_size(t) != sizeof(T)) return false;
-    if (data_.size() - pos_ < n * sizeof(T)) truncated();
-    for (std::size_t i = 0; i < n; ++i) out[i] = load<T>(data_.data() + pos_ + i * sizeof(T), swap_);
-    pos_ += n * sizeof(T);
-    return true;
-  }
   void skip(Scalar t, std::uint64_t n) {
     if (encoding_ == Encoding::ascii) {
       for (std::uint64_t i = 0; i < n; ++i)
@@ -268,7 +270,7 @@ class DataReader {
   std::uint64_t read_list_count(const Property& p) {
     double count = read(p.count_type);
     if (count < 0 || count != std::floor(count))
-      fail_here("has a list '" + p.name + "' with an invalid length " + format_number(count));
+      fail_here("has a list '" + p.name + "' with an invalid length " + number_text(count));
     std::uint64_t n = static_cast<std::uint64_t>(count);
     std::uint64_t item_bytes = encoding_ == Encoding::ascii ? 1 : scalar_size(p.type);
     if (n * item_bytes > data_.size() - pos_) truncated();
@@ -279,6 +281,7 @@ class DataReader {
   }
 
  private:
+  // Out of line, like truncated(), so that read() stays small enough to inline into the loops.
   [[gnu::noinline]] double read_ascii() {
     std::string_view token = next_token(data_, pos_);
     if (token.empty()) truncated();
@@ -290,11 +293,6 @@ class DataReader {
     fail(path_, "truncated: file ends in " + element_->name + " " + std::to_string(index_) + " of " +
                     std::to_string(element_->count));
   }
-  static std::string format_number(double v) {
-    if (std::fabs(v) < 1e15 && v == std::floor(v)) return std::to_string(static_cast<long long>(v));
-    return std::to_string(v);
-  }
-
   const std::string& path_;
   Encoding encoding_;
   std::string_view data_;
@@ -376,7 +374,8 @@ void read_vertex(DataReader& reader, const Element& e, const Layout& layout, std
       default: break;
     }
   }
-  if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) reader.fail_here("has a non-finite coordinate");
+  if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+    reader.fail_here("has a non-finite coordinate");
   if (!std::isfinite(n.x) || !std::isfinite(n.y) || !std::isfinite(n.z)) reader.fail_here("has a non-finite normal");
   if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) reader.fail_here("has a non-finite texture coordinate");
   m.positions[i] = p;
@@ -414,8 +413,7 @@ class FaceReader {
     for (std::uint64_t k = 0; k < n; ++k) {
       double v = reader.read(prop.type);
       if (v < 0 || v >= double(vertex_count_) || v != std::floor(v))
-        reader.fail_here("refers to vertex " + std::to_string(static_cast<long long>(v)) + " but the file has " +
-                         std::to_string(vertex_count_));
+        reader.fail_here("refers to vertex " + number_text(v) + " but the file has " + std::to_string(vertex_count_));
       auto index = static_cast<std::uint32_t>(v);
       corners_.push_back({index, index, index});
     }
@@ -439,8 +437,10 @@ class FaceReader {
       }
     }
     ++out_.file_faces;
-    if (has_uvs) ++out_.faces_with_uvs;
-    else if (out_.first_face_without_uvs.empty()) out_.first_face_without_uvs = "face " + std::to_string(face);
+    if (has_uvs)
+      ++out_.faces_with_uvs;
+    else if (out_.first_face_without_uvs.empty())
+      out_.first_face_without_uvs = "face " + std::to_string(face);
     if (layout_.normals) ++out_.faces_with_normals;
     add_polygon(out_, corners_.data(), n, face);
   }

@@ -26,6 +26,20 @@ TexelTriangle setup_texel_triangle(glm::vec2 uv0, glm::vec2 uv1, glm::vec2 uv2, 
   t.area2 = e1.x * e2.y - e1.y * e2.x;
   if (!std::isfinite(t.area2)) t.area2 = 0.0;
   if (t.area2 == 0.0) return t;
+  for (int k = 0; k < 3; ++k) {
+    // Evaluating each edge from its lexicographically smaller end makes its value bit-identical
+    // for both triangles sharing it.
+    glm::dvec2 a = t.p[k], b = t.p[(k + 1) % 3];
+    if (less(b, a)) std::swap(a, b);
+    const glm::dvec2 c = t.p[(k + 2) % 3];
+    t.edge_a[k] = a;
+    t.edge_d[k] = b - a;
+    t.edge_side[k] = t.edge_d[k].x * (c.y - a.y) - t.edge_d[k].y * (c.x - a.x);
+    if (t.edge_side[k] == 0.0) {  // collinear in texel space after rounding: covers nothing
+      t.area2 = 0.0;
+      return t;
+    }
+  }
   const double minx = std::min({t.p[0].x, t.p[1].x, t.p[2].x}), maxx = std::max({t.p[0].x, t.p[1].x, t.p[2].x});
   const double miny = std::min({t.p[0].y, t.p[1].y, t.p[2].y}), maxy = std::max({t.p[0].y, t.p[1].y, t.p[2].y});
   // Any sample x + ox with ox in [0,1) inside [minx, maxx] has x in [floor(minx), floor(maxx)].
@@ -42,18 +56,12 @@ bool covers(const TexelTriangle& tri, glm::dvec2 q, double bary[3]) {
   if (tri.area2 == 0.0) return false;
   double w[3];
   for (int k = 0; k < 3; ++k) {
-    // Edge k runs between corners k and k+1 and is opposite corner k+2. Evaluating it from its
-    // lexicographically smaller end makes the value bit-identical for both triangles sharing it.
-    glm::dvec2 a = tri.p[k], b = tri.p[(k + 1) % 3];
-    if (less(b, a)) std::swap(a, b);
-    const glm::dvec2 c = tri.p[(k + 2) % 3];
-    const double side = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-    const double e = (b.x - a.x) * (q.y - a.y) - (b.y - a.y) * (q.x - a.x);
-    if (side == 0.0) return false;
+    const glm::dvec2 a = tri.edge_a[k], d = tri.edge_d[k];
+    const double side = tri.edge_side[k];
+    const double e = d.x * (q.y - a.y) - d.y * (q.x - a.x);
     // Strictly inside, or on the edge and this triangle lies on the edge's positive side: of two
     // triangles sharing an edge exactly one does.
-    if (side > 0.0 ? e < 0.0 : e > 0.0) return false;
-    if (e == 0.0 && side < 0.0) return false;
+    if (side > 0.0 ? e < 0.0 : e >= 0.0) return false;
     w[(k + 2) % 3] = e / side;
   }
   const double sum = w[0] + w[1] + w[2];

@@ -21,6 +21,10 @@ namespace nmbake {
 struct TexelTriangle {
   glm::dvec2 p[3];        // corners in texel space
   double area2 = 0.0;     // twice the signed area in texel space (0: degenerate, covers nothing)
+  // Edge k (corners k, k+1, opposite corner k+2) from its lexicographically smaller end `a` along
+  // `d`, and the signed value of the opposite corner (`side`) in that edge function.
+  glm::dvec2 edge_a[3], edge_d[3];
+  double edge_side[3] = {0, 0, 0};
   int xmin = 0, xmax = -1, ymin = 0, ymax = -1;  // inclusive texel bounding box, clipped to image
   bool valid() const { return area2 != 0.0; }
 };

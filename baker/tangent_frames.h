@@ -45,6 +45,9 @@ struct PixelFrame {
 };
 PixelFrame interpolate_frame(const TangentFrames& frames, std::size_t tri, const double bary[3],
                              BitangentMode mode = BitangentMode::per_pixel);
+// The same from a triangle's three corner normals and tangents.
+PixelFrame interpolate_frame(const glm::vec3 normal[3], const glm::vec4 tangent[3], const double bary[3],
+                             BitangentMode mode = BitangentMode::per_pixel);
 
 // Tangent-space unit vector whose decoding in `frame` is the world direction `world`: the exact
 // inverse of normalize(t.x*T + t.y*B + t.z*N), renormalized. Falls back to (0,0,1) when the frame

@@ -10,6 +10,7 @@
 #include <cstring>
 #include <fstream>
 #include <initializer_list>
+#include <iterator>
 #include <string>
 #include <utility>
 #include <vector>
@@ -27,8 +28,8 @@ namespace {
 using test::data_path;
 using test::shared_data_path;
 
-#define SKIP_WITHOUT_SHARED_DATA()                                                         \
-  if (!test::exists(shared_data_path("meshes")))                                          \
+#define SKIP_WITHOUT_SHARED_DATA()               \
+  if (!test::exists(shared_data_path("meshes"))) \
   GTEST_SKIP() << "../shared/data is absent (" << shared_data_path("meshes") << "); skipping"
 
 std::string file_name(const std::string& path) { return path.substr(path.find_last_of('/') + 1); }
@@ -48,12 +49,11 @@ void expect_error(const std::string& path, std::initializer_list<const char*> wo
   std::string message = load_error(path, options);
   EXPECT_NE(message.find(file_name(path)), std::string::npos) << message;
   EXPECT_EQ(message.find('\n'), std::string::npos) << "not one line: " << message;
-  for (const char* word : words) EXPECT_NE(message.find(word), std::string::npos) << "'" << word << "' not in: " << message;
+  for (const char* word : words)
+    EXPECT_NE(message.find(word), std::string::npos) << "'" << word << "' not in: " << message;
 }
 
-void write_file(const std::string& path, const std::string& bytes) {
-  std::ofstream(path, std::ios::binary) << bytes;
-}
+void write_file(const std::string& path, const std::string& bytes) { std::ofstream(path, std::ios::binary) << bytes; }
 
 // Defects that must be refused --------------------------------------------------------------------
 
@@ -72,7 +72,8 @@ TEST_P(DefectTest, FailsWithMessageNamingFileAndProblem) {
   std::string message = load_error(data_path(std::string("defects/") + d.file), options);
   EXPECT_NE(message.find(d.file), std::string::npos) << message;
   EXPECT_EQ(message.find('\n'), std::string::npos) << message;
-  for (const char* word : d.words) EXPECT_NE(message.find(word), std::string::npos) << "'" << word << "' not in: " << message;
+  for (const char* word : d.words)
+    EXPECT_NE(message.find(word), std::string::npos) << "'" << word << "' not in: " << message;
 }
 
 const Defect kDefects[] = {
@@ -259,7 +260,7 @@ TEST(MeshIo, StlDegenerateFacetIsCounted) {
 
 // A PLY written by the test itself, value by value, so every encoding and type can be checked.
 struct PlyProperty {
-  std::string type;        // "float", "uint8", ...
+  std::string type;  // "float", "uint8", ...
   std::string name;
   std::string count_type;  // non-empty for a list
 };
@@ -270,22 +271,21 @@ struct PlyElement {
 };
 
 void put_binary(std::string& out, const std::string& type, double v, bool big_endian) {
-  unsigned char raw[8];
-  std::size_t size = 0;
-  auto store = [&](auto value) {
-    size = sizeof(value);
-    std::memcpy(raw, &value, size);
+  auto put = [&](auto value) {
+    unsigned char raw[sizeof(value)];
+    std::memcpy(raw, &value, sizeof(value));
+    for (std::size_t i = 0; i < sizeof(value); ++i)
+      out.push_back(static_cast<char>(raw[big_endian ? sizeof(value) - 1 - i : i]));
   };
-  if (type == "char" || type == "int8") store(static_cast<std::int8_t>(v));
-  else if (type == "uchar" || type == "uint8") store(static_cast<std::uint8_t>(v));
-  else if (type == "short" || type == "int16") store(static_cast<std::int16_t>(v));
-  else if (type == "ushort" || type == "uint16") store(static_cast<std::uint16_t>(v));
-  else if (type == "int" || type == "int32") store(static_cast<std::int32_t>(v));
-  else if (type == "uint" || type == "uint32") store(static_cast<std::uint32_t>(v));
-  else if (type == "float" || type == "float32") store(static_cast<float>(v));
-  else if (type == "double" || type == "float64") store(v);
-  else ADD_FAILURE() << "bad type " << type;
-  for (std::size_t i = 0; i < size; ++i) out.push_back(static_cast<char>(raw[big_endian ? size - 1 - i : i]));
+  if (type == "char" || type == "int8") return put(static_cast<std::int8_t>(v));
+  if (type == "uchar" || type == "uint8") return put(static_cast<std::uint8_t>(v));
+  if (type == "short" || type == "int16") return put(static_cast<std::int16_t>(v));
+  if (type == "ushort" || type == "uint16") return put(static_cast<std::uint16_t>(v));
+  if (type == "int" || type == "int32") return put(static_cast<std::int32_t>(v));
+  if (type == "uint" || type == "uint32") return put(static_cast<std::uint32_t>(v));
+  if (type == "float" || type == "float32") return put(static_cast<float>(v));
+  if (type == "double" || type == "float64") return put(v);
+  ADD_FAILURE() << "bad type " << type;
 }
 
 std::string make_ply(const std::string& format, const std::vector<PlyElement>& elements) {
@@ -303,8 +303,11 @@ std::string make_ply(const std::string& format, const std::vector<PlyElement>& e
       for (std::size_t k = 0; k < e.properties.size(); ++k) {
         const PlyProperty& p = e.properties[k];
         if (!p.count_type.empty()) {
-          if (ascii) out += std::to_string(row[k].size()) + " ";
-          else put_binary(out, p.count_type, double(row[k].size()), big);
+          if (ascii) {
+            out += std::to_string(row[k].size()) + " ";
+          } else {
+            put_binary(out, p.count_type, double(row[k].size()), big);
+          }
         }
         for (double v : row[k]) {
           if (ascii) {
@@ -328,14 +331,23 @@ std::vector<PlyElement> sample_ply(const std::string& coord_type, const std::str
   PlyElement extra{"material", {{"uchar", "id", ""}, {"float", "weights", "uchar"}}, {}};
   extra.rows = {{{7}, {0.5, 0.25}}, {{8}, {}}};
   PlyElement vertex{"vertex",
-                    {{coord_type, "x", ""}, {"uchar", "red", ""}, {coord_type, "y", ""}, {"int", "ring", "uchar"},
-                     {coord_type, "z", ""}, {"float", "nx", ""}, {"float", "ny", ""}, {"float", "nz", ""},
-                     {"float", u, ""}, {"float", v, ""}},
+                    {{coord_type, "x", ""},
+                     {"uchar", "red", ""},
+                     {coord_type, "y", ""},
+                     {"int", "ring", "uchar"},
+                     {coord_type, "z", ""},
+                     {"float", "nx", ""},
+                     {"float", "ny", ""},
+                     {"float", "nz", ""},
+                     {"float", u, ""},
+                     {"float", v, ""}},
                     {}};
   const double p[5][3] = {{0, 0, 0}, {2, 0, 0}, {2, 2, 0}, {0, 2, 0}, {1, 3, -1}};
   for (int i = 0; i < 5; ++i)
-    vertex.rows.push_back({{p[i][0]}, {200}, {p[i][1]}, {1, 2, 3}, {p[i][2]}, {0}, {0}, {1}, {p[i][0] / 4}, {p[i][1] / 4}});
-  PlyElement face{"face", {{"uchar", "flags", ""}, {index_type, "vertex_indices", count_type}, {"float", "quality", "uchar"}}, {}};
+    vertex.rows.push_back(
+        {{p[i][0]}, {200}, {p[i][1]}, {1, 2, 3}, {p[i][2]}, {0}, {0}, {1}, {p[i][0] / 4}, {p[i][1] / 4}});
+  PlyElement face{
+      "face", {{"uchar", "flags", ""}, {index_type, "vertex_indices", count_type}, {"float", "quality", "uchar"}}, {}};
   face.rows = {{{1}, {0, 1, 2, 3}, {0.5}}, {{2}, {3, 2, 4}, {}}};
   PlyElement edge{"edge", {{"int", "vertex1", ""}, {"int", "vertex2", ""}}, {{{0}, {1}}}};
   return {extra, vertex, face, edge};
@@ -355,7 +367,8 @@ void expect_sample_mesh(const Mesh& m, const std::string& what) {
 TEST(MeshIo, PlyEveryEncodingAndScalarType) {
   const std::string dir = test::scratch_dir();
   const char* formats[] = {"ascii", "binary_little_endian", "binary_big_endian"};
-  const char* coord_types[] = {"float", "float32", "double", "float64", "char", "int8", "short", "int16", "int", "int32"};
+  const char* coord_types[] = {"float", "float32", "double", "float64", "char",
+                               "int8",  "short",   "int16",  "int",     "int32"};
   const char* count_types[] = {"uchar", "uint8", "char", "ushort", "short", "int", "uint", "uint32"};
   const char* index_types[] = {"int", "int32", "uint", "uint32", "uchar", "uint8", "short", "ushort", "uint16", "char"};
   int n = 0;
@@ -444,8 +457,14 @@ TEST(MeshIo, PlyTruncatedInEveryElement) {
 std::vector<PlyElement> mesh_as_ply(const Mesh& m) {
   // Unshared corners, as OBJ's separate index streams cannot be written as PLY vertices otherwise.
   PlyElement vertex{"vertex",
-                    {{"float", "x", ""}, {"float", "y", ""}, {"float", "z", ""}, {"float", "nx", ""},
-                     {"float", "ny", ""}, {"float", "nz", ""}, {"float", "s", ""}, {"float", "t", ""}},
+                    {{"float", "x", ""},
+                     {"float", "y", ""},
+                     {"float", "z", ""},
+                     {"float", "nx", ""},
+                     {"float", "ny", ""},
+                     {"float", "nz", ""},
+                     {"float", "s", ""},
+                     {"float", "t", ""}},
                     {}};
   PlyElement face{"face", {{"uint", "vertex_indices", "uchar"}}, {}};
   for (std::size_t t = 0; t < m.triangle_count(); ++t) {

@@ -52,8 +52,10 @@ TEST(Rasterize, SharedEdgesNeitherCrackNorDoubleCount) {
     // The centre region (radius 0.3 in UV) lies inside the polygon: no cracks there.
     for (int y = 0; y < H; ++y)
       for (int x = 0; x < W; ++x) {
-        const glm::vec2 p((x + 0.5f) / W, 1.0f - (y + 0.5f) / H);
-        if (glm::length(p - glm::vec2(0.5f)) < 0.38f) EXPECT_EQ(count[y * W + x], 1) << "crack at " << x << "," << y;
+        const glm::vec2 p((float(x) + 0.5f) / float(W), 1.0f - (float(y) + 0.5f) / float(H));
+        if (glm::length(p - glm::vec2(0.5f)) < 0.38f) {
+          EXPECT_EQ(count[y * W + x], 1) << "crack at " << x << "," << y;
+        }
       }
   }
 }

@@ -382,14 +382,22 @@ void Renderer::render(unsigned target, int width, int height, const OrbitView& v
   const float scale = std::max(1.0f, std::floor(float(height) / 400.0f));
   const float margin = 4.0f * scale;
   if (toggles.labels) {
-    std::string left = toggles.tangent_colours ? "LOW: MAP IN TANGENT-SPACE COLOURS"
-                       : toggles.map           ? "LOW + NORMAL MAP"
-                                               : "LOW, NO MAP";
-    std::vector<std::string> titles = {left + "   " + with_thousands(low_triangles()) + " TRIS",
-                                       "HIGH   " + with_thousands(high_triangles()) + " TRIS"};
-    if (toggles.difference) titles.push_back("DIFFERENCE X" + std::to_string(int(kDifferenceGain)));
-    for (std::size_t i = 0; i < layout.size(); ++i)
-      draw_text(titles[i], float(layout[i].x) + margin, margin, scale, width, height);
+    // Two lines per pane, clipped to the pane: what it is with its triangle count, then its mode.
+    const std::string mode = toggles.tangent_colours ? "MAP IN TANGENT-SPACE COLOURS"
+                             : toggles.map           ? "WITH NORMAL MAP"
+                                                     : "NO MAP (BARE SHADING)";
+    const std::vector<std::pair<std::string, std::string>> titles = {
+        {"LOW  " + with_thousands(low_triangles()) + " TRIS", mode},
+        {"HIGH  " + with_thousands(high_triangles()) + " TRIS", "OWN NORMALS"},
+        {"DIFFERENCE X" + std::to_string(int(kDifferenceGain)), "LEFT - RIGHT"}};
+    glEnable(GL_SCISSOR_TEST);
+    for (std::size_t i = 0; i < layout.size(); ++i) {
+      const Rect& r = layout[i];
+      glScissor(r.x, r.y, r.width, r.height);
+      draw_text(titles[i].first, float(r.x) + margin, margin, scale, width, height);
+      draw_text(titles[i].second, float(r.x) + margin, margin + kCellHeight * scale, scale, width, height);
+    }
+    glDisable(GL_SCISSOR_TEST);
   }
   for (std::size_t i = 0; i < help.size(); ++i) {
     float y = float(height) - margin - float(help.size() - i) * kCellHeight * scale;

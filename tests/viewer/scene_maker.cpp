@@ -65,14 +65,15 @@ void write_uv_sphere(const std::string& path, int segments, int rings) {
   write_faces(out, segments, rings, true);
 }
 
-void write_bumpy_sphere(const std::string& path, int segments, int rings) {
+void write_bumpy_sphere(const std::string& path, int segments, int rings, double frequency, double amplitude) {
   std::ofstream out(path);
   if (!out) throw std::runtime_error("cannot write " + path);
   out.precision(9);
   for (int i = 0; i <= rings; ++i)
     for (int j = 0; j <= segments; ++j) {
       const glm::dvec3 d = sphere_direction(i, j, segments, rings);
-      const double r = 1.0 + 0.01 * (std::sin(9 * d.x) + std::sin(9 * d.y) + std::sin(9 * d.z));
+      const double r =
+          1.0 + amplitude * (std::sin(frequency * d.x) + std::sin(frequency * d.y) + std::sin(frequency * d.z));
       out << "v " << r * d.x << " " << r * d.y << " " << r * d.z << "\n";
     }
   write_faces(out, segments, rings, false);

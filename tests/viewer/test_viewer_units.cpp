@@ -1,4 +1,5 @@
-// Known answers for the viewer's CPU parts: vertex merging, camera, metrics, font, layout.
+// Known answers for the viewer: vertex merging, camera, metrics, font, layout (CPU), and the
+// decoding of a constant tilted map on a plane rendered headless (GPU or llvmpipe).
 #include <cmath>
 #include <set>
 
@@ -6,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "font.h"
+#include "gl_context.h"
 #include "metrics.h"
 #include "renderer.h"
 #include "tangent_frames.h"
@@ -191,6 +193,67 @@ TEST(Layout, PanesHaveEqualWidthsSideBySide) {
   EXPECT_EQ(with_thousands(98304), "98,304");
   EXPECT_EQ(with_thousands(1234567), "1,234,567");
   EXPECT_EQ(with_thousands(12), "12");
+}
+
+// --- rendering known answers --------------------------------------------------------------------
+
+// Lambert of the shaders: albedo 0.8, ambient 0.1, one-sided.
+double lit(glm::dvec3 n, glm::dvec3 light) {
+  return 0.8 * (0.1 + 0.9 * std::max(0.0, glm::dot(glm::normalize(n), glm::normalize(light))));
+}
+
+// The centre pixel of each pane for a 2 x 2 plane at z = 0 facing +Z seen from +Z, its map
+// constant = the encoding of tangent-space `t`; `mirror_v` flips the UVs' v (handedness -1).
+std::pair<double, double> render_plane(glm::dvec3 t, Light light, bool mirror_v, bool use_map = true) {
+  nmbake::Mesh plane = nmbake::test::make_grid(4, 4);
+  if (mirror_v)
+    for (glm::vec2& uv : plane.uvs) uv.y = 1.0f - uv.y;
+  const nmbake::TangentFrames frames = nmbake::compute_tangent_frames(plane);
+  nmbake::Image map(8, 8, 3);
+  const glm::dvec3 n = glm::normalize(t);
+  for (std::size_t i = 0; i < map.pixels.size(); ++i) map.pixels[i] = float(n[int(i % 3)] * 0.5 + 0.5);
+
+  HeadlessContext context;
+  Renderer renderer(build_low_vertices(plane, frames, glm::vec3(0.0f)), build_high_vertices(plane, glm::vec3(0.0f)),
+                    map, std::sqrt(2.0f));
+  Toggles toggles;
+  toggles.map = use_map;
+  renderer.render_panes(64, 64, {0.0f, 0.0f, 1.0f}, light, toggles);
+  const Rgba8Image low = renderer.read_pane(0), high = renderer.read_pane(1);
+  const std::size_t centre = (32 * 64 + 32) * 4;
+  EXPECT_EQ(low.pixels[centre + 3], 255);
+  EXPECT_EQ(high.pixels[centre + 3], 255);
+  return {low.pixels[centre] / 255.0, high.pixels[centre] / 255.0};
+}
+
+TEST(RenderKnownAnswer, RedTiltsTowardsTangentAndGreenTowardsBitangent) {
+  // Light 60 degrees to the viewer's right (+X): a normal tilted towards +X (red) is bright,
+  // towards -X dark. Light 60 degrees above (+Y): the same for green.
+  const double tol = 1.5 / 255.0;  // 8-bit quantization plus float rounding
+  const glm::dvec3 right(std::sin(glm::radians(60.0)), 0, 0.5), up(0, std::sin(glm::radians(60.0)), 0.5);
+  auto [plus_x, flat_a] = render_plane({0.5, 0, 1}, {60.0f, 0.0f}, false);
+  EXPECT_NEAR(plus_x, lit({0.5, 0, 1}, right), tol);
+  EXPECT_NEAR(flat_a, lit({0, 0, 1}, right), tol);
+  EXPECT_NEAR(render_plane({-0.5, 0, 1}, {60.0f, 0.0f}, false).first, lit({-0.5, 0, 1}, right), tol);
+  EXPECT_NEAR(render_plane({0, 0.5, 1}, {0.0f, 60.0f}, false).first, lit({0, 0.5, 1}, up), tol);
+  EXPECT_NEAR(render_plane({0, -0.5, 1}, {0.0f, 60.0f}, false).first, lit({0, -0.5, 1}, up), tol);
+}
+
+TEST(RenderKnownAnswer, MirroredUvsFlipTheBitangent) {
+  const double tol = 1.5 / 255.0;
+  const glm::dvec3 up(0, std::sin(glm::radians(60.0)), 0.5);
+  // With v running down the plane the handedness is -1 and +green points to -Y.
+  EXPECT_NEAR(render_plane({0, 0.5, 1}, {0.0f, 60.0f}, true).first, lit({0, -0.5, 1}, up), tol);
+  // Red is unaffected by the mirror.
+  const glm::dvec3 right(std::sin(glm::radians(60.0)), 0, 0.5);
+  EXPECT_NEAR(render_plane({0.5, 0, 1}, {60.0f, 0.0f}, true).first, lit({0.5, 0, 1}, right), tol);
+}
+
+TEST(RenderKnownAnswer, MapOffShowsTheBareNormal) {
+  const glm::dvec3 right(std::sin(glm::radians(60.0)), 0, 0.5);
+  auto [low, high] = render_plane({0.5, 0, 1}, {60.0f, 0.0f}, false, false);
+  EXPECT_NEAR(low, lit({0, 0, 1}, right), 1.5 / 255.0);
+  EXPECT_EQ(low, high);
 }
 
 }  // namespace
