@@ -1,5 +1,7 @@
 #include "bake.h"
 
+#include <time.h>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -22,6 +24,12 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+double process_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
 
 constexpr int kTile = 16;            // texels per tile side
 constexpr int kMaxSamples = 1024;    // per texel
@@ -305,6 +313,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
 
   // Trace: tiles of texels, each rasterized against the triangles binned to it, rays in packets.
   t0 = Clock::now();
+  const double cpu0 = process_cpu_seconds();
   const int W = opt.width, H = opt.height;
   const int tiles_x = (W + kTile - 1) / kTile, tiles_y = (H + kTile - 1) / kTile;
   const std::size_t tile_count = std::size_t(tiles_x) * tiles_y;
@@ -544,6 +553,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   for (std::uint8_t c : result.coverage) st.texels_covered += c;
   st.coverage = double(st.texels_covered) / double(st.texels_total);
   st.seconds_trace = seconds_since(t0);
+  st.cpu_seconds_trace = process_cpu_seconds() - cpu0;
 
   // Padding. Background (never reached by padding) stays the flat normal.
   t0 = Clock::now();

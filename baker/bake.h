@@ -67,6 +67,7 @@ struct BakeStats {
   bool high_normals_computed = false;
   // Seconds per stage.
   double seconds_prepare = 0, seconds_bvh = 0, seconds_distances = 0, seconds_trace = 0, seconds_padding = 0;
+  double cpu_seconds_trace = 0;  // process CPU time of the trace stage (all threads)
 };
 
 struct BakeResult {

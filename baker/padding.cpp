@@ -1,5 +1,6 @@
 #include "padding.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -60,6 +61,9 @@ std::size_t pad_islands(Image& image, const std::vector<std::uint8_t>& covered, 
   if (padding <= 0) return 0;
   const int w = image.width, h = image.height;
   const std::size_t n = std::size_t(w) * h;
+  // Nothing to fill from, or nothing to fill: skip the distance transform.
+  const std::size_t covered_count = std::size_t(std::count_if(covered.begin(), covered.end(), [](std::uint8_t c) { return c != 0; }));
+  if (covered_count == 0 || covered_count == n) return 0;
   // Pass 1, columns: squared distance to the nearest covered texel in the same column.
   std::vector<double> g(n);
   std::vector<int> gy(n);
