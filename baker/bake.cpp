@@ -32,8 +32,6 @@ double process_cpu_seconds() {
 }
 
 constexpr int kTile = 16;            // texels per tile side
-constexpr int kMaxSamples = 1024;    // per texel
-constexpr int kMaxSide = 65536;      // texels
 // Tangent components this close to zero are written as exactly 0: a flat result is then
 // (128,128,255) and not a coin flip between 127 and 128 decided by float noise.
 constexpr double kSnap = 1e-6;
@@ -157,9 +155,9 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   // Options.
   if (opt.width < 1 || opt.height < 1)
     throw UsageError("--size must be at least 1x1 (got " + std::to_string(opt.width) + "x" + std::to_string(opt.height) + ")");
-  if (opt.width > kMaxSide || opt.height > kMaxSide)
+  if (opt.width > kMaxMapSide || opt.height > kMaxMapSide)
     throw ResourceError("--size " + std::to_string(opt.width) + "x" + std::to_string(opt.height) +
-                        " refused: the largest supported side is " + std::to_string(kMaxSide) + " texels");
+                        " refused: the largest supported side is " + std::to_string(kMaxMapSide) + " texels");
   if (opt.samples < 1 || opt.samples > kMaxSamples)
     throw UsageError("--samples must be between 1 and " + std::to_string(kMaxSamples) + " (got " + std::to_string(opt.samples) + ")");
   if (opt.padding < 0) throw UsageError("--padding must not be negative");
@@ -200,6 +198,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     grow_box(lo, hi, high.positions);
     if (cage) grow_box(lo, hi, cage->positions);
     s.centre = 0.5 * (lo + hi);
+    st.centre = s.centre;
     s.diagonal = glm::length(hi - lo);
     if (!(s.diagonal > 0.0)) s.diagonal = 1.0;
   }

@@ -29,6 +29,9 @@ enum class RayPolicy {
 
 enum class NormalSpace { tangent, object };
 
+constexpr int kMaxMapSide = 65536;  // texels per side; larger maps are refused (ResourceError)
+constexpr int kMaxSamples = 1024;   // sample points per texel
+
 struct BakeOptions {
   int width = 2048;   // map width in texels
   int height = 2048;  // map height in texels
@@ -42,7 +45,8 @@ struct BakeOptions {
   int padding = 16;     // texels of edge padding around islands; 0 = none
   int threads = 0;      // worker threads; 0 = all cores
   bool miss_mask = false;  // fill BakeResult::miss_mask (share of missed samples per texel)
-  // For the bench: when set, receives a copy of every ray the trace stage cast (order unspecified).
+  // For the bench: when set, receives a copy of every ray the trace stage cast (order unspecified),
+  // in coordinates re-centred on BakeStats::centre.
   std::vector<raycast::Ray>* record_rays = nullptr;
   // Called from the calling thread with the fraction done in [0,1]; return false to cancel
   // (bake_normal_map then throws Cancelled).
@@ -51,6 +55,7 @@ struct BakeOptions {
 
 struct BakeStats {
   float front = 0.0f, rear = 0.0f;  // distances used (scene units)
+  glm::dvec3 centre{0.0};           // subtracted from every coordinate before tracing (bounding-box centre)
   bool auto_distances = false;      // front/rear were measured, not given
   double auto_probe_beyond = 0.0;   // share of probe points farther than the chosen distances
   std::uint64_t rays = 0, hits = 0, misses = 0;  // misses/hits count samples, rays count casts

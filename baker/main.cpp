@@ -59,8 +59,8 @@ void parse_size(const std::string& text, int& w, int& h) {
   const long long a = parse_side(x == std::string::npos ? text : text.substr(0, x));
   const long long b = x == std::string::npos ? a : parse_side(text.substr(x + 1));
   if (a < 1 || b < 1) throw UsageError("--size must be at least 1 texel per side, got '" + text + "'");
-  if (a > 65536 || b > 65536)
-    throw ResourceError("--size " + text + " refused: the largest supported side is 65536 texels");
+  if (a > kMaxMapSide || b > kMaxMapSide)
+    throw ResourceError("--size " + text + " refused: the largest supported side is " + std::to_string(kMaxMapSide) + " texels");
   w = int(a);
   h = int(b);
 }
@@ -147,8 +147,10 @@ int run(int argc, char** argv) {
   const auto start = Clock::now();
   BakeOptions o;
   parse_size(a.size, o.width, o.height);
-  if (a.samples < 1 || a.samples > 1024) throw UsageError("--samples must be between 1 and 1024, got " + std::to_string(a.samples));
-  if (a.padding < 0 || a.padding > 65536) throw UsageError("--padding must be between 0 and 65536, got " + std::to_string(a.padding));
+  if (a.samples < 1 || a.samples > kMaxSamples)
+    throw UsageError("--samples must be between 1 and " + std::to_string(kMaxSamples) + ", got " + std::to_string(a.samples));
+  if (a.padding < 0 || a.padding > kMaxMapSide)
+    throw UsageError("--padding must be between 0 and " + std::to_string(kMaxMapSide) + ", got " + std::to_string(a.padding));
   if (a.threads < 0 || a.threads > 1024) throw UsageError("--threads must be between 0 and 1024, got " + std::to_string(a.threads));
   auto check_distance = [](double d, const char* name) {
     if (d != -1.0 && !(d >= 0.0 && d < 1e30)) throw UsageError(std::string(name) + " must be a distance >= 0 in scene units");

@@ -168,13 +168,7 @@ int main(int argc, char** argv) {
       o.front = first.stats.front;
       o.rear = first.stats.rear;
       // The BVH the bare loop uses: the same re-centred coordinates the bake traced.
-      glm::dvec3 lo_b(1e300), hi_b(-1e300);
-      for (const auto* m : {&low, &high})
-        for (const glm::vec3& p : m->positions) {
-          lo_b = glm::min(lo_b, glm::dvec3(p));
-          hi_b = glm::max(hi_b, glm::dvec3(p));
-        }
-      const glm::dvec3 centre = 0.5 * (lo_b + hi_b);
+      const glm::dvec3 centre = first.stats.centre;
       std::vector<glm::vec3> pos(high.positions.size());
       for (std::size_t i = 0; i < pos.size(); ++i) pos[i] = glm::vec3(glm::dvec3(high.positions[i]) - centre);
       raycast::Scene scene(&pos[0].x, pos.size(), high.position_index.data(), high.triangle_count());
