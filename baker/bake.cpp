@@ -17,6 +17,7 @@
 #include "padding.h"
 #include "rasterize.h"
 #include "raycast.h"
+#include "shade_batch.h"
 
 namespace nmbake {
 
@@ -45,13 +46,6 @@ std::uint64_t available_memory_bytes() {
     if (key == "MemAvailable:") return value * 1024;
   return std::numeric_limits<std::uint64_t>::max();
 }
-
-// What the trace loop reads of one low-poly triangle, in one place: re-centred corner positions,
-// ray normals, and the tangent frame's corner normals and tangents.
-struct LowTriangle {
-  glm::vec3 p[3], ray_n[3], n[3];
-  glm::vec4 t[3];
-};
 
 // The scene in re-centred float coordinates, flat arrays for the hot loop.
 struct Prepared {
@@ -237,22 +231,22 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   for (std::size_t t = 0; t < low.triangle_count(); ++t)
     for (int c = 0; c < 3; ++c) {
       const std::uint32_t pi = low.position_index[3 * t + c];
-      low_tris[t].p[c] = s.low_pos[pi];
-      low_tris[t].ray_n[c] = s.ray_normal[pi];
-      low_tris[t].n[c] = s.frames.normal[3 * t + c];
-      low_tris[t].t[c] = s.frames.tangent[3 * t + c];
+      low_tris[t].p[c] = glm::dvec3(s.low_pos[pi]);
+      low_tris[t].ray_n[c] = glm::dvec3(s.ray_normal[pi]);
+      low_tris[t].n[c] = glm::dvec3(s.frames.normal[3 * t + c]);
+      low_tris[t].t[c] = glm::dvec4(s.frames.tangent[3 * t + c]);
     }
   auto low_point = [&](std::size_t tri, const double b[3]) {
     const LowTriangle& lt = low_tris[tri];
-    return b[0] * glm::dvec3(lt.p[0]) + b[1] * glm::dvec3(lt.p[1]) + b[2] * glm::dvec3(lt.p[2]);
+    return b[0] * lt.p[0] + b[1] * lt.p[1] + b[2] * lt.p[2];
   };
   auto low_ray_normal = [&](std::size_t tri, const double b[3]) {
     const LowTriangle& lt = low_tris[tri];
-    const glm::dvec3 n = b[0] * glm::dvec3(lt.ray_n[0]) + b[1] * glm::dvec3(lt.ray_n[1]) + b[2] * glm::dvec3(lt.ray_n[2]);
+    const glm::dvec3 n = b[0] * lt.ray_n[0] + b[1] * lt.ray_n[1] + b[2] * lt.ray_n[2];
     const double len2 = glm::dot(n, n);
     if (len2 > 1e-24) return n / std::sqrt(len2);
     // Opposite corner normals cancel: fall back to the face normal.
-    const glm::dvec3 f = glm::cross(glm::dvec3(lt.p[1]) - glm::dvec3(lt.p[0]), glm::dvec3(lt.p[2]) - glm::dvec3(lt.p[0]));
+    const glm::dvec3 f = glm::cross(lt.p[1] - lt.p[0], lt.p[2] - lt.p[0]);
     const double fl = glm::length(f);
     return fl > 0.0 ? f / fl : glm::dvec3(0, 0, 1);
   };
@@ -356,6 +350,30 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   std::atomic<bool> cancel{false};
   std::mutex record_mutex;
 
+  // One sample's value, one at a time: every case, with the fallbacks for degenerate hit normals and
+  // frames. encode_hits_per_pixel gives the same bits for the common case, many at a time.
+  const bool batched = opt.space == NormalSpace::tangent && opt.bitangent == BitangentMode::per_pixel;
+  auto shade_one = [&](std::int32_t tri, const double b[3], const raycast::Hit& h) -> glm::dvec3 {
+    const PixelFrame frame = interpolate_frame(low_tris[tri].n, low_tris[tri].t, b, opt.bitangent);
+    if (!h.hit()) {
+      const double nl = glm::length(frame.n);
+      return opt.space == NormalSpace::tangent ? glm::dvec3(0, 0, 1) : (nl > 0 ? frame.n / nl : glm::dvec3(0, 0, 1));
+    }
+    const std::size_t ht = h.triangle;
+    const double w[3] = {1.0 - double(h.u) - double(h.v), double(h.u), double(h.v)};
+    glm::dvec3 nh(0.0);
+    for (int c = 0; c < 3; ++c) nh += w[c] * glm::dvec3(s.high_corner_normals[3 * ht + c]);
+    double len = glm::length(nh);
+    if (!(len > 1e-12)) {
+      const glm::dvec3 q0(s.high_pos[high.position_index[3 * ht]]), q1(s.high_pos[high.position_index[3 * ht + 1]]),
+          q2(s.high_pos[high.position_index[3 * ht + 2]]);
+      nh = glm::cross(q1 - q0, q2 - q0);
+      len = glm::length(nh);
+    }
+    nh = len > 0.0 ? nh / len : glm::normalize(frame.n);
+    return opt.space == NormalSpace::tangent ? encode_tangent_normal(frame, nh) : nh;
+  };
+
   auto worker = [&](int id) {
     ThreadStats& ts = tstats[id];
     struct Slot {
@@ -363,10 +381,16 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
       double b[3];
     };
     std::vector<Slot> slots(std::size_t(kTile) * kTile * S);
-    std::vector<raycast::Ray> rays;
-    std::vector<raycast::Hit> hits;
-    std::vector<std::uint32_t> slot_of_ray;
-    std::vector<double> signed_base;  // per ray: distance from P to the ray origin along the ray
+    // Sized once for a full tile; each tile fills the first `ray_count` / `sample_count` entries.
+    std::vector<raycast::Ray> rays(slots.size() * rays_per_sample);
+    std::vector<raycast::Hit> hits(rays.size());
+    std::vector<std::uint32_t> slot_of_ray(slots.size());  // per covered sample: its slot
+    std::vector<double> signed_base(rays.size());  // per ray: distance from P to the ray origin along the ray
+    std::vector<const raycast::Hit*> chosen(slots.size());  // per covered sample: the hit that counts
+    std::vector<std::int32_t> batch_of(slots.size());       // per covered sample: its batch entry, or -1
+    std::vector<HitSample> batch(slots.size());
+    std::vector<glm::dvec3> batch_value(slots.size());
+    std::vector<std::uint8_t> batch_degenerate(slots.size());
     std::vector<glm::dvec4> acc(std::size_t(kTile) * kTile);  // xyz sum, w = covered samples
     std::vector<std::uint32_t> miss_count(std::size_t(kTile) * kTile);
     for (std::size_t tile; !cancel.load(std::memory_order_relaxed) && (tile = next_tile.fetch_add(1)) < tile_count;) {
@@ -401,9 +425,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
             }
       }
       // Rays for the covered samples.
-      rays.clear();
-      slot_of_ray.clear();
-      signed_base.clear();
+      std::size_t ray_count = 0, sample_count = 0;
       for (std::uint32_t si = 0; si < slots.size(); ++si) {
         const Slot& sl = slots[si];
         if (sl.tri < 0) continue;
@@ -422,33 +444,40 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
           } else {
             d /= len;
           }
-          rays.push_back({glm::vec3(pc), 0.0f, glm::vec3(d), float(len + st.rear)});
-          signed_base.push_back(len);
+          signed_base[ray_count] = len;
+          rays[ray_count++] = {glm::vec3(pc), 0.0f, glm::vec3(d), float(len + st.rear)};
         } else if (closest) {
-          rays.push_back({glm::vec3(p), 0.0f, glm::vec3(n), st.front});
-          signed_base.push_back(0.0);
-          rays.push_back({glm::vec3(p), 0.0f, glm::vec3(-n), st.rear});
-          signed_base.push_back(0.0);
+          signed_base[ray_count] = 0.0;
+          rays[ray_count++] = {glm::vec3(p), 0.0f, glm::vec3(n), st.front};
+          signed_base[ray_count] = 0.0;
+          rays[ray_count++] = {glm::vec3(p), 0.0f, glm::vec3(-n), st.rear};
         } else {
-          rays.push_back({glm::vec3(p + double(st.front) * n), 0.0f, glm::vec3(-n), st.front + st.rear});
-          signed_base.push_back(st.front);
+          signed_base[ray_count] = st.front;
+          rays[ray_count++] = {glm::vec3(p + double(st.front) * n), 0.0f, glm::vec3(-n), st.front + st.rear};
         }
-        slot_of_ray.push_back(si);
+        slot_of_ray[sample_count++] = si;
       }
-      hits.resize(rays.size());
-      if (!rays.empty()) scene.intersect(rays.data(), hits.data(), rays.size());
+      if (ray_count) scene.intersect(rays.data(), hits.data(), ray_count);
       if (opt.record_rays) {
         std::lock_guard<std::mutex> lock(record_mutex);
-        opt.record_rays->insert(opt.record_rays->end(), rays.begin(), rays.end());
+        opt.record_rays->insert(opt.record_rays->end(), rays.begin(), rays.begin() + std::ptrdiff_t(ray_count));
       }
-      ts.rays += rays.size();
-      // Shade: the high-poly normal at the hit, in the low-poly's tangent frame at P.
+      ts.rays += ray_count;
+      // The hit triangles' corner normals are scattered over the high-poly: ask for them all before
+      // shading needs the first, so the cache misses overlap.
+      for (std::size_t r = 0; r < ray_count; ++r)
+        if (hits[r].hit()) {
+          const char* line = reinterpret_cast<const char*>(&s.high_corner_normals[3 * std::size_t(hits[r].triangle)]);
+          __builtin_prefetch(line);
+          __builtin_prefetch(line + sizeof(glm::vec3) * 3 - 1);
+        }
+      // Shade: the high-poly normal at the hit, in the low-poly's tangent frame at P. First, in
+      // sample order, which ray's hit counts and the hit statistics; then the common case (tangent
+      // space, per-pixel bitangent) for all hits at once; then each sample's value into its texel.
       std::fill(acc.begin(), acc.end(), glm::dvec4(0.0));
       std::fill(miss_count.begin(), miss_count.end(), 0u);
-      for (std::size_t r = 0; r < slot_of_ray.size(); ++r) {
-        const std::uint32_t si = slot_of_ray[r];
-        const Slot& sl = slots[si];
-        const std::size_t texel = si / S;
+      std::size_t batch_count = 0;
+      for (std::size_t r = 0; r < sample_count; ++r) {
         const raycast::Hit* h = &hits[r * rays_per_sample];
         double dist = 0.0;
         if (closest) {
@@ -464,34 +493,33 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
         } else {
           dist = signed_base[r] - h->t;
         }
-        const PixelFrame frame = interpolate_frame(low_tris[sl.tri].n, low_tris[sl.tri].t, sl.b, opt.bitangent);
-        glm::dvec3 value;
+        chosen[r] = h;
+        batch_of[r] = -1;
         ++ts.covered;
         if (h->hit()) {
           ++ts.hits;
           ts.dmin = std::min(ts.dmin, dist);
           ts.dmax = std::max(ts.dmax, dist);
           ts.dsum += dist;
-          const std::size_t ht = h->triangle;
-          const double w[3] = {1.0 - double(h->u) - double(h->v), double(h->u), double(h->v)};
-          glm::dvec3 nh(0.0);
-          for (int c = 0; c < 3; ++c) nh += w[c] * glm::dvec3(s.high_corner_normals[3 * ht + c]);
-          double len = glm::length(nh);
-          if (!(len > 1e-12)) {
-            const glm::dvec3 q0(s.high_pos[high.position_index[3 * ht]]), q1(s.high_pos[high.position_index[3 * ht + 1]]),
-                q2(s.high_pos[high.position_index[3 * ht + 2]]);
-            nh = glm::cross(q1 - q0, q2 - q0);
-            len = glm::length(nh);
+          if (batched) {
+            const Slot& sl = slots[slot_of_ray[r]];
+            batch_of[r] = std::int32_t(batch_count);
+            batch[batch_count++] = {{sl.b[0], sl.b[1], sl.b[2]}, std::uint32_t(sl.tri), h->triangle, h->u, h->v};
           }
-          nh = len > 0.0 ? nh / len : glm::normalize(frame.n);
-          value = opt.space == NormalSpace::tangent ? encode_tangent_normal(frame, nh) : nh;
         } else {
           ++ts.misses;
-          ++miss_count[texel];
-          const double nl = glm::length(frame.n);
-          value = opt.space == NormalSpace::tangent ? glm::dvec3(0, 0, 1) : (nl > 0 ? frame.n / nl : glm::dvec3(0, 0, 1));
+          ++miss_count[slot_of_ray[r] / S];
         }
-        acc[texel] += glm::dvec4(value, 1.0);
+      }
+      if (batch_count)
+        encode_hits_per_pixel(low_tris.data(), s.high_corner_normals.data(), batch.data(), batch_count,
+                              batch_value.data(), batch_degenerate.data());
+      for (std::size_t r = 0; r < sample_count; ++r) {
+        const std::uint32_t si = slot_of_ray[r];
+        const std::int32_t bi = batch_of[r];
+        const glm::dvec3 value =
+            bi >= 0 && !batch_degenerate[std::size_t(bi)] ? batch_value[std::size_t(bi)] : shade_one(slots[si].tri, slots[si].b, *chosen[r]);
+        acc[si / S] += glm::dvec4(value, 1.0);
       }
       // Texels: renormalized mean of their covered samples.
       for (int y = 0; y < th; ++y)
@@ -515,12 +543,25 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   };
 
   {
+    // Progress every 100 ms; the last worker to finish wakes the wait at once, so the stage does not
+    // end up to 100 ms after its work.
+    std::mutex done_mutex;
+    std::condition_variable done_cv;
+    int running = threads;
     std::vector<std::thread> pool;
-    for (int i = 0; i < threads; ++i) pool.emplace_back(worker, i);
+    for (int i = 0; i < threads; ++i)
+      pool.emplace_back([&, i] {
+        worker(i);
+        std::lock_guard<std::mutex> lock(done_mutex);
+        if (--running == 0) done_cv.notify_all();
+      });
     if (opt.progress) {
-      while (tiles_done.load() < tile_count && !cancel.load()) {
+      std::unique_lock<std::mutex> lock(done_mutex);
+      while (running > 0 && !cancel.load()) {
+        lock.unlock();
         if (!opt.progress(double(tiles_done.load()) / double(tile_count))) cancel = true;
-        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        lock.lock();
+        done_cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return running == 0; });
       }
     }
     for (auto& t : pool) t.join();

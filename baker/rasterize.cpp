@@ -52,24 +52,6 @@ TexelTriangle setup_texel_triangle(glm::vec2 uv0, glm::vec2 uv1, glm::vec2 uv2, 
   return t;
 }
 
-bool covers(const TexelTriangle& tri, glm::dvec2 q, double bary[3]) {
-  if (tri.area2 == 0.0) return false;
-  double w[3];
-  for (int k = 0; k < 3; ++k) {
-    const glm::dvec2 a = tri.edge_a[k], d = tri.edge_d[k];
-    const double side = tri.edge_side[k];
-    const double e = d.x * (q.y - a.y) - d.y * (q.x - a.x);
-    // Strictly inside, or on the edge and this triangle lies on the edge's positive side: of two
-    // triangles sharing an edge exactly one does.
-    if (side > 0.0 ? e < 0.0 : e >= 0.0) return false;
-    w[(k + 2) % 3] = e / side;
-  }
-  const double sum = w[0] + w[1] + w[2];
-  if (!(sum > 0.0) || !std::isfinite(sum)) return false;
-  for (int k = 0; k < 3; ++k) bary[k] = w[k] / sum;
-  return true;
-}
-
 std::vector<std::int32_t> rasterize_texel_triangles(const Mesh& mesh, int width, int height, std::size_t* overlaps) {
   std::vector<std::int32_t> owner(std::size_t(width) * height, -1);
   std::size_t overlapped = 0;

@@ -8,6 +8,7 @@
 // cover nothing. Where UV islands overlap, the triangle with the lowest index wins.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -32,8 +33,24 @@ struct TexelTriangle {
 TexelTriangle setup_texel_triangle(glm::vec2 uv0, glm::vec2 uv1, glm::vec2 uv2, int width, int height);
 
 // True when sample point q (texel space) is covered; then bary receives the weights of corners
-// 0, 1, 2 (they sum to 1 and are each in [0,1]).
-bool covers(const TexelTriangle& tri, glm::dvec2 q, double bary[3]);
+// 0, 1, 2 (they sum to 1 and are each in [0,1]). Inline: the bake calls it per sample.
+inline bool covers(const TexelTriangle& tri, glm::dvec2 q, double bary[3]) {
+  if (tri.area2 == 0.0) return false;
+  double w[3];
+  for (int k = 0; k < 3; ++k) {
+    const glm::dvec2 a = tri.edge_a[k], d = tri.edge_d[k];
+    const double side = tri.edge_side[k];
+    const double e = d.x * (q.y - a.y) - d.y * (q.x - a.x);
+    // Strictly inside, or on the edge and this triangle lies on the edge's positive side: of two
+    // triangles sharing an edge exactly one does.
+    if (side > 0.0 ? e < 0.0 : e >= 0.0) return false;
+    w[(k + 2) % 3] = e / side;
+  }
+  const double sum = w[0] + w[1] + w[2];
+  if (!(sum > 0.0) || !std::isfinite(sum)) return false;
+  for (int k = 0; k < 3; ++k) bary[k] = w[k] / sum;
+  return true;
+}
 
 // Texel-space position of sample (ox, oy) of texel (x, y).
 inline glm::dvec2 sample_point(int x, int y, double ox, double oy) { return {x + ox, y + oy}; }

@@ -231,38 +231,8 @@ TangentFrames compute_tangent_frames(const Mesh& mesh) {
   return out;
 }
 
-PixelFrame interpolate_frame(const glm::vec3 normal[3], const glm::vec4 tangent[3], const double bary[3], BitangentMode mode) {
-  PixelFrame f{glm::dvec3(0.0), glm::dvec3(0.0), glm::dvec3(0.0)};
-  double sign = 0.0;
-  for (int c = 0; c < 3; ++c) {
-    const glm::dvec3 n(normal[c]);
-    const glm::dvec4 t(tangent[c]);
-    f.n += bary[c] * n;
-    f.t += bary[c] * glm::dvec3(t);
-    sign += bary[c] * t.w;
-    if (mode == BitangentMode::per_vertex) f.b += bary[c] * (t.w * glm::cross(n, glm::dvec3(t)));
-  }
-  if (mode == BitangentMode::per_pixel) f.b = sign * glm::cross(f.n, f.t);
-  return f;
-}
-
 PixelFrame interpolate_frame(const TangentFrames& frames, std::size_t tri, const double bary[3], BitangentMode mode) {
   return interpolate_frame(&frames.normal[3 * tri], &frames.tangent[3 * tri], bary, mode);
-}
-
-glm::dvec3 encode_tangent_normal(const PixelFrame& f, const glm::dvec3& world) {
-  // Solve [T B N] x = world by Cramer's rule; x is defined up to a positive scale because the
-  // renderer normalizes, so the determinant's magnitude does not matter, only its sign and zero.
-  const glm::dvec3 bxn = glm::cross(f.b, f.n), nxt = glm::cross(f.n, f.t), txb = glm::cross(f.t, f.b);
-  const double det = glm::dot(f.t, bxn);
-  // Singular when |det| <= 1e-12 |T||B||N|, compared squared to spare three square roots.
-  const double scale2 = glm::dot(f.t, f.t) * glm::dot(f.b, f.b) * glm::dot(f.n, f.n);
-  if (!(det * det > 1e-24 * scale2) || !std::isfinite(det)) return {0.0, 0.0, 1.0};
-  glm::dvec3 x(glm::dot(world, bxn), glm::dot(world, nxt), glm::dot(world, txb));
-  x /= det;
-  const double len = glm::length(x);
-  if (!(len > 0.0) || !std::isfinite(len)) return {0.0, 0.0, 1.0};
-  return x / len;
 }
 
 glm::dvec3 decode_tangent_normal(const PixelFrame& f, const glm::dvec3& t) {

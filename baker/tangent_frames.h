@@ -13,6 +13,7 @@
 // world normal of a map value t is normalize(t.x * T + t.y * B + t.z * N).
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <vector>
 
@@ -45,14 +46,43 @@ struct PixelFrame {
 };
 PixelFrame interpolate_frame(const TangentFrames& frames, std::size_t tri, const double bary[3],
                              BitangentMode mode = BitangentMode::per_pixel);
-// The same from a triangle's three corner normals and tangents.
-PixelFrame interpolate_frame(const glm::vec3 normal[3], const glm::vec4 tangent[3], const double bary[3],
-                             BitangentMode mode = BitangentMode::per_pixel);
+// The same from a triangle's three corner normals and tangents, given in float (glm::vec3/vec4) or
+// already widened to double (glm::dvec3/dvec4: the same result, without the per-call widening).
+// Inline: the bake calls it per sample.
+template <typename Vec3, typename Vec4>
+inline PixelFrame interpolate_frame(const Vec3 normal[3], const Vec4 tangent[3], const double bary[3],
+                                    BitangentMode mode = BitangentMode::per_pixel) {
+  PixelFrame f{glm::dvec3(0.0), glm::dvec3(0.0), glm::dvec3(0.0)};
+  double sign = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    const glm::dvec3 n(normal[c]);
+    const glm::dvec4 t(tangent[c]);
+    f.n += bary[c] * n;
+    f.t += bary[c] * glm::dvec3(t);
+    sign += bary[c] * t.w;
+    if (mode == BitangentMode::per_vertex) f.b += bary[c] * (t.w * glm::cross(n, glm::dvec3(t)));
+  }
+  if (mode == BitangentMode::per_pixel) f.b = sign * glm::cross(f.n, f.t);
+  return f;
+}
 
 // Tangent-space unit vector whose decoding in `frame` is the world direction `world`: the exact
 // inverse of normalize(t.x*T + t.y*B + t.z*N), renormalized. Falls back to (0,0,1) when the frame
-// is singular.
-glm::dvec3 encode_tangent_normal(const PixelFrame& frame, const glm::dvec3& world);
+// is singular. Inline: the bake calls it per sample.
+inline glm::dvec3 encode_tangent_normal(const PixelFrame& f, const glm::dvec3& world) {
+  // Solve [T B N] x = world by Cramer's rule; x is defined up to a positive scale because the
+  // renderer normalizes, so the determinant's magnitude does not matter, only its sign and zero.
+  const glm::dvec3 bxn = glm::cross(f.b, f.n), nxt = glm::cross(f.n, f.t), txb = glm::cross(f.t, f.b);
+  const double det = glm::dot(f.t, bxn);
+  // Singular when |det| <= 1e-12 |T||B||N|, compared squared to spare three square roots.
+  const double scale2 = glm::dot(f.t, f.t) * glm::dot(f.b, f.b) * glm::dot(f.n, f.n);
+  if (!(det * det > 1e-24 * scale2) || !std::isfinite(det)) return {0.0, 0.0, 1.0};
+  glm::dvec3 x(glm::dot(world, bxn), glm::dot(world, nxt), glm::dot(world, txb));
+  x /= det;
+  const double len = glm::length(x);
+  if (!(len > 0.0) || !std::isfinite(len)) return {0.0, 0.0, 1.0};
+  return x / len;
+}
 
 // World direction of a tangent-space vector (the renderer's decoding).
 glm::dvec3 decode_tangent_normal(const PixelFrame& frame, const glm::dvec3& tangent_space);
