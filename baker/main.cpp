@@ -19,6 +19,7 @@
 #include "image_io.h"
 #include "mesh_io.h"
 #include "report.h"
+#include "warnings.h"
 
 namespace {
 
@@ -193,6 +194,7 @@ int run(int argc, char** argv) {
   Mesh high = load_mesh(a.high, {}, &run.high_info);
   Mesh cage;
   if (!a.cage.empty()) cage = load_mesh(a.cage, {}, &run.cage_info);
+  run.high_topology = inspect_topology(high);
   run.seconds_load = std::chrono::duration<double>(Clock::now() - t0).count();
   if (g_interrupted) throw Cancelled();
 
@@ -203,12 +205,8 @@ int run(int argc, char** argv) {
   if (s.auto_distances && !a.quiet)
     std::fprintf(stderr, "nmbake: ray distances measured: --front %.6g --rear %.6g (%.2f%% of probes lie beyond)\n", s.front, s.rear,
                  100.0 * s.auto_probe_beyond);
-  if (!a.quiet && s.uv_outside_triangles)
-    std::fprintf(stderr, "nmbake: warning: %s: %zu triangles have UVs outside [0,1]; only the part inside the map is baked\n",
-                 a.low.c_str(), s.uv_outside_triangles);
-  if (!a.quiet && s.overlapping_samples)
-    std::fprintf(stderr, "nmbake: warning: %s: UV islands overlap (%llu samples covered twice; the lower face number wins)\n",
-                 a.low.c_str(), (unsigned long long)s.overlapping_samples);
+  if (!a.quiet)
+    for (const std::string& w : bake_warnings(s, run.high_topology, a.low, a.high)) std::fprintf(stderr, "nmbake: %s\n", w.c_str());
   if (g_interrupted) throw Cancelled();
 
   // Write.

@@ -67,6 +67,16 @@ bool covers(const TexelTriangle& tri, glm::dvec2 q, double bary[3]) {
   const double sum = w[0] + w[1] + w[2];
   if (!(sum > 0.0) || !std::isfinite(sum)) return false;
   for (int k = 0; k < 3; ++k) bary[k] = w[k] / sum;
+  // A sample on an edge (a texel centre on a UV edge) lies on the 3D edge too, where a high-poly
+  // with the same edge (coincident, or hard-edged) ties between two triangles and the ray may take
+  // the neighbour's normal. Moving it kEdgeInset inside its own triangle breaks the tie; samples
+  // farther inside are untouched.
+  constexpr double kEdgeInset = 1e-5;
+  if (bary[0] < kEdgeInset || bary[1] < kEdgeInset || bary[2] < kEdgeInset) {
+    double s = 0.0;
+    for (int k = 0; k < 3; ++k) s += (bary[k] = std::max(bary[k], kEdgeInset));
+    for (int k = 0; k < 3; ++k) bary[k] /= s;
+  }
   return true;
 }
 

@@ -32,7 +32,8 @@ struct TexelTriangle {
 TexelTriangle setup_texel_triangle(glm::vec2 uv0, glm::vec2 uv1, glm::vec2 uv2, int width, int height);
 
 // True when sample point q (texel space) is covered; then bary receives the weights of corners
-// 0, 1, 2 (they sum to 1 and are each in [0,1]).
+// 0, 1, 2 (they sum to 1 and are each in [0,1]). A sample on an edge gets weights of at least 1e-5
+// (moved just inside its triangle, so a coincident high-poly cannot tie with the neighbour).
 bool covers(const TexelTriangle& tri, glm::dvec2 q, double bary[3]);
 
 // Texel-space position of sample (ox, oy) of texel (x, y).
