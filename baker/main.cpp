@@ -6,6 +6,7 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <future>
 #include <iostream>
 #include <new>
 #include <sstream>
@@ -194,14 +195,16 @@ int run(int argc, char** argv) {
   Mesh high = load_mesh(a.high, {}, &run.high_info);
   Mesh cage;
   if (!a.cage.empty()) cage = load_mesh(a.cage, {}, &run.cage_info);
-  run.high_topology = inspect_topology(high);
   run.seconds_load = std::chrono::duration<double>(Clock::now() - t0).count();
+  // Topology checks are only reported: they run beside the bake (about 0.5 s CPU per 400k triangles).
+  auto topology = std::async(std::launch::async, [&high] { return inspect_topology(high); });
   if (g_interrupted) throw Cancelled();
 
   ProgressBar bar(tty);
   o.progress = [&](double f) { return bar.update(f); };
   BakeResult r = bake_normal_map(low, high, a.cage.empty() ? nullptr : &cage, o);
   const BakeStats& s = r.stats;
+  run.high_topology = topology.get();
   if (s.auto_distances && !a.quiet)
     std::fprintf(stderr, "nmbake: ray distances measured: --front %.6g --rear %.6g (%.2f%% of probes lie beyond)\n", s.front, s.rear,
                  100.0 * s.auto_probe_beyond);

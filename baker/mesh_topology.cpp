@@ -60,10 +60,14 @@ Analysis analyze(const Mesh& m) {
       if (v[0] == v[1] || v[1] == v[2]) a.skip[t] = 1;  // collapsed: no edges, no direction
     }
     std::sort(sorted.begin(), sorted.end(), [](const Tri& x, const Tri& y) {
-      return std::memcmp(x.v, y.v, sizeof x.v) < 0 || (std::memcmp(x.v, y.v, sizeof x.v) == 0 && x.face < y.face);
+      if (x.v[0] != y.v[0]) return x.v[0] < y.v[0];
+      if (x.v[1] != y.v[1]) return x.v[1] < y.v[1];
+      if (x.v[2] != y.v[2]) return x.v[2] < y.v[2];
+      return x.face < y.face;
     });
+    auto same = [](const Tri& x, const Tri& y) { return x.v[0] == y.v[0] && x.v[1] == y.v[1] && x.v[2] == y.v[2]; };
     for (std::size_t i = 1; i < tris; ++i)
-      if (std::memcmp(sorted[i].v, sorted[i - 1].v, sizeof sorted[i].v) == 0 && !a.skip[sorted[i].face]) {
+      if (same(sorted[i], sorted[i - 1]) && !a.skip[sorted[i].face]) {
         a.skip[sorted[i].face] = 1;
         ++a.topo.duplicate_faces;
       }
