@@ -13,6 +13,8 @@
 #include <sstream>
 #include <thread>
 
+#include "memory_budget.h"
+#include "mesh_topology.h"
 #include "normals.h"
 #include "padding.h"
 #include "rasterize.h"
@@ -37,16 +39,6 @@ constexpr int kTile = 16;            // texels per tile side
 // (128,128,255) and not a coin flip between 127 and 128 decided by float noise.
 constexpr double kSnap = 1e-6;
 
-std::uint64_t available_memory_bytes() {
-  std::ifstream in("/proc/meminfo");
-  std::string key;
-  std::uint64_t value = 0;
-  std::string unit;
-  while (in >> key >> value >> unit)
-    if (key == "MemAvailable:") return value * 1024;
-  return std::numeric_limits<std::uint64_t>::max();
-}
-
 // The scene in re-centred float coordinates, flat arrays for the hot loop.
 struct Prepared {
   glm::dvec3 centre{0.0};
@@ -57,10 +49,12 @@ struct Prepared {
   TangentFrames frames;
 };
 
-void grow_box(glm::dvec3& lo, glm::dvec3& hi, const std::vector<glm::vec3>& pts) {
-  for (const glm::vec3& p : pts) {
-    lo = glm::min(lo, glm::dvec3(p));
-    hi = glm::max(hi, glm::dvec3(p));
+// Over the positions faces use: a vertex no face uses (a stray point far away) must not move the
+// centre or stretch the diagonal that scales every distance.
+void grow_box(glm::dvec3& lo, glm::dvec3& hi, const std::vector<glm::vec3>& pts, const std::vector<std::uint32_t>& index) {
+  for (std::uint32_t i : index) {
+    lo = glm::min(lo, glm::dvec3(pts[i]));
+    hi = glm::max(hi, glm::dvec3(pts[i]));
   }
 }
 
@@ -70,16 +64,14 @@ std::vector<glm::vec3> recentre(const std::vector<glm::vec3>& pts, const glm::dv
   return out;
 }
 
-// Ray normals: one per position, the normalized mean of the distinct normals its corners use, so
-// split normals (hard edges) open no gaps between the rays of neighbouring faces.
-std::vector<glm::vec3> position_averaged_normals(const Mesh& low, const TangentFrames& frames) {
-  const std::size_t np = low.positions.size();
+std::vector<glm::vec3> position_averaged_normals(const Mesh& low, const TangentFrames& frames, const std::vector<std::uint32_t>& weld,
+                                                 std::size_t np) {
   // A position whose corners all use one normal keeps it bit for bit; one with several gets the
   // normalized mean over its corners (a normal shared by more faces weighs more).
   std::vector<glm::vec3> out(np, glm::vec3(0, 0, 1));
   std::vector<std::uint8_t> state(np, 0);  // 0 unseen, 1 one normal so far, 2 several
   for (std::size_t c = 0; c < low.position_index.size(); ++c) {
-    const std::uint32_t p = low.position_index[c];
+    const std::uint32_t p = weld[low.position_index[c]];
     if (state[p] == 0) {
       state[p] = 1;
       out[p] = frames.normal[c];
@@ -89,11 +81,23 @@ std::vector<glm::vec3> position_averaged_normals(const Mesh& low, const TangentF
   }
   std::vector<glm::dvec3> sum(np, glm::dvec3(0.0));
   for (std::size_t c = 0; c < low.position_index.size(); ++c)
-    if (state[low.position_index[c]] == 2) sum[low.position_index[c]] += glm::dvec3(frames.normal[c]);
+    if (state[weld[low.position_index[c]]] == 2) sum[weld[low.position_index[c]]] += glm::dvec3(frames.normal[c]);
   for (std::size_t p = 0; p < np; ++p) {
     const double len = glm::length(sum[p]);
     if (state[p] == 2 && len > 1e-12) out[p] = glm::vec3(sum[p] / len);
   }
+  return out;
+}
+
+// Ray normals: one per position, the normalized mean of the distinct normals its corners use, so
+// split normals (hard edges) open no gaps between the rays of neighbouring faces. Positions are
+// welded by value first: glTF-style files split hard edges into separate vertices.
+std::vector<glm::vec3> position_averaged_normals(const Mesh& low, const TangentFrames& frames) {
+  std::size_t np = 0;
+  const std::vector<std::uint32_t> weld = weld_positions(low.positions, &np);
+  const std::vector<glm::vec3> welded = position_averaged_normals(low, frames, weld, np);
+  std::vector<glm::vec3> out(low.positions.size());
+  for (std::size_t p = 0; p < out.size(); ++p) out[p] = welded[weld[p]];
   return out;
 }
 
@@ -166,7 +170,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
                      std::to_string(low.triangle_count()) + " and " + std::to_string(low.positions.size()) + ")");
   {
     const std::uint64_t need = estimate_bake_bytes(opt);
-    const std::uint64_t avail = available_memory_bytes();
+    const std::uint64_t avail = opt.memory_limit ? opt.memory_limit : memory_budget_bytes();
     if (need > avail)
       throw ResourceError("--size " + std::to_string(opt.width) + "x" + std::to_string(opt.height) + " needs about " +
                           std::to_string(need >> 20) + " MiB for its buffers but only " + std::to_string(avail >> 20) +
@@ -188,34 +192,39 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   st.corners_without_tangent = s.frames.corners_without_tangent;
   {
     glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
-    grow_box(lo, hi, low.positions);
-    grow_box(lo, hi, high.positions);
-    if (cage) grow_box(lo, hi, cage->positions);
+    grow_box(lo, hi, low.positions, low.position_index);
+    grow_box(lo, hi, high.positions, high.position_index);
+    if (cage) grow_box(lo, hi, cage->positions, cage->position_index);
     s.centre = 0.5 * (lo + hi);
     st.centre = s.centre;
     s.diagonal = glm::length(hi - lo);
     if (!(s.diagonal > 0.0)) s.diagonal = 1.0;
+    // Float spacing at the largest coordinate: the precision the inputs carry (float positions).
+    const glm::dvec3 far = glm::max(glm::abs(lo), glm::abs(hi));
+    const float largest = float(std::max({far.x, far.y, far.z}));
+    st.largest_coordinate = largest;
+    st.coordinate_spacing = double(std::nextafter(largest, std::numeric_limits<float>::infinity()) - largest) / s.diagonal;
   }
   s.low_pos = recentre(low.positions, s.centre);
   s.high_pos = recentre(high.positions, s.centre);
   if (cage) s.cage_pos = recentre(cage->positions, s.centre);
   s.ray_normal = position_averaged_normals(low, s.frames);
-  {
-    std::vector<glm::vec3> computed;
-    if (!high.has_normals()) {
-      computed = compute_vertex_normals(high);
-      st.high_normals_computed = true;
-    }
-    const std::vector<glm::vec3>& normals = high.has_normals() ? high.normals : computed;
-    const std::vector<std::uint32_t>& index = high.has_normals() ? high.normal_index : high.position_index;
-    s.high_corner_normals.resize(index.size());
-    for (std::size_t c = 0; c < index.size(); ++c) s.high_corner_normals[c] = normals[index[c]];
+  if (high.has_normals()) {
+    s.high_corner_normals.resize(high.normal_index.size());
+    for (std::size_t c = 0; c < high.normal_index.size(); ++c) s.high_corner_normals[c] = high.normals[high.normal_index[c]];
+  } else {
+    // Welded by value, duplicate faces once, one winding per piece (mesh_topology.h).
+    s.high_corner_normals = compute_high_corner_normals(high, &st.high_faces_reoriented);
+    st.high_normals_computed = true;
   }
   for (std::size_t t = 0; t < low.triangle_count(); ++t)
     for (int c = 0; c < 3; ++c) {
       const glm::vec2 uv = low.corner_uv(t, c);
       if (uv.x < 0.0f || uv.x > 1.0f || uv.y < 0.0f || uv.y > 1.0f) {
         ++st.uv_outside_triangles;
+        glm::vec2 lo = uv, hi = uv;
+        for (int k = 0; k < 3; ++k) lo = glm::min(lo, low.corner_uv(t, k)), hi = glm::max(hi, low.corner_uv(t, k));
+        st.uv_outside_entirely_triangles += hi.x < 0.0f || lo.x > 1.0f || hi.y < 0.0f || lo.y > 1.0f;
         break;
       }
     }
@@ -601,6 +610,8 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   for (std::size_t i = 0; i < result.coverage.size(); ++i)
     if (!result.coverage[i])
       for (int c = 0; c < 3; ++c) result.map.pixels[3 * i + c] = flat[c];
+  if (opt.space == NormalSpace::tangent)
+    for (std::size_t i = 0; i < result.coverage.size(); ++i) st.texels_facing_away += result.coverage[i] && result.map.pixels[3 * i + 2] < 0.5f;
   st.texels_padded = pad_islands(result.map, result.coverage, opt.padding);
   st.seconds_padding = seconds_since(t0);
   return result;

@@ -31,6 +31,7 @@ enum class NormalSpace { tangent, object };
 
 constexpr int kMaxMapSide = 65536;  // texels per side; larger maps are refused (ResourceError)
 constexpr int kMaxSamples = 1024;   // sample points per texel
+constexpr double kCoordinateSpacingWarn = 1e-3;  // BakeStats::coordinate_spacing above this: warn
 
 struct BakeOptions {
   int width = 2048;   // map width in texels
@@ -45,6 +46,9 @@ struct BakeOptions {
   int padding = 16;     // texels of edge padding around islands; 0 = none
   int threads = 0;      // worker threads; 0 = all cores
   bool miss_mask = false;  // fill BakeResult::miss_mask (share of missed samples per texel)
+  // Bytes the bake's buffers may take (estimate_bake_bytes); 0 = what the machine has
+  // (memory_budget_bytes: MemAvailable, cgroup limit, ulimit -v). Larger bakes are refused.
+  std::uint64_t memory_limit = 0;
   // For the bench: when set, receives a copy of every ray the trace stage cast (order unspecified),
   // in coordinates re-centred on BakeStats::centre.
   std::vector<raycast::Ray>* record_rays = nullptr;
@@ -69,6 +73,16 @@ struct BakeStats {
   std::size_t low_triangles = 0, high_triangles = 0;
   std::size_t degenerate_uv_triangles = 0, degenerate_3d_triangles = 0, corners_without_tangent = 0;
   std::size_t uv_outside_triangles = 0;  // low-poly triangles with a UV outside [0,1]
+  std::size_t uv_outside_entirely_triangles = 0;  // of those, UV bounding box outside [0,1]^2: not baked
+  std::size_t high_faces_reoriented = 0;  // computed high-poly normals: faces turned to their piece's winding
+  // Float spacing at the largest (referenced) coordinate of the inputs, relative to the scene
+  // diagonal: the precision the meshes themselves carry. Above kCoordinateSpacingWarn the map
+  // degrades measurably (data/stability/README.md, case 5).
+  double coordinate_spacing = 0.0;
+  double largest_coordinate = 0.0;  // largest |x|, |y| or |z| of a position a face uses
+  // Tangent space: covered texels whose normal points into the low-poly surface (z < 0), e.g.
+  // from inverted high-poly normals or winding. 0 for object-space maps.
+  std::size_t texels_facing_away = 0;
   bool high_normals_computed = false;
   // Seconds per stage.
   double seconds_prepare = 0, seconds_bvh = 0, seconds_distances = 0, seconds_trace = 0, seconds_padding = 0;

@@ -6,6 +6,7 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <future>
 #include <iostream>
 #include <new>
 #include <sstream>
@@ -19,6 +20,7 @@
 #include "image_io.h"
 #include "mesh_io.h"
 #include "report.h"
+#include "warnings.h"
 
 namespace {
 
@@ -194,21 +196,20 @@ int run(int argc, char** argv) {
   Mesh cage;
   if (!a.cage.empty()) cage = load_mesh(a.cage, {}, &run.cage_info);
   run.seconds_load = std::chrono::duration<double>(Clock::now() - t0).count();
+  // Topology checks are only reported: they run beside the bake (about 0.5 s CPU per 400k triangles).
+  auto topology = std::async(std::launch::async, [&high] { return inspect_topology(high); });
   if (g_interrupted) throw Cancelled();
 
   ProgressBar bar(tty);
   o.progress = [&](double f) { return bar.update(f); };
   BakeResult r = bake_normal_map(low, high, a.cage.empty() ? nullptr : &cage, o);
   const BakeStats& s = r.stats;
+  run.high_topology = topology.get();
   if (s.auto_distances && !a.quiet)
     std::fprintf(stderr, "nmbake: ray distances measured: --front %.6g --rear %.6g (%.2f%% of probes lie beyond)\n", s.front, s.rear,
                  100.0 * s.auto_probe_beyond);
-  if (!a.quiet && s.uv_outside_triangles)
-    std::fprintf(stderr, "nmbake: warning: %s: %zu triangles have UVs outside [0,1]; only the part inside the map is baked\n",
-                 a.low.c_str(), s.uv_outside_triangles);
-  if (!a.quiet && s.overlapping_samples)
-    std::fprintf(stderr, "nmbake: warning: %s: UV islands overlap (%llu samples covered twice; the lower face number wins)\n",
-                 a.low.c_str(), (unsigned long long)s.overlapping_samples);
+  if (!a.quiet)
+    for (const std::string& w : bake_warnings(s, run.high_topology, a.low, a.high)) std::fprintf(stderr, "nmbake: %s\n", w.c_str());
   if (g_interrupted) throw Cancelled();
 
   // Write.

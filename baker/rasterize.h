@@ -8,6 +8,7 @@
 // cover nothing. Where UV islands overlap, the triangle with the lowest index wins.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -33,7 +34,9 @@ struct TexelTriangle {
 TexelTriangle setup_texel_triangle(glm::vec2 uv0, glm::vec2 uv1, glm::vec2 uv2, int width, int height);
 
 // True when sample point q (texel space) is covered; then bary receives the weights of corners
-// 0, 1, 2 (they sum to 1 and are each in [0,1]). Inline: the bake calls it per sample.
+// 0, 1, 2 (they sum to 1 and are each in [0,1]). A sample on an edge gets weights of at least 1e-5
+// (moved just inside its triangle, so a coincident high-poly cannot tie with the neighbour).
+// Inline: the bake calls it per sample.
 inline bool covers(const TexelTriangle& tri, glm::dvec2 q, double bary[3]) {
   if (tri.area2 == 0.0) return false;
   double w[3];
@@ -49,6 +52,16 @@ inline bool covers(const TexelTriangle& tri, glm::dvec2 q, double bary[3]) {
   const double sum = w[0] + w[1] + w[2];
   if (!(sum > 0.0) || !std::isfinite(sum)) return false;
   for (int k = 0; k < 3; ++k) bary[k] = w[k] / sum;
+  // A sample on an edge (a texel centre on a UV edge) lies on the 3D edge too, where a high-poly
+  // with the same edge (coincident, or hard-edged) ties between two triangles and the ray may take
+  // the neighbour's normal. Moving it kEdgeInset inside its own triangle breaks the tie; samples
+  // farther inside are untouched.
+  constexpr double kEdgeInset = 1e-5;
+  if (bary[0] < kEdgeInset || bary[1] < kEdgeInset || bary[2] < kEdgeInset) {
+    double s = 0.0;
+    for (int k = 0; k < 3; ++k) s += (bary[k] = std::max(bary[k], kEdgeInset));
+    for (int k = 0; k < 3; ++k) bary[k] /= s;
+  }
   return true;
 }
 

@@ -82,7 +82,20 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
       {"high_mesh", mesh_json(r.high_info, s.high_triangles)},
       {"high_normals_computed", s.high_normals_computed},
       {"peak_memory_bytes", r.peak_memory_bytes},
+      {"uv_outside_entirely_triangles", s.uv_outside_entirely_triangles},
+      {"high_faces_reoriented", s.high_faces_reoriented},
+      {"texels_facing_away", s.texels_facing_away},
+      {"coordinate_spacing", s.coordinate_spacing},
+      {"largest_coordinate", s.largest_coordinate},
   };
+  const MeshTopology& t = r.high_topology;
+  json& high = report["high_mesh"];
+  high["welded_vertices"] = t.welded_vertices;
+  high["isolated_vertices"] = t.isolated_vertices;
+  high["duplicate_faces"] = t.duplicate_faces;
+  high["boundary_edges"] = t.boundary_edges;
+  high["non_manifold_edges"] = t.non_manifold_edges;
+  high["inconsistent_winding_faces"] = t.inconsistent_winding_faces;
   return report;
 }
 

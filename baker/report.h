@@ -8,6 +8,7 @@
 
 #include "bake.h"
 #include "mesh.h"
+#include "mesh_topology.h"
 
 namespace nmbake {
 
@@ -15,6 +16,7 @@ struct RunInfo {
   std::string low_path, high_path, cage_path, output_path, miss_mask_path;
   int bits = 8;
   MeshLoadInfo low_info, high_info, cage_info;
+  MeshTopology high_topology;  // inspect_topology(high)
   double seconds_load = 0, seconds_write = 0, seconds_total = 0;
   std::uint64_t peak_memory_bytes = 0;
   unsigned threads_used = 0;

@@ -1,0 +1,13 @@
+// How much memory a bake may allocate on this machine, checked before the big buffers exist.
+#pragma once
+
+#include <cstdint>
+
+namespace nmbake {
+
+// The smallest of: MemAvailable (/proc/meminfo), the cgroup's limit minus its usage (containers,
+// cgroup v2 memory.max or v1 memory.limit_in_bytes), and the address-space limit (ulimit -v) minus
+// what the process already maps. UINT64_MAX when none is known.
+std::uint64_t memory_budget_bytes();
+
+}  // namespace nmbake
