@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <memory>
 #include <new>
 #include <system_error>
@@ -161,13 +162,13 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
     spec.attribute("png:filter", 0x20);
   }
   if (ext == ".exr") spec.attribute("compression", "none");
-  // The TIFF writer drops attributes it does not know; keep them readable in the description tag.
-  if ((ext == ".tif" || ext == ".tiff") && !options.metadata.empty() &&
-      spec.get_string_attribute("ImageDescription").empty()) {
-    std::string description;
+  // The TIFF writer drops attributes it does not know; keep them readable (and parsable by
+  // read_image_metadata) as "key=value" items after any given description in the description tag.
+  if (ext == ".tif" || ext == ".tiff") {
+    std::string description = spec.get_string_attribute("ImageDescription");
     for (const auto& [key, value] : options.metadata)
-      description += (description.empty() ? "" : "; ") + key + "=" + value;
-    spec.attribute("ImageDescription", description);
+      if (key != "ImageDescription") description += (description.empty() ? "" : "; ") + key + "=" + value;
+    if (!description.empty()) spec.attribute("ImageDescription", description);
   }
 
   // Create with the real path so the writer is chosen by its extension.
@@ -244,6 +245,32 @@ Image read_image(const std::string& path) {
     return fail(one_line(in->geterror()));
   in->close();
   return image;
+}
+
+std::map<std::string, std::string> read_image_metadata(const std::string& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec) || fs::is_directory(path, ec))
+    throw InputError(path + ": cannot read image: " + (fs::is_directory(path, ec) ? "it is a folder" : "no such file"));
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) throw InputError(path + ": cannot read image: " + one_line(OIIO::geterror()));
+  std::map<std::string, std::string> metadata;
+  for (const OIIO::ParamValue& p : in->spec().extra_attribs)
+    if (p.type() == OIIO::TypeDesc::STRING) metadata[p.name().string()] = p.get_string();
+  // "key=value" items of the description tag (how write_image keeps them in TIFF).
+  const std::string description = in->spec().get_string_attribute("ImageDescription");
+  std::size_t begin = 0;
+  while (begin < description.size()) {
+    std::size_t end = description.find(';', begin);
+    if (end == std::string::npos) end = description.size();
+    std::string item = description.substr(begin, end - begin);
+    item.erase(0, item.find_first_not_of(' '));
+    const std::size_t equals = item.find('=');
+    if (item.rfind("nmbake:", 0) == 0 && equals != std::string::npos)
+      metadata.emplace(item.substr(0, equals), item.substr(equals + 1));
+    begin = end + 1;
+  }
+  in->close();
+  return metadata;
 }
 
 }  // namespace nmbake

@@ -1,6 +1,7 @@
 // Reading and writing images through OpenImageIO: the only code that includes OpenImageIO.
 #pragma once
 
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -29,5 +30,11 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
 // Reads any format OpenImageIO reads, converted to float (integer formats scaled to [0,1]).
 // Throws InputError naming the file when it cannot be read.
 Image read_image(const std::string& path);
+
+// The string attributes stored with an image (e.g. "nmbake:green" -> "down", as the baker writes
+// them with WriteOptions::metadata), including "nmbake:key=value" items of the description tag,
+// where TIFF keeps them. Reads the header only. Throws InputError naming the file when it cannot
+// be opened.
+std::map<std::string, std::string> read_image_metadata(const std::string& path);
 
 }  // namespace nmbake

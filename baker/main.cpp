@@ -219,6 +219,7 @@ int run(int argc, char** argv) {
   wo.metadata = {{"nmbake:space", to_string(o.space)},
                  {"nmbake:green", o.green_down ? "down" : "up"},
                  {"nmbake:tangent_basis", "mikktspace"},
+                 {"nmbake:bitangent", o.bitangent == BitangentMode::per_vertex ? "vertex" : "pixel"},
                  {"nmbake:version", NMBAKE_VERSION},
                  {"ImageDescription", std::string(o.space == NormalSpace::object ? "object-space normal map" : "tangent-space normal map, ") +
                                           (o.space == NormalSpace::object ? "" : (o.green_down ? "DirectX (Y-)" : "OpenGL (Y+)")) +

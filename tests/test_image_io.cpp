@@ -164,6 +164,23 @@ TEST(ImageIo, MetadataIsStoredInTheFile) {
   }
 }
 
+TEST(ImageIo, MetadataReadsBackFromEveryFormat) {
+  const std::string dir = nmbake::test::scratch_dir();
+  nmbake::WriteOptions options;
+  options.metadata = {{"nmbake:green", "down"}, {"nmbake:space", "tangent"}, {"ImageDescription", "a map, baked"}};
+  for (const std::string name : {"meta.png", "meta.tif", "meta.exr"}) {
+    nmbake::write_image(dir + "/" + name, Image(2, 2, 3, 0.5f), options);
+    const auto metadata = nmbake::read_image_metadata(dir + "/" + name);
+    EXPECT_EQ(metadata.count("nmbake:green") ? metadata.at("nmbake:green") : "", "down") << name;
+    EXPECT_EQ(metadata.count("nmbake:space") ? metadata.at("nmbake:space") : "", "tangent") << name;
+    ASSERT_TRUE(metadata.count("ImageDescription")) << name;
+    EXPECT_EQ(metadata.at("ImageDescription").rfind("a map, baked", 0), 0u) << name;
+  }
+  nmbake::write_image(dir + "/plain.png", Image(2, 2, 3, 0.5f));
+  EXPECT_EQ(nmbake::read_image_metadata(dir + "/plain.png").count("nmbake:green"), 0u);
+  EXPECT_THROW(nmbake::read_image_metadata(dir + "/none.png"), nmbake::InputError);
+}
+
 TEST(ImageIo, SuccessfulWriteReplacesTheFileAndLeavesNoTemporary) {
   const std::string dir = nmbake::test::scratch_dir();
   const std::string path = dir + "/out.png";

@@ -116,7 +116,7 @@ std::string title(const Scene& scene) {
 void run_interactive(const Scene& scene, const InteractiveOptions& options) {
   Window window(options.width, options.height, title(scene));
   std::cerr << "nmview: " << current_renderer() << "\n";
-  Renderer renderer(scene.low, scene.high, scene.map, scene.radius);
+  Renderer renderer(scene.low, scene.high, scene.map, scene.radius, scene.decoding);
 
   State s;
   s.initial = options;

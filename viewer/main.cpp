@@ -32,6 +32,7 @@ struct Options {
   std::string show;
   bool no_map = false;
   bool compare = false;
+  nmview::DecodingOverrides decoding;
 };
 
 // "A,B" of two finite numbers.
@@ -78,7 +79,7 @@ int run(const Options& o) {
   parse_show(o.show, io.toggles);
   io.toggles.map = !o.no_map;
 
-  const nmview::Scene scene = nmview::load_scene(o.low, o.map, o.high, std::cerr);
+  const nmview::Scene scene = nmview::load_scene(o.low, o.map, o.high, std::cerr, o.decoding);
 
   if (!o.compare && o.screenshot.empty()) {
     nmview::run_interactive(scene, io);
@@ -87,7 +88,7 @@ int run(const Options& o) {
 
   nmview::HeadlessContext context;
   std::cerr << "nmview: " << context.description() << "\n";
-  nmview::Renderer renderer(scene.low, scene.high, scene.map, scene.radius);
+  nmview::Renderer renderer(scene.low, scene.high, scene.map, scene.radius, scene.decoding);
 
   if (o.compare) {
     // Each view is measured at the size of one pane of the --size window.
@@ -122,7 +123,8 @@ int main(int argc, char** argv) {
                "lit alike from one camera"};
   Options o;
   app.add_option("low", o.low, "Low-poly mesh with UVs (OBJ, PLY, OFF, STL), as given to nmbake")->required();
-  app.add_option("map", o.map, "Tangent-space normal map baked for it (any size)")->required();
+  app.add_option("map", o.map, "Normal map baked for it (any size; its nmbake:* metadata says how it was baked)")
+      ->required();
   app.add_option("high", o.high, "High-poly mesh (its normals, else computed ones)")->required();
   app.add_option("--screenshot", o.screenshot,
                  "Render without a display to FILE and exit (with --compare: the worst view's difference image)");
@@ -134,8 +136,23 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_flag("--no-map", o.no_map, "Left pane without the normal map (the low-poly's bare shading)");
   app.add_flag("--compare", o.compare,
-               "Render both models from 10 fixed views and print the difference over the object's pixels; "
-               "last line: psnr=<dB> rmse=<0..1> within2=<fraction>");
+               "Render both models from 10 fixed views (8 around at 20 deg elevation, top, bottom) with one light "
+               "and print the appearance difference. psnr/rmse/within2 are over the INTERIOR: pixels fully covered "
+               "by both models whose neighbours within 1 pixel are too (silhouettes and their anti-aliasing left "
+               "out); rmse of the 8-bit RGB values scaled to 0..1, psnr = 20 log10(1/rmse), within2 = share of "
+               "pixels with every channel within 2/255. silhouette_mismatch = share of the object's pixels "
+               "(covered by either model) covered by one model only; union_psnr/union_rmse = the same over all "
+               "the object's pixels (one-model pixels against black). Last stdout line: psnr=<dB> rmse=<0..1> "
+               "within2=<fraction> silhouette_mismatch=<fraction> union_psnr=<dB> union_rmse=<0..1> "
+               "interior_share=<fraction>");
+  app.add_option("--space", o.decoding.space,
+                 "How the map was baked: tangent or object space (default: the map's nmbake:space metadata, "
+                 "else tangent)");
+  app.add_option("--green", o.decoding.green,
+                 "Tangent-space map's green: up = OpenGL, down = DirectX (default: nmbake:green metadata, else up)");
+  app.add_option("--bitangent", o.decoding.bitangent,
+                 "Tangent-space map's bitangent: pixel = sign*cross(N,T) per pixel (MikkTSpace), vertex = "
+                 "interpolated per-corner B (default: nmbake:bitangent metadata, else pixel)");
   app.add_option("--show", o.show, "Start with toggles on: wire,diff,tangent,specular,nolabels");
 
   try {

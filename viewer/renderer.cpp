@@ -124,8 +124,9 @@ std::vector<Rect> pane_layout(int width, int height, bool difference) {
   return panes;
 }
 
-Renderer::Renderer(const LowVertices& low, const HighVertices& high, const nmbake::Image& map, float radius)
-    : radius_(radius) {
+Renderer::Renderer(const LowVertices& low, const HighVertices& high, const nmbake::Image& map, float radius,
+                   const MapDecoding& decoding)
+    : radius_(radius), decoding_(decoding) {
   low_program_ = link(shaders::kLowVertex, shaders::kLowFragment, "low", true);
   high_program_ = link(shaders::kHighVertex, shaders::kHighFragment, "high", true);
   wire_program_ = link(shaders::kWireVertex, shaders::kFlatFragment, "wire");
@@ -134,7 +135,7 @@ Renderer::Renderer(const LowVertices& low, const HighVertices& high, const nmbak
   difference_program_ = link(shaders::kFullscreenVertex, shaders::kDifferenceFragment, "difference");
   text_program_ = link(shaders::kTextVertex, shaders::kFlatFragment, "text");
 
-  upload(low, {{0, 3}, {1, 3}, {2, 4}, {3, 2}}, low_.vao, low_.vbo, low_.ebo);
+  upload(low, {{0, 3}, {1, 3}, {2, 4}, {3, 2}, {4, 3}}, low_.vao, low_.vbo, low_.ebo);
   low_.index_count = low.indices.size();
   upload(high, {{0, 3}, {1, 3}}, high_.vao, high_.vbo, high_.ebo);
   high_.index_count = high.indices.size();
@@ -250,6 +251,9 @@ void Renderer::draw_model(int which, const CameraMatrices& camera, const Toggles
     glBindTexture(GL_TEXTURE_2D, map_texture_);
     glUniform1i(uniform(program, "u_map"), 0);
     glUniform1i(uniform(program, "u_mode"), toggles.tangent_colours ? 2 : toggles.map ? 0 : 1);
+    glUniform1i(uniform(program, "u_object"), decoding_.object_space ? 1 : 0);
+    glUniform1f(uniform(program, "u_green"), decoding_.green_down ? -1.0f : 1.0f);
+    glUniform1i(uniform(program, "u_bitangent"), decoding_.bitangent == nmbake::BitangentMode::per_vertex ? 1 : 0);
   }
   glBindVertexArray(model.vao);
   // The filled pass is pushed back a little so the wireframe lines win the depth test.
@@ -389,7 +393,7 @@ void Renderer::render(unsigned target, int width, int height, const OrbitView& v
     const std::vector<std::pair<std::string, std::string>> titles = {
         {"LOW  " + with_thousands(low_triangles()) + " TRIS", mode},
         {"HIGH  " + with_thousands(high_triangles()) + " TRIS", "OWN NORMALS"},
-        {"DIFFERENCE X" + std::to_string(int(kDifferenceGain)), "LEFT - RIGHT"}};
+        {"DIFFERENCE X" + std::to_string(int(kDifferenceGain)), "BLUE: ONE MODEL ONLY"}};
     glEnable(GL_SCISSOR_TEST);
     for (std::size_t i = 0; i < layout.size(); ++i) {
       const Rect& r = layout[i];

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "decoding.h"
 #include "image.h"
 #include "metrics.h"
 #include "vertex_data.h"
@@ -42,7 +43,9 @@ class Renderer {
  public:
   // `map` has at least 3 channels (RGB encoded normals). Throws nmbake::Error (ExitCode::output)
   // when a shader does not compile or the map is larger than the GL texture limit.
-  Renderer(const LowVertices& low, const HighVertices& high, const nmbake::Image& map, float radius);
+  // `decoding` is the convention the map was baked with.
+  Renderer(const LowVertices& low, const HighVertices& high, const nmbake::Image& map, float radius,
+           const MapDecoding& decoding = {});
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
@@ -84,6 +87,7 @@ class Renderer {
   Pane panes_[2];
   int pane_width_ = 0, pane_height_ = 0, samples_ = 1;
   float radius_ = 1.0f;
+  MapDecoding decoding_;
 };
 
 // An offscreen RGBA8 framebuffer for headless frames.

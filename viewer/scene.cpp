@@ -11,7 +11,7 @@
 namespace nmview {
 
 Scene load_scene(const std::string& low_path, const std::string& map_path, const std::string& high_path,
-                 std::ostream& log) {
+                 std::ostream& log, const DecodingOverrides& overrides) {
   Scene scene;
   scene.low_name = low_path;
   scene.map_name = map_path;
@@ -25,13 +25,16 @@ Scene load_scene(const std::string& low_path, const std::string& map_path, const
   scene.map = nmbake::read_image(map_path);
   if (scene.map.channels < 3)
     throw nmbake::InputError(map_path + ": has " + std::to_string(scene.map.channels) +
-                             " channel(s); a tangent-space normal map needs RGB");
+                             " channel(s); a normal map needs RGB");
   if (scene.map.width <= 0 || scene.map.height <= 0) throw nmbake::InputError(map_path + ": empty image");
+  std::string note;
+  scene.decoding = resolve_decoding(nmbake::read_image_metadata(map_path), overrides, map_path, &note);
+  log << "nmview: " << map_path << ": decoded as " << note << "\n";
   double blue = 0.0;
   for (int y = 0; y < scene.map.height; ++y)
     for (int x = 0; x < scene.map.width; ++x) blue += scene.map.at(x, y)[2];
   blue /= double(scene.map.width) * double(scene.map.height);
-  if (blue < 0.5)
+  if (blue < 0.5 && !scene.decoding.object_space)
     log << "nmview: warning: " << map_path << ": mean blue " << blue
         << " < 0.5, so most normals point into the surface; is this a tangent-space normal map?\n";
 

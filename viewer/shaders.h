@@ -30,16 +30,19 @@ layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec4 a_tangent;
 layout(location = 3) in vec2 a_uv;
+layout(location = 4) in vec3 a_bitangent;
 uniform mat4 u_view_projection;
 out vec3 v_position;
 out vec3 v_normal;
 out vec4 v_tangent;
 out vec2 v_uv;
+out vec3 v_bitangent;
 void main() {
   v_position = a_position;
   v_normal = a_normal;
   v_tangent = a_tangent;
   v_uv = a_uv;
+  v_bitangent = a_bitangent;
   gl_Position = u_view_projection * vec4(a_position, 1.0);
 }
 )";
@@ -49,6 +52,9 @@ void main() {
 // The sign is tangent.w interpolated like N and T, as nmbake::interpolate_frame does (it is +1 or
 // -1 on every triangle whose corners agree, i.e. all but some UV-degenerate ones). Perspective-
 // correct interpolation gives the same barycentrics the baker uses on the triangle.
+// Maps baked otherwise (decoding.h): green down negates t.y, as the baker negated it; a per-vertex
+// bitangent map takes B interpolated from the corners' B (computed by interpolate_frame); an
+// object-space map is the normal itself (re-centring the scene does not turn directions).
 // The map texture's rows are uploaded bottom-up, so texture coordinates are the mesh UVs as they
 // are (v = 1 is the image's top row).
 inline const char* kLowFragment = R"(
@@ -56,8 +62,12 @@ in vec3 v_position;
 in vec3 v_normal;
 in vec4 v_tangent;
 in vec2 v_uv;
+in vec3 v_bitangent;
 uniform sampler2D u_map;
-uniform int u_mode;  // 0 = lit with the map, 1 = lit with the bare interpolated normal, 2 = map colours
+uniform int u_mode;       // 0 = lit with the map, 1 = lit with the bare interpolated normal, 2 = map colours
+uniform int u_object;     // 1 = object-space map
+uniform float u_green;    // +1 green up (OpenGL), -1 green down (DirectX)
+uniform int u_bitangent;  // 0 = per pixel, 1 = per vertex
 out vec4 frag_color;
 void main() {
   vec3 N = v_normal;
@@ -68,9 +78,12 @@ void main() {
     return;
   }
   vec3 n;
-  if (u_mode == 0) {
-    vec3 B = v_tangent.w * cross(N, T);
+  if (u_mode == 0 && u_object == 1) {
+    n = normalize(texel * 2.0 - 1.0);
+  } else if (u_mode == 0) {
+    vec3 B = u_bitangent == 1 ? v_bitangent : v_tangent.w * cross(N, T);
     vec3 t = texel * 2.0 - 1.0;
+    t.y *= u_green;
     n = normalize(t.x * T + t.y * B + t.z * N);
   } else {
     n = normalize(N);
@@ -137,8 +150,9 @@ out vec4 frag_color;
 void main() { frag_color = texelFetch(u_pane, ivec2(gl_FragCoord.xy) - u_origin, 0); }
 )";
 
-// |left - right| over the object's pixels (covered by either pane), largest channel times
-// u_gain, as a heat colour: black, red, yellow, white.
+// |left - right| where both panes cover the pixel, largest channel times u_gain, as a heat colour:
+// black, red, yellow, white. Pixels only one model covers (the silhouette mismatch, which no map
+// can fix) are blue, so they are not read as shading error.
 inline const char* kDifferenceFragment = R"(
 uniform sampler2D u_left;
 uniform sampler2D u_right;
@@ -150,6 +164,10 @@ void main() {
   vec4 a = texelFetch(u_left, p, 0);
   vec4 b = texelFetch(u_right, p, 0);
   if (a.a == 0.0 && b.a == 0.0) discard;
+  if (a.a == 0.0 || b.a == 0.0) {
+    frag_color = vec4(0.15, 0.35, 0.85, 1.0);
+    return;
+  }
   vec3 d = abs(a.rgb - b.rgb);
   float v = clamp(max(d.r, max(d.g, d.b)) * u_gain, 0.0, 1.0);
   frag_color = vec4(clamp(3.0 * v, 0.0, 1.0), clamp(3.0 * v - 1.0, 0.0, 1.0), clamp(3.0 * v - 2.0, 0.0, 1.0), 1.0);

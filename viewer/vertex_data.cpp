@@ -26,6 +26,9 @@ LowVertices build_low_vertices(const nmbake::Mesh& mesh, const nmbake::TangentFr
     corner[c].normal = frames.normal[c];
     corner[c].tangent = frames.tangent[c];
     corner[c].uv = mesh.uvs[mesh.uv_index[c]];
+    const double at_corner[3] = {c % 3 == 0 ? 1.0 : 0.0, c % 3 == 1 ? 1.0 : 0.0, c % 3 == 2 ? 1.0 : 0.0};
+    corner[c].bitangent =
+        glm::vec3(nmbake::interpolate_frame(frames, c / 3, at_corner, nmbake::BitangentMode::per_vertex).b);
   }
 
   // Merge corners with identical bytes: sort an index permutation, then number the runs.

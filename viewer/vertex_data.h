@@ -37,14 +37,17 @@ struct Bounds {
 // Bounds of the positions the triangles use.
 Bounds mesh_bounds(const nmbake::Mesh& mesh);
 
-// Low-poly corner: exactly the baker's per-corner frame (normal, tangent xyz + sign in w).
+// Low-poly corner: exactly the baker's per-corner frame (normal, tangent xyz + sign in w, and the
+// per-vertex bitangent).
 struct LowVertex {
   glm::vec3 position;  // object space minus the scene centre
   glm::vec3 normal;    // frames.normal of the corner, unit length
   glm::vec4 tangent;   // frames.tangent of the corner: xyz unit, w = +1 or -1
   glm::vec2 uv;        // OBJ convention, v = 1 at the top of the image
+  glm::vec3 bitangent; // the corner's B of BitangentMode::per_vertex (nmbake::interpolate_frame at
+                       // the corner), interpolated when a map was baked that way
 };
-static_assert(sizeof(LowVertex) == 48, "LowVertex is uploaded as tightly packed floats");
+static_assert(sizeof(LowVertex) == 60, "LowVertex is uploaded as tightly packed floats");
 
 // High-poly vertex: position and its own normal.
 struct HighVertex {

@@ -92,4 +92,61 @@ void write_flat_map(const std::string& path, int width, int height) {
   nmbake::write_image(path, map);
 }
 
+namespace {
+
+// The cube's faces as corner quads, counter-clockwise seen from outside.
+constexpr int kCubeFaces[6][4][3] = {
+    {{1, -1, -1}, {1, 1, -1}, {1, 1, 1}, {1, -1, 1}},     {{-1, -1, 1}, {-1, 1, 1}, {-1, 1, -1}, {-1, -1, -1}},
+    {{-1, 1, -1}, {-1, 1, 1}, {1, 1, 1}, {1, 1, -1}},     {{-1, -1, 1}, {-1, -1, -1}, {1, -1, -1}, {1, -1, 1}},
+    {{-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}},     {{1, -1, -1}, {-1, -1, -1}, {-1, 1, -1}, {1, 1, -1}}};
+
+glm::dvec3 cube_corner(int face, int k) {
+  return {double(kCubeFaces[face][k][0]), double(kCubeFaces[face][k][1]), double(kCubeFaces[face][k][2])};
+}
+
+}  // namespace
+
+void write_smooth_cube(const std::string& path) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error("cannot write " + path);
+  int vertex = 0;
+  for (int f = 0; f < 6; ++f) {
+    const double u0 = (f % 3) / 3.0 + 0.01, v0 = (f / 3) / 2.0 + 0.01, su = 1.0 / 3.0 - 0.02, sv = 0.5 - 0.02;
+    const int square[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    for (int k = 0; k < 4; ++k) {
+      const glm::dvec3 p = cube_corner(f, k), n = glm::normalize(p);
+      out << "v " << p.x << " " << p.y << " " << p.z << "\nvn " << n.x << " " << n.y << " " << n.z << "\nvt "
+          << u0 + square[k][0] * su << " " << v0 + square[k][1] * sv << "\n";
+    }
+    auto c = [&](int k) { return std::to_string(vertex + k + 1) + "/" + std::to_string(vertex + k + 1) + "/" + std::to_string(vertex + k + 1); };
+    out << "f " << c(0) << " " << c(1) << " " << c(2) << "\nf " << c(0) << " " << c(2) << " " << c(3) << "\n";
+    vertex += 4;
+  }
+}
+
+void write_normal_detail_cube(const std::string& path, int cells) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error("cannot write " + path);
+  out.precision(9);
+  int base = 1;
+  for (int f = 0; f < 6; ++f) {
+    for (int j = 0; j <= cells; ++j)
+      for (int i = 0; i <= cells; ++i) {
+        const double s = double(i) / cells, t = double(j) / cells;
+        const glm::dvec3 p = (1 - s) * (1 - t) * cube_corner(f, 0) + s * (1 - t) * cube_corner(f, 1) +
+                             s * t * cube_corner(f, 2) + (1 - s) * t * cube_corner(f, 3);
+        const glm::dvec3 wave(std::sin(5 * p.y + 2 * p.z), std::sin(6 * p.z + p.x), std::sin(5 * p.x + 3 * p.y));
+        const glm::dvec3 n = glm::normalize(glm::normalize(p) + 0.3 * wave);
+        out << "v " << p.x << " " << p.y << " " << p.z << "\nvn " << n.x << " " << n.y << " " << n.z << "\n";
+      }
+    for (int j = 0; j < cells; ++j)
+      for (int i = 0; i < cells; ++i) {
+        const int a = base + j * (cells + 1) + i, b = a + 1, c = b + cells + 1, d = a + cells + 1;
+        out << "f " << a << "//" << a << " " << b << "//" << b << " " << c << "//" << c << "\n";
+        out << "f " << a << "//" << a << " " << c << "//" << c << " " << d << "//" << d << "\n";
+      }
+    base += (cells + 1) * (cells + 1);
+  }
+}
+
 }  // namespace nmview::test

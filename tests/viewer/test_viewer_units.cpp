@@ -6,6 +6,8 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
+#include "decoding.h"
+#include "errors.h"
 #include "font.h"
 #include "gl_context.h"
 #include "metrics.h"
@@ -113,14 +115,16 @@ Rgba8Image solid(int w, int h, std::uint8_t value, std::uint8_t alpha) {
 
 TEST(Metrics, IdenticalImagesHaveZeroError) {
   const Rgba8Image a = solid(4, 3, 100, 255);
-  const DifferenceStats s = compare_images(a, a);
-  EXPECT_EQ(s.object_pixels, 12u);
-  EXPECT_EQ(s.rmse(), 0.0);
-  EXPECT_TRUE(std::isinf(s.psnr()));
-  EXPECT_EQ(s.within2(), 1.0);
+  const DifferenceStats s = compare_images(a, a, 0);
+  EXPECT_EQ(s.object.pixels, 12u);
+  EXPECT_EQ(s.interior.pixels, 12u);
+  EXPECT_EQ(s.interior.rmse(), 0.0);
+  EXPECT_TRUE(std::isinf(s.interior.psnr()));
+  EXPECT_EQ(s.interior.within2(), 1.0);
+  EXPECT_EQ(s.silhouette_mismatch(), 0.0);
 }
 
-TEST(Metrics, OnlyObjectPixelsCount) {
+TEST(Metrics, UnionCountsObjectPixelsOnly) {
   Rgba8Image a = solid(2, 2, 0, 0), b = solid(2, 2, 0, 0);
   // Pixel 0 covered by a only (white vs black background), pixel 1 by both with a difference of
   // 2 in one channel, pixels 2 and 3 background in both (differences there are ignored).
@@ -128,22 +132,93 @@ TEST(Metrics, OnlyObjectPixelsCount) {
   a.pixels[4] = 10, a.pixels[7] = 255;
   b.pixels[4] = 12, b.pixels[7] = 255;
   a.pixels[8] = 200;
-  const DifferenceStats s = compare_images(a, b);
-  EXPECT_EQ(s.object_pixels, 2u);
-  EXPECT_EQ(s.within2_pixels, 1u);
+  const DifferenceStats s = compare_images(a, b, 0);
+  EXPECT_EQ(s.object.pixels, 2u);
+  EXPECT_EQ(s.object.within2_pixels, 1u);
   const double expected = std::sqrt((3.0 * 255 * 255 + 2.0 * 2) / (255.0 * 255) / 6.0);
-  EXPECT_NEAR(s.rmse(), expected, 1e-12);
-  EXPECT_NEAR(s.psnr(), 20.0 * std::log10(1.0 / expected), 1e-9);
+  EXPECT_NEAR(s.object.rmse(), expected, 1e-12);
+  EXPECT_NEAR(s.object.psnr(), 20.0 * std::log10(1.0 / expected), 1e-9);
+  // Without erosion the interior is pixel 1 alone; the mismatch is pixel 0 of the two.
+  EXPECT_EQ(s.interior.pixels, 1u);
+  EXPECT_NEAR(s.interior.rmse(), std::sqrt(4.0 / (255.0 * 255) / 3.0), 1e-12);
+  EXPECT_EQ(s.mismatch_pixels, 1u);
+  EXPECT_EQ(s.silhouette_mismatch(), 0.5);
+}
+
+TEST(Metrics, InteriorLeavesOutEdgesAndTheirNeighbours) {
+  // 7 x 5, both fully covered except a's column 0 (only a half-covered pixel at row 2, an
+  // anti-aliased edge) and b's column 6 (not covered). Interior with erosion 1: columns 2..4 of
+  // rows 1..3 (9 pixels): column 1 touches a's edge column, column 5 touches b's missing column,
+  // rows 0 and 4 touch the image border.
+  Rgba8Image a = solid(7, 5, 100, 255), b = solid(7, 5, 100, 255);
+  for (int y = 0; y < 5; ++y) {
+    a.pixels[4 * std::size_t(y * 7) + 3] = y == 2 ? 128 : 0;
+    b.pixels[4 * std::size_t(y * 7 + 6) + 3] = 0;
+  }
+  b.pixels[4 * std::size_t(2 * 7 + 3)] = 110;  // a difference of 10 inside the interior
+  b.pixels[4 * std::size_t(0 * 7 + 3)] = 200;  // and one outside it (row 0)
+  const DifferenceStats s = compare_images(a, b, 1);
+  EXPECT_EQ(s.interior.pixels, 9u);
+  EXPECT_EQ(s.interior.within2_pixels, 8u);
+  EXPECT_NEAR(s.interior.rmse(), std::sqrt(100.0 / (255.0 * 255) / 27.0), 1e-12);
+  // Union: every pixel is covered by one model at least; a-only column 6 (5 pixels) and b-only
+  // column 0 rows 0, 1, 3, 4 (4 pixels) mismatch.
+  EXPECT_EQ(s.object.pixels, 35u);
+  EXPECT_EQ(s.mismatch_pixels, 9u);
+  // Erosion 0 keeps every pixel fully covered by both: columns 1..5, 25 pixels.
+  EXPECT_EQ(compare_images(a, b, 0).interior.pixels, 25u);
 }
 
 TEST(Metrics, PooledStatsAddUp) {
   DifferenceStats a, b;
-  a.object_pixels = 10, a.within2_pixels = 5, a.sum_squared = 0.3;
-  b.object_pixels = 30, b.within2_pixels = 30, b.sum_squared = 0.0;
+  a.interior.pixels = 10, a.interior.within2_pixels = 5, a.interior.sum_squared = 0.3;
+  b.interior.pixels = 30, b.interior.within2_pixels = 30, b.interior.sum_squared = 0.0;
+  a.object.pixels = 20, a.mismatch_pixels = 4;
+  b.object.pixels = 60, b.mismatch_pixels = 0;
   a.add(b);
-  EXPECT_EQ(a.within2(), 35.0 / 40.0);
-  EXPECT_NEAR(a.rmse(), std::sqrt(0.3 / 120.0), 1e-12);
-  EXPECT_EQ(DifferenceStats{}.rmse(), 0.0);
+  EXPECT_EQ(a.interior.within2(), 35.0 / 40.0);
+  EXPECT_NEAR(a.interior.rmse(), std::sqrt(0.3 / 120.0), 1e-12);
+  EXPECT_EQ(a.silhouette_mismatch(), 4.0 / 80.0);
+  EXPECT_EQ(DifferenceStats{}.interior.rmse(), 0.0);
+  EXPECT_EQ(DifferenceStats{}.silhouette_mismatch(), 0.0);
+}
+
+TEST(Decoding, MetadataThenOverridesThenDefaults) {
+  std::string note;
+  MapDecoding d = resolve_decoding({}, {}, "m.png", &note);
+  EXPECT_FALSE(d.object_space);
+  EXPECT_FALSE(d.green_down);
+  EXPECT_EQ(d.bitangent, nmbake::BitangentMode::per_pixel);
+  EXPECT_EQ(note, "space tangent (default), green up (default), bitangent pixel (default)");
+
+  const std::map<std::string, std::string> baked = {
+      {"nmbake:space", "tangent"}, {"nmbake:green", "down"}, {"nmbake:bitangent", "vertex"}};
+  d = resolve_decoding(baked, {}, "m.png", &note);
+  EXPECT_TRUE(d.green_down);
+  EXPECT_EQ(d.bitangent, nmbake::BitangentMode::per_vertex);
+  EXPECT_EQ(note, "space tangent (metadata), green down (metadata), bitangent vertex (metadata)");
+
+  DecodingOverrides o;
+  o.green = "up";
+  d = resolve_decoding(baked, o, "m.png", &note);
+  EXPECT_FALSE(d.green_down);
+  EXPECT_EQ(d.bitangent, nmbake::BitangentMode::per_vertex);
+  EXPECT_EQ(note, "space tangent (metadata), green up (--green), bitangent vertex (metadata)");
+
+  d = resolve_decoding({{"nmbake:space", "object"}, {"nmbake:green", "up"}}, {}, "m.png", &note);
+  EXPECT_TRUE(d.object_space);
+  EXPECT_EQ(note, "space object (metadata)");
+}
+
+TEST(Decoding, UnknownValuesAreErrors) {
+  EXPECT_THROW(resolve_decoding({{"nmbake:green", "sideways"}}, {}, "m.png"), nmbake::InputError);
+  DecodingOverrides o;
+  o.space = "world";
+  EXPECT_THROW(resolve_decoding({}, o, "m.png"), nmbake::UsageError);
+  o = {};
+  o.space = "object";
+  o.green = "down";
+  EXPECT_THROW(resolve_decoding({}, o, "m.png"), nmbake::UsageError);
 }
 
 TEST(Font, EveryPrintedCharacterHasAGlyph) {
@@ -203,8 +278,10 @@ double lit(glm::dvec3 n, glm::dvec3 light) {
 }
 
 // The centre pixel of each pane for a 2 x 2 plane at z = 0 facing +Z seen from +Z, its map
-// constant = the encoding of tangent-space `t`; `mirror_v` flips the UVs' v (handedness -1).
-std::pair<double, double> render_plane(glm::dvec3 t, Light light, bool mirror_v, bool use_map = true) {
+// constant = the encoding of `t` (tangent space unless `decoding` says otherwise); `mirror_v` flips
+// the UVs' v (handedness -1).
+std::pair<double, double> render_plane(glm::dvec3 t, Light light, bool mirror_v, bool use_map = true,
+                                       const MapDecoding& decoding = {}) {
   nmbake::Mesh plane = nmbake::test::make_grid(4, 4);
   if (mirror_v)
     for (glm::vec2& uv : plane.uvs) uv.y = 1.0f - uv.y;
@@ -215,7 +292,7 @@ std::pair<double, double> render_plane(glm::dvec3 t, Light light, bool mirror_v,
 
   HeadlessContext context;
   Renderer renderer(build_low_vertices(plane, frames, glm::vec3(0.0f)), build_high_vertices(plane, glm::vec3(0.0f)),
-                    map, std::sqrt(2.0f));
+                    map, std::sqrt(2.0f), decoding);
   Toggles toggles;
   toggles.map = use_map;
   renderer.render_panes(64, 64, {0.0f, 0.0f, 1.0f}, light, toggles);
@@ -247,6 +324,20 @@ TEST(RenderKnownAnswer, MirroredUvsFlipTheBitangent) {
   // Red is unaffected by the mirror.
   const glm::dvec3 right(std::sin(glm::radians(60.0)), 0, 0.5);
   EXPECT_NEAR(render_plane({0.5, 0, 1}, {60.0f, 0.0f}, true).first, lit({0.5, 0, 1}, right), tol);
+}
+
+TEST(RenderKnownAnswer, GreenDownAndObjectSpaceMaps) {
+  const double tol = 1.5 / 255.0;
+  const glm::dvec3 up(0, std::sin(glm::radians(60.0)), 0.5);
+  MapDecoding green_down;
+  green_down.green_down = true;
+  // A DirectX map stores -green: (0, -0.5, 1) is the normal tilted towards +bitangent (+Y).
+  EXPECT_NEAR(render_plane({0, -0.5, 1}, {0.0f, 60.0f}, false, true, green_down).first, lit({0, 0.5, 1}, up), tol);
+  // An object-space map is the normal itself, whatever the tangent frame (here mirrored).
+  MapDecoding object;
+  object.object_space = true;
+  EXPECT_NEAR(render_plane({0, 0.5, 1}, {0.0f, 60.0f}, true, true, object).first, lit({0, 0.5, 1}, up), tol);
+  EXPECT_NEAR(render_plane({0, -0.5, 1}, {0.0f, 60.0f}, true, true, object).first, lit({0, -0.5, 1}, up), tol);
 }
 
 TEST(RenderKnownAnswer, MapOffShowsTheBareNormal) {
