@@ -10,9 +10,11 @@
 #include <fstream>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <thread>
 
+#include "cull.h"
 #include "memory_budget.h"
 #include "mesh_topology.h"
 #include "normals.h"
@@ -46,6 +48,12 @@ struct Prepared {
   std::vector<glm::vec3> low_pos, cage_pos, high_pos;
   std::vector<glm::vec3> ray_normal;  // per low-poly position: mean of its corners' normals
   std::vector<glm::vec3> high_corner_normals;  // 3 per high-poly triangle: one cache line per hit
+  // The triangles in the BVH, in its order: vertex indices and corner normals, 3 per triangle.
+  // They point into the mesh and high_corner_normals, or, after culling, into the kept_ copies.
+  const std::uint32_t* bvh_index = nullptr;
+  const glm::vec3* bvh_normals = nullptr;
+  std::vector<std::uint32_t> kept_index;
+  std::vector<glm::vec3> kept_normals;
   TangentFrames frames;
 };
 
@@ -230,12 +238,6 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     }
   st.seconds_prepare = seconds_since(t0);
 
-  // BVH over the high-poly.
-  t0 = Clock::now();
-  raycast::Scene scene(&s.high_pos[0].x, s.high_pos.size(), high.position_index.data(), high.triangle_count(),
-                       raycast::BuildQuality::medium, opt.threads);
-  st.seconds_bvh = seconds_since(t0);
-
   std::vector<LowTriangle> low_tris(low.triangle_count());
   for (std::size_t t = 0; t < low.triangle_count(); ++t)
     for (int c = 0; c < 3; ++c) {
@@ -260,13 +262,70 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     return fl > 0.0 ? f / fl : glm::dvec3(0, 0, 1);
   };
 
+  // BVH over the high-poly triangles some ray can reach (all of them without culling). Each ray
+  // stays within `margin` of its low-poly triangle's box (grown over the cage triangle): front
+  // and rear when given, else the distance probe's reach, and after the probe the distances it
+  // chose (the BVH is rebuilt then only if that leaves out a fifth of it or more).
+  const bool auto_distances = !cage && (opt.front < 0.0f || opt.rear < 0.0f);
+  const double reach = 0.1 * s.diagonal;  // the probe's: farther than this is another part of the model
+  std::vector<Box> regions;
+  auto ray_margin = [&](double front, double rear) {
+    // Rays are cast in float: a little slack keeps the test conservative.
+    return 1.01 * (cage ? rear : std::max(front, rear)) + 1e-6 * s.diagonal;
+  };
+  std::vector<std::uint32_t> kept;  // triangles in the BVH, increasing; empty with all of them in
+  std::optional<raycast::Scene> scene;
+  auto build_scene = [&] {
+    // The trace reads per-triangle arrays in BVH order, so a hit's triangle index needs no mapping.
+    s.bvh_index = high.position_index.data();
+    s.bvh_normals = s.high_corner_normals.data();
+    if (!kept.empty()) {
+      std::vector<std::uint32_t> index(3 * kept.size());
+      std::vector<glm::vec3> normals(3 * kept.size());
+      for (std::size_t i = 0; i < kept.size(); ++i)
+        for (int c = 0; c < 3; ++c) {
+          index[3 * i + c] = high.position_index[3 * std::size_t(kept[i]) + c];
+          normals[3 * i + c] = s.high_corner_normals[3 * std::size_t(kept[i]) + c];
+        }
+      s.kept_index = std::move(index);
+      s.kept_normals = std::move(normals);
+      s.bvh_index = s.kept_index.data();
+      s.bvh_normals = s.kept_normals.data();
+    }
+    scene.reset();
+    scene.emplace(&s.high_pos[0].x, s.high_pos.size(), s.bvh_index, kept.empty() ? high.triangle_count() : kept.size(),
+                  raycast::BuildQuality::medium, opt.threads);
+    st.high_triangles_culled = kept.empty() ? 0 : high.triangle_count() - kept.size();
+  };
+  t0 = Clock::now();
+  if (opt.cull_far) {
+    regions.resize(low.triangle_count());
+    for (std::size_t t = 0; t < low.triangle_count(); ++t) {
+      Box b{low_tris[t].p[0], low_tris[t].p[0]};
+      for (int c = 0; c < 3; ++c) {
+        b.lo = glm::min(b.lo, low_tris[t].p[c]);
+        b.hi = glm::max(b.hi, low_tris[t].p[c]);
+        if (cage) {
+          const glm::dvec3 q(s.cage_pos[cage->position_index[3 * t + c]]);
+          b.lo = glm::min(b.lo, q);
+          b.hi = glm::max(b.hi, q);
+        }
+      }
+      regions[t] = b;
+    }
+    const double margin = auto_distances ? reach * 1.01 + 1e-6 * s.diagonal : ray_margin(opt.front, opt.rear);
+    kept = triangles_near(regions, margin, s.high_pos, high.position_index);
+    if (kept.size() == high.triangle_count()) kept.clear();
+  }
+  build_scene();
+  st.seconds_bvh = seconds_since(t0);
+
   // Ray distances: given, or measured by probing along the ray normals from points on the low-poly.
   t0 = Clock::now();
   st.front = opt.front;
   st.rear = opt.rear;
-  if (!cage && (opt.front < 0.0f || opt.rear < 0.0f)) {
+  if (auto_distances) {
     st.auto_distances = true;
-    const double reach = 0.1 * s.diagonal;  // farther than this is another part of the model
     const std::size_t tris = low.triangle_count();
     const std::size_t stride = std::max<std::size_t>(1, tris / 50000);
     static const double probe_bary[4][3] = {{1 / 3.0, 1 / 3.0, 1 / 3.0}, {4 / 6.0, 1 / 6.0, 1 / 6.0},
@@ -284,7 +343,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     run_parallel(threads, [&](int) {
       for (std::size_t i; (i = next.fetch_add(4096)) < pairs;) {
         const std::size_t n = std::min<std::size_t>(4096, pairs - i);
-        scene.intersect(&rays[2 * i], &hits[2 * i], 2 * n);
+        scene->intersect(&rays[2 * i], &hits[2 * i], 2 * n);
       }
     });
     std::vector<float> outside, inside;
@@ -312,6 +371,22 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     if (st.rear < 0.0f) st.rear = float(1e-4 * s.diagonal);
   }
   st.seconds_distances = seconds_since(t0);
+  if (opt.cull_far && auto_distances) {
+    t0 = Clock::now();
+    std::vector<std::uint32_t> all;
+    if (kept.empty()) {
+      all.resize(high.triangle_count());
+      for (std::size_t t = 0; t < all.size(); ++t) all[t] = std::uint32_t(t);
+    }
+    const std::vector<std::uint32_t>& current = kept.empty() ? all : kept;
+    std::vector<std::uint32_t> nearer =
+        triangles_near(regions, ray_margin(st.front, st.rear), s.high_pos, high.position_index, &current);
+    if (double(nearer.size()) < 0.8 * double(current.size())) {
+      kept = std::move(nearer);
+      build_scene();
+    }
+    st.seconds_bvh += seconds_since(t0);
+  }
 
   // Trace: tiles of texels, each rasterized against the triangles binned to it, rays in packets.
   t0 = Clock::now();
@@ -371,11 +446,11 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     const std::size_t ht = h.triangle;
     const double w[3] = {1.0 - double(h.u) - double(h.v), double(h.u), double(h.v)};
     glm::dvec3 nh(0.0);
-    for (int c = 0; c < 3; ++c) nh += w[c] * glm::dvec3(s.high_corner_normals[3 * ht + c]);
+    for (int c = 0; c < 3; ++c) nh += w[c] * glm::dvec3(s.bvh_normals[3 * ht + c]);
     double len = glm::length(nh);
     if (!(len > 1e-12)) {
-      const glm::dvec3 q0(s.high_pos[high.position_index[3 * ht]]), q1(s.high_pos[high.position_index[3 * ht + 1]]),
-          q2(s.high_pos[high.position_index[3 * ht + 2]]);
+      const glm::dvec3 q0(s.high_pos[s.bvh_index[3 * ht]]), q1(s.high_pos[s.bvh_index[3 * ht + 1]]),
+          q2(s.high_pos[s.bvh_index[3 * ht + 2]]);
       nh = glm::cross(q1 - q0, q2 - q0);
       len = glm::length(nh);
     }
@@ -466,7 +541,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
         }
         slot_of_ray[sample_count++] = si;
       }
-      if (ray_count) scene.intersect(rays.data(), hits.data(), ray_count);
+      if (ray_count) scene->intersect(rays.data(), hits.data(), ray_count);
       if (opt.record_rays) {
         std::lock_guard<std::mutex> lock(record_mutex);
         opt.record_rays->insert(opt.record_rays->end(), rays.begin(), rays.begin() + std::ptrdiff_t(ray_count));
@@ -476,7 +551,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
       // shading needs the first, so the cache misses overlap.
       for (std::size_t r = 0; r < ray_count; ++r)
         if (hits[r].hit()) {
-          const char* line = reinterpret_cast<const char*>(&s.high_corner_normals[3 * std::size_t(hits[r].triangle)]);
+          const char* line = reinterpret_cast<const char*>(&s.bvh_normals[3 * std::size_t(hits[r].triangle)]);
           __builtin_prefetch(line);
           __builtin_prefetch(line + sizeof(glm::vec3) * 3 - 1);
         }
@@ -521,7 +596,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
         }
       }
       if (batch_count)
-        encode_hits_per_pixel(low_tris.data(), s.high_corner_normals.data(), batch.data(), batch_count,
+        encode_hits_per_pixel(low_tris.data(), s.bvh_normals, batch.data(), batch_count,
                               batch_value.data(), batch_degenerate.data());
       for (std::size_t r = 0; r < sample_count; ++r) {
         const std::uint32_t si = slot_of_ray[r];

@@ -46,6 +46,9 @@ struct BakeOptions {
   int padding = 16;     // texels of edge padding around islands; 0 = none
   int threads = 0;      // worker threads; 0 = all cores
   bool miss_mask = false;  // fill BakeResult::miss_mask (share of missed samples per texel)
+  // Leave high-poly triangles out of the BVH when they lie farther from the low-poly (and cage)
+  // than any ray reaches (cull.h). The map is the same either way; off only for comparison.
+  bool cull_far = true;
   // Bytes the bake's buffers may take (estimate_bake_bytes); 0 = what the machine has
   // (memory_budget_bytes: MemAvailable, cgroup limit, ulimit -v). Larger bakes are refused.
   std::uint64_t memory_limit = 0;
@@ -71,6 +74,7 @@ struct BakeStats {
   // outside the low-poly), over all hits.
   double hit_distance_min = 0.0, hit_distance_mean = 0.0, hit_distance_max = 0.0;
   std::size_t low_triangles = 0, high_triangles = 0;
+  std::size_t high_triangles_culled = 0;  // left out of the BVH: out of every ray's reach
   std::size_t degenerate_uv_triangles = 0, degenerate_3d_triangles = 0, corners_without_tangent = 0;
   std::size_t uv_outside_triangles = 0;  // low-poly triangles with a UV outside [0,1]
   std::size_t uv_outside_entirely_triangles = 0;  // of those, UV bounding box outside [0,1]^2: not baked

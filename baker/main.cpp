@@ -49,6 +49,7 @@ struct Args {
   int padding = 16;
   int threads = 0;
   bool quiet = false;
+  bool no_cull = false;
 };
 
 void parse_size(const std::string& text, int& w, int& h) {
@@ -133,6 +134,8 @@ int run(int argc, char** argv) {
   app.add_option("--miss-mask", a.miss_mask, "Write an image of the share of missed rays per texel");
   app.add_option("--report", a.report, "Write a JSON report of options, timings and counts");
   app.add_option("--threads", a.threads, "Worker threads (default: all cores)");
+  app.add_flag("--no-cull", a.no_cull,
+               "Keep high-poly triangles out of every ray's reach in the BVH (default: left out; same map)");
   app.add_flag("--quiet", a.quiet, "No progress bar and no summary line");
   app.set_version_flag("--version", std::string("nmbake ") + NMBAKE_VERSION);
 
@@ -170,6 +173,7 @@ int run(int argc, char** argv) {
   o.padding = a.padding;
   o.threads = a.threads;
   o.miss_mask = !a.miss_mask.empty();
+  o.cull_far = !a.no_cull;
   const int bits = a.bits ? a.bits : default_bits_for(a.output);
   check_output_path(a.output, "the map");
   if (!a.miss_mask.empty()) check_output_path(a.miss_mask, "the miss mask");

@@ -42,6 +42,7 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
       {"bits", r.bits},
       {"padding", o.padding},
       {"threads", r.threads_used},
+      {"cull", o.cull_far},
   };
   auto mesh_json = [](const MeshLoadInfo& info, std::size_t triangles) {
     return json{{"format", info.format},
@@ -96,6 +97,7 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
   high["boundary_edges"] = t.boundary_edges;
   high["non_manifold_edges"] = t.non_manifold_edges;
   high["inconsistent_winding_faces"] = t.inconsistent_winding_faces;
+  high["triangles_culled"] = s.high_triangles_culled;
   return report;
 }
 

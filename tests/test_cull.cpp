@@ -1,0 +1,114 @@
+// Far-geometry culling (cull.h): the test is conservative, and a bake with it gives the same map as
+// one without, bit for bit, while leaving the unreachable triangles out of the BVH.
+#include <gtest/gtest.h>
+
+#include "bake.h"
+#include "cull.h"
+#include "test_support.h"
+
+using namespace nmbake;
+
+namespace {
+
+// One triangle per row of `corners`: index triples 0..3n-1.
+std::vector<std::uint32_t> iota_indices(std::size_t n) {
+  std::vector<std::uint32_t> idx(n);
+  for (std::size_t i = 0; i < n; ++i) idx[i] = std::uint32_t(i);
+  return idx;
+}
+
+// `a` with the triangles of `mesh` moved by `offset` appended (positions, normals, UVs).
+Mesh joined(const Mesh& a, const Mesh& mesh, const glm::vec3& offset) {
+  Mesh m = a;
+  const auto np = std::uint32_t(a.positions.size()), nn = std::uint32_t(a.normals.size()),
+             nt = std::uint32_t(a.uvs.size());
+  for (const glm::vec3& p : mesh.positions) m.positions.push_back(p + offset);
+  m.normals.insert(m.normals.end(), mesh.normals.begin(), mesh.normals.end());
+  m.uvs.insert(m.uvs.end(), mesh.uvs.begin(), mesh.uvs.end());
+  for (std::uint32_t i : mesh.position_index) m.position_index.push_back(i + np);
+  for (std::uint32_t i : mesh.normal_index) m.normal_index.push_back(i + nn);
+  for (std::uint32_t i : mesh.uv_index) m.uv_index.push_back(i + nt);
+  m.source_face.clear();
+  return m;
+}
+
+BakeResult bake(const Mesh& low, const Mesh& high, const Mesh* cage, BakeOptions o, bool cull) {
+  o.cull_far = cull;
+  return bake_normal_map(low, high, cage, o);
+}
+
+}  // namespace
+
+TEST(Cull, KeepsExactlyWhatTheMarginReaches) {
+  const std::vector<Box> regions = {{glm::dvec3(0.0), glm::dvec3(1.0)}};
+  // Triangle 0 inside the box, 1 at 0.5 beyond its +x face, 2 far away.
+  const std::vector<glm::vec3> pos = {{0.2f, 0.2f, 0.2f}, {0.8f, 0.2f, 0.2f}, {0.2f, 0.8f, 0.2f},
+                                      {1.5f, 0.2f, 0.2f}, {1.6f, 0.2f, 0.2f}, {1.5f, 0.8f, 0.2f},
+                                      {50.f, 50.f, 50.f}, {51.f, 50.f, 50.f}, {50.f, 51.f, 50.f}};
+  const auto idx = iota_indices(pos.size());
+  EXPECT_EQ(triangles_near(regions, 0.6, pos, idx), (std::vector<std::uint32_t>{0, 1}));
+  EXPECT_EQ(triangles_near(regions, 0.4, pos, idx), (std::vector<std::uint32_t>{0}));
+  EXPECT_EQ(triangles_near(regions, 100.0, pos, idx), (std::vector<std::uint32_t>{0, 1, 2}));
+  const std::vector<std::uint32_t> only_far = {2};
+  EXPECT_TRUE(triangles_near(regions, 0.6, pos, idx, &only_far).empty());
+}
+
+TEST(Cull, ATriangleTouchingARegionIsKept) {
+  // Many small regions along a line; a triangle crossing between two of them, touching one.
+  std::vector<Box> regions;
+  for (int i = 0; i < 100; ++i) regions.push_back({glm::dvec3(i, 0, 0), glm::dvec3(i + 0.5, 0.5, 0.5)});
+  // (Values exact in float and double: the box test compares them exactly.)
+  const std::vector<glm::vec3> pos = {{10.5f, 0.625f, 0.125f}, {10.75f, 0.625f, 0.125f}, {10.625f, 0.875f, 0.125f}};
+  EXPECT_EQ(triangles_near(regions, 0.125, pos, iota_indices(3)).size(), 1u);
+  EXPECT_TRUE(triangles_near(regions, 0.0625, pos, iota_indices(3)).empty());
+}
+
+TEST(Cull, FarCopyIsLeftOutAndTheMapIsUnchanged) {
+  const Mesh low = test::make_torus(24, 12);
+  const Mesh near_high = test::make_torus(96, 48, 1.0f, 0.37f);
+  const Mesh high = joined(near_high, near_high, glm::vec3(20.0f, 0.0f, 0.0f));
+  BakeOptions o;
+  o.width = o.height = 96;
+  o.samples = 2;
+  o.padding = 4;
+  for (const bool given : {true, false}) {
+    o.front = o.rear = given ? 0.1f : -1.0f;
+    const BakeResult on = bake(low, high, nullptr, o, true), off = bake(low, high, nullptr, o, false);
+    EXPECT_EQ(on.stats.high_triangles_culled, near_high.triangle_count()) << "given distances: " << given;
+    EXPECT_EQ(off.stats.high_triangles_culled, 0u);
+    EXPECT_EQ(on.stats.front, off.stats.front);
+    EXPECT_TRUE(on.map.pixels == off.map.pixels) << "given distances: " << given;
+    EXPECT_EQ(on.stats.hits, off.stats.hits);
+  }
+  // The closest-hit policy reaches outward too: still the same map.
+  o.policy = RayPolicy::closest;
+  o.front = o.rear = 0.1f;
+  EXPECT_TRUE(bake(low, high, nullptr, o, true).map.pixels == bake(low, high, nullptr, o, false).map.pixels);
+}
+
+TEST(Cull, GeometryWithinReachStaysIn) {
+  // A second layer 0.05 outside the first, inside a front distance of 0.1: nothing culled.
+  const Mesh low = test::make_torus(24, 12);
+  const Mesh high = joined(test::make_torus(48, 24, 1.0f, 0.37f), test::make_torus(48, 24, 1.0f, 0.40f), glm::vec3(0.0f));
+  BakeOptions o;
+  o.width = o.height = 64;
+  o.front = o.rear = 0.1f;
+  const BakeResult on = bake(low, high, nullptr, o, true), off = bake(low, high, nullptr, o, false);
+  EXPECT_EQ(on.stats.high_triangles_culled, 0u);
+  EXPECT_TRUE(on.map.pixels == off.map.pixels);
+}
+
+TEST(Cull, CageReachIsRespected) {
+  // A cage 0.2 outside the low-poly: rays start on it, so geometry between them must stay in.
+  const Mesh low = test::make_torus(24, 12);
+  const Mesh cage = test::make_torus(24, 12, 1.0f, 0.55f);
+  const Mesh near_high = test::make_torus(96, 48, 1.0f, 0.45f);
+  const Mesh high = joined(near_high, near_high, glm::vec3(0.0f, 30.0f, 0.0f));
+  BakeOptions o;
+  o.width = o.height = 96;
+  o.rear = 0.05f;
+  const BakeResult on = bake(low, high, &cage, o, true), off = bake(low, high, &cage, o, false);
+  EXPECT_EQ(on.stats.high_triangles_culled, high.triangle_count() / 2);
+  EXPECT_GT(on.stats.hits, on.stats.samples_covered * 9 / 10);
+  EXPECT_TRUE(on.map.pixels == off.map.pixels);
+}
