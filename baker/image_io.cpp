@@ -26,31 +26,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Formats we write, and the bit depths each can hold (32 = float, EXR 16 = half).
-struct FormatInfo {
-  const char* extension;
-  bool bits8, bits16, bits32;
-};
-constexpr FormatInfo kFormats[] = {
-    {".png", true, true, false},
-    {".tif", true, true, true},
-    {".tiff", true, true, true},
-    {".exr", false, true, true},
-};
-
-std::string lower_extension(const std::string& path) {
-  std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
-
-const FormatInfo* find_format(const std::string& ext) {
-  for (const FormatInfo& f : kFormats)
-    if (ext == f.extension) return &f;
-  return nullptr;
-}
-
 // OpenImageIO messages may span lines; our errors are printed as one line.
 std::string one_line(std::string s) {
   for (char& c : s)
@@ -88,31 +63,6 @@ std::string temp_path_for(const fs::path& target) {
 
 }  // namespace
 
-int default_bits_for(const std::string& path) {
-  const std::string ext = lower_extension(path);
-  if (ext == ".tif" || ext == ".tiff") return 16;
-  if (ext == ".exr") return 32;
-  return 8;
-}
-
-void check_output_format(const std::string& path, int bits) {
-  const std::string ext = lower_extension(path);
-  const FormatInfo* f = find_format(ext);
-  if (!f)
-    throw UsageError(path + ": unsupported image format '" + ext +
-                     "' (use .png, .tif, .tiff or .exr)");
-  if (bits == 0) return;
-  bool ok = (bits == 8 && f->bits8) || (bits == 16 && f->bits16) || (bits == 32 && f->bits32);
-  if (!ok) {
-    std::string can;
-    if (f->bits8) can += "8";
-    if (f->bits16) can += std::string(can.empty() ? "" : ", ") + "16";
-    if (f->bits32) can += std::string(can.empty() ? "" : ", ") + "32";
-    throw UsageError(path + ": " + ext + " cannot hold " + std::to_string(bits) +
-                     "-bit values (supported: " + can + ")");
-  }
-}
-
 void write_image(const std::string& path, const Image& image, const WriteOptions& options) {
   const int bits = options.bits ? options.bits : default_bits_for(path);
   check_output_format(path, bits);
@@ -131,7 +81,7 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
 
   // Pixels in the stored type: integer formats are quantized here, float goes through as is
   // (OpenImageIO converts float to half for EXR 16).
-  const std::string ext = lower_extension(path);
+  const std::string ext = image_io_detail::lower_extension(path);
   OIIO::TypeDesc stored = OIIO::TypeDesc::FLOAT;
   OIIO::TypeDesc given = OIIO::TypeDesc::FLOAT;
   std::vector<std::uint8_t> data8;
@@ -272,5 +222,7 @@ std::map<std::string, std::string> read_image_metadata(const std::string& path) 
   in->close();
   return metadata;
 }
+
+void preload_image_io() {}  // linked directly: nothing to load
 
 }  // namespace nmbake

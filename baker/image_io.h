@@ -1,4 +1,9 @@
 // Reading and writing images through OpenImageIO: the only code that includes OpenImageIO.
+//
+// Two builds of the same interface: image_io.cpp links OpenImageIO directly (the library nmbake::io
+// that nmdiff, nmview and the tests use); the nmbake command instead loads it as a module on a
+// background thread (image_io_loader.cpp), because loading OpenImageIO and its ~260 libraries takes
+// a sizeable part of a quick bake.
 #pragma once
 
 #include <map>
@@ -36,5 +41,13 @@ Image read_image(const std::string& path);
 // where TIFF keeps them. Reads the header only. Throws InputError naming the file when it cannot
 // be opened.
 std::map<std::string, std::string> read_image_metadata(const std::string& path);
+
+// Starts loading the image library in the background where it is a module (the nmbake command);
+// does nothing where it is linked. Optional: the functions above load it when first called.
+void preload_image_io();
+
+namespace image_io_detail {
+std::string lower_extension(const std::string& path);  // ".png" for "A/b.PNG"
+}
 
 }  // namespace nmbake

@@ -256,6 +256,7 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  preload_image_io();  // OpenImageIO loads on its own thread while the command line and meshes are read
   try {
     return run(argc, argv);
   } catch (const nmbake::Cancelled&) {
