@@ -565,4 +565,171 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   return result;
 }
 
+// ---- Re-baking chosen texels (for the error estimate, error_estimate.h) ----
+// A copy of the trace loop's ray and shading rules for a list of texels, so that the bake's own
+// loop stays untouched; tests/test_error_estimate.cpp checks that both agree texel for texel.
+std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt,
+                                          const BakeStats& st, const std::vector<std::uint32_t>& texels, int samples) {
+  std::vector<glm::dvec3> out(texels.size(), glm::dvec3(0.0));
+  if (texels.empty() || low.triangle_count() == 0 || high.triangle_count() == 0 || !low.has_uvs()) return out;
+  const int threads = opt.threads > 0 ? opt.threads : std::max(1, int(std::thread::hardware_concurrency()));
+  const int W = opt.width, H = opt.height;
+  const TangentFrames frames = compute_tangent_frames(low);
+  const std::vector<glm::vec3> low_pos = recentre(low.positions, st.centre);
+  const std::vector<glm::vec3> high_pos = recentre(high.positions, st.centre);
+  const std::vector<glm::vec3> cage_pos = cage ? recentre(cage->positions, st.centre) : std::vector<glm::vec3>();
+  const std::vector<glm::vec3> ray_normal = position_averaged_normals(low, frames);
+  std::vector<glm::vec3> high_corner_normals;
+  {
+    const std::vector<glm::vec3> computed = high.has_normals() ? std::vector<glm::vec3>() : compute_vertex_normals(high);
+    const std::vector<glm::vec3>& normals = high.has_normals() ? high.normals : computed;
+    const std::vector<std::uint32_t>& index = high.has_normals() ? high.normal_index : high.position_index;
+    high_corner_normals.resize(index.size());
+    for (std::size_t c = 0; c < index.size(); ++c) high_corner_normals[c] = normals[index[c]];
+  }
+  double diagonal = 0.0;
+  {
+    glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+    grow_box(lo, hi, low.positions);
+    grow_box(lo, hi, high.positions);
+    if (cage) grow_box(lo, hi, cage->positions);
+    diagonal = glm::length(hi - lo);
+    if (!(diagonal > 0.0)) diagonal = 1.0;
+  }
+  // Few rays: a quick BVH build pays off more than a fast one to trace.
+  raycast::Scene scene(&high_pos[0].x, high_pos.size(), high.position_index.data(), high.triangle_count(),
+                       raycast::BuildQuality::low, opt.threads);
+
+  // Low-poly triangles binned to the tiles that hold a requested texel.
+  const int tiles_x = (W + kTile - 1) / kTile, tiles_y = (H + kTile - 1) / kTile;
+  std::vector<std::int32_t> tile_slot(std::size_t(tiles_x) * tiles_y, -1);
+  std::int32_t used_tiles = 0;
+  for (std::uint32_t t : texels) {
+    const std::size_t tile = std::size_t((t / W) / kTile) * tiles_x + (t % W) / kTile;
+    if (tile_slot[tile] < 0) tile_slot[tile] = used_tiles++;
+  }
+  std::vector<TexelTriangle> texel_tris(low.triangle_count());
+  std::vector<std::vector<std::uint32_t>> bins(static_cast<std::size_t>(used_tiles));
+  for (std::size_t t = 0; t < low.triangle_count(); ++t) {
+    texel_tris[t] = setup_texel_triangle(low.corner_uv(t, 0), low.corner_uv(t, 1), low.corner_uv(t, 2), W, H);
+    const TexelTriangle& tt = texel_tris[t];
+    if (!tt.valid() || tt.xmax < tt.xmin || tt.ymax < tt.ymin) continue;
+    for (int ty = tt.ymin / kTile; ty <= tt.ymax / kTile; ++ty)
+      for (int tx = tt.xmin / kTile; tx <= tt.xmax / kTile; ++tx) {
+        const std::int32_t slot = tile_slot[std::size_t(ty) * tiles_x + tx];
+        if (slot >= 0) bins[std::size_t(slot)].push_back(std::uint32_t(t));  // ascending: the lowest index wins
+      }
+  }
+
+  const std::vector<glm::dvec2> offsets = sample_offsets(samples);
+  const bool closest = opt.policy == RayPolicy::closest && !cage;
+  std::vector<std::uint8_t> covered(texels.size(), 0);  // each entry written by one thread only
+  std::atomic<std::size_t> next{0};
+  run_parallel(threads, [&](int) {
+    struct Sample {
+      std::size_t texel;  // index into `texels`
+      std::uint32_t tri;
+      double b[3];
+    };
+    std::vector<Sample> work;
+    std::vector<raycast::Ray> rays;
+    std::vector<raycast::Hit> hits;
+    constexpr std::size_t kChunk = 64;
+    for (std::size_t i0; (i0 = next.fetch_add(kChunk)) < texels.size();) {
+      const std::size_t i1 = std::min(texels.size(), i0 + kChunk);
+      work.clear();
+      rays.clear();
+      for (std::size_t i = i0; i < i1; ++i) {
+        const int x = int(texels[i] % W), y = int(texels[i] / W);
+        const auto& bin = bins[std::size_t(tile_slot[std::size_t(y / kTile) * tiles_x + x / kTile])];
+        for (const glm::dvec2& o : offsets)
+          for (std::uint32_t t : bin) {
+            Sample sm{i, t, {0, 0, 0}};
+            if (!covers(texel_tris[t], sample_point(x, y, o.x, o.y), sm.b)) continue;
+            work.push_back(sm);
+            break;
+          }
+      }
+      for (const Sample& sm : work) {
+        glm::dvec3 p(0.0), n(0.0);
+        for (int c = 0; c < 3; ++c) {
+          const std::uint32_t pi = low.position_index[3 * sm.tri + c];
+          p += sm.b[c] * glm::dvec3(low_pos[pi]);
+          n += sm.b[c] * glm::dvec3(ray_normal[pi]);
+        }
+        if (glm::dot(n, n) > 1e-24) {
+          n /= std::sqrt(glm::dot(n, n));
+        } else {
+          const glm::dvec3 p0(low_pos[low.position_index[3 * sm.tri]]), p1(low_pos[low.position_index[3 * sm.tri + 1]]),
+              p2(low_pos[low.position_index[3 * sm.tri + 2]]);
+          const glm::dvec3 f = glm::cross(p1 - p0, p2 - p0);
+          n = glm::length(f) > 0.0 ? f / glm::length(f) : glm::dvec3(0, 0, 1);
+        }
+        if (cage) {
+          glm::dvec3 pc(0.0);
+          for (int c = 0; c < 3; ++c) pc += sm.b[c] * glm::dvec3(cage_pos[low.position_index[3 * sm.tri + c]]);
+          glm::dvec3 d = p - pc;
+          double len = glm::length(d);
+          if (!(len > 1e-9 * diagonal)) {
+            d = -n;
+            len = 0.0;
+            pc = p;
+          } else {
+            d /= len;
+          }
+          rays.push_back({glm::vec3(pc), 0.0f, glm::vec3(d), float(len + st.rear)});
+        } else if (closest) {
+          rays.push_back({glm::vec3(p), 0.0f, glm::vec3(n), st.front});
+          rays.push_back({glm::vec3(p), 0.0f, glm::vec3(-n), st.rear});
+        } else {
+          rays.push_back({glm::vec3(p + double(st.front) * n), 0.0f, glm::vec3(-n), st.front + st.rear});
+        }
+      }
+      hits.resize(rays.size());
+      if (!rays.empty()) scene.intersect(rays.data(), hits.data(), rays.size());
+      for (std::size_t r = 0; r < work.size(); ++r) {
+        const Sample& sm = work[r];
+        const raycast::Hit* h = &hits[closest ? 2 * r : r];
+        if (closest && !(h->hit() && (!hits[2 * r + 1].hit() || h->t <= hits[2 * r + 1].t))) h = &hits[2 * r + 1];
+        glm::vec3 cn[3];
+        glm::vec4 ct[3];
+        for (int c = 0; c < 3; ++c) {
+          cn[c] = frames.normal[3 * sm.tri + c];
+          ct[c] = frames.tangent[3 * sm.tri + c];
+        }
+        const PixelFrame frame = interpolate_frame(cn, ct, sm.b, opt.bitangent);
+        glm::dvec3 value;
+        if (h->hit()) {
+          const std::size_t ht = h->triangle;
+          const double w[3] = {1.0 - double(h->u) - double(h->v), double(h->u), double(h->v)};
+          glm::dvec3 nh(0.0);
+          for (int c = 0; c < 3; ++c) nh += w[c] * glm::dvec3(high_corner_normals[3 * ht + c]);
+          double len = glm::length(nh);
+          if (!(len > 1e-12)) {
+            const glm::dvec3 q0(high_pos[high.position_index[3 * ht]]), q1(high_pos[high.position_index[3 * ht + 1]]),
+                q2(high_pos[high.position_index[3 * ht + 2]]);
+            nh = glm::cross(q1 - q0, q2 - q0);
+            len = glm::length(nh);
+          }
+          nh = len > 0.0 ? nh / len : glm::normalize(frame.n);
+          value = opt.space == NormalSpace::tangent ? encode_tangent_normal(frame, nh) : nh;
+        } else {
+          const double nl = glm::length(frame.n);
+          value = opt.space == NormalSpace::tangent ? glm::dvec3(0, 0, 1) : (nl > 0 ? frame.n / nl : glm::dvec3(0, 0, 1));
+        }
+        out[sm.texel] += value;
+        covered[sm.texel] = 1;
+      }
+      for (std::size_t i = i0; i < i1; ++i) {
+        if (!covered[i]) continue;
+        const double len = glm::length(out[i]);
+        out[i] = len > 0.0 ? out[i] / len : glm::dvec3(0, 0, 1);
+        if (opt.space == NormalSpace::tangent && opt.green_down) out[i].y = -out[i].y;
+      }
+    }
+  });
+  return out;
+}
+// ---- end of re-baking chosen texels ----
+
 }  // namespace nmbake
