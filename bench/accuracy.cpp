@@ -486,7 +486,10 @@ std::string quote(const std::string& s) {
 
 // RMSE from the last "psnr=... rmse=... within2=..." line, or < 0 when nmview failed.
 double appearance_rmse(const std::string& nmview, const std::string& low, const std::string& map, const std::string& high) {
-  const std::string out = run_capture(quote(nmview) + " " + quote(low) + " " + quote(map) + " " + quote(high) +
+  // nmview --compare leaves nmview-compare-worst.png in its working folder: run it beside the map.
+  const std::string out = run_capture("cd " + quote(fs::path(map).parent_path().string()) + " && " + quote(nmview) + " " +
+                                      quote(fs::absolute(low).string()) + " " + quote(fs::absolute(map).string()) + " " +
+                                      quote(fs::absolute(high).string()) +
                                       " --compare --size 800x400 2>/dev/null");
   const auto pos = out.rfind("rmse=");
   if (pos == std::string::npos || out.rfind("psnr=") == std::string::npos) return -1.0;
