@@ -55,6 +55,8 @@ struct Prepared {
   std::vector<std::uint32_t> kept_index;
   std::vector<glm::vec3> kept_normals;
   TangentFrames frames;
+  std::vector<LowTriangle> low_tris;
+  std::vector<glm::dvec3> cage_corners;  // 3 per low-poly triangle, with a cage
 };
 
 // Over the positions faces use: a vertex no face uses (a stray point far away) must not move the
@@ -122,6 +124,155 @@ void run_parallel(int threads, Fn&& worker) {
   for (int i = 1; i < threads; ++i) pool.emplace_back(worker, i);
   worker(0);
   for (auto& t : pool) t.join();
+}
+
+// Everything the rays and the shading read, from the meshes: tangent frames, re-centred
+// coordinates, ray normals, high-poly corner normals, the low-poly triangles in double. Fills the
+// stats it learns on the way (degenerate counts, centre, coordinate precision, computed normals).
+Prepared prepare(const Mesh& low, const Mesh& high, const Mesh* cage, BakeStats& st) {
+  Prepared s;
+  s.frames = compute_tangent_frames(low);
+  st.degenerate_uv_triangles = s.frames.degenerate_uv_triangles;
+  st.degenerate_3d_triangles = s.frames.degenerate_3d_triangles;
+  st.corners_without_tangent = s.frames.corners_without_tangent;
+  {
+    glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+    grow_box(lo, hi, low.positions, low.position_index);
+    grow_box(lo, hi, high.positions, high.position_index);
+    if (cage) grow_box(lo, hi, cage->positions, cage->position_index);
+    s.centre = 0.5 * (lo + hi);
+    st.centre = s.centre;
+    s.diagonal = glm::length(hi - lo);
+    if (!(s.diagonal > 0.0)) s.diagonal = 1.0;
+    // Float spacing at the largest coordinate: the precision the inputs carry (float positions).
+    const glm::dvec3 far = glm::max(glm::abs(lo), glm::abs(hi));
+    const float largest = float(std::max({far.x, far.y, far.z}));
+    st.largest_coordinate = largest;
+    st.coordinate_spacing = double(std::nextafter(largest, std::numeric_limits<float>::infinity()) - largest) / s.diagonal;
+  }
+  s.low_pos = recentre(low.positions, s.centre);
+  s.high_pos = recentre(high.positions, s.centre);
+  if (cage) s.cage_pos = recentre(cage->positions, s.centre);
+  s.ray_normal = position_averaged_normals(low, s.frames);
+  if (high.has_normals()) {
+    s.high_corner_normals.resize(high.normal_index.size());
+    for (std::size_t c = 0; c < high.normal_index.size(); ++c) s.high_corner_normals[c] = high.normals[high.normal_index[c]];
+  } else {
+    // Welded by value, duplicate faces once, one winding per piece (mesh_topology.h).
+    s.high_corner_normals = compute_high_corner_normals(high, &st.high_faces_reoriented);
+    st.high_normals_computed = true;
+  }
+  s.low_tris.resize(low.triangle_count());
+  for (std::size_t t = 0; t < low.triangle_count(); ++t)
+    for (int c = 0; c < 3; ++c) {
+      const std::uint32_t pi = low.position_index[3 * t + c];
+      s.low_tris[t].p[c] = glm::dvec3(s.low_pos[pi]);
+      s.low_tris[t].ray_n[c] = glm::dvec3(s.ray_normal[pi]);
+      s.low_tris[t].n[c] = glm::dvec3(s.frames.normal[3 * t + c]);
+      s.low_tris[t].t[c] = glm::dvec4(s.frames.tangent[3 * t + c]);
+    }
+  if (cage) {
+    s.cage_corners.resize(3 * low.triangle_count());
+    for (std::size_t c = 0; c < s.cage_corners.size(); ++c) s.cage_corners[c] = glm::dvec3(s.cage_pos[cage->position_index[c]]);
+  }
+  s.bvh_index = high.position_index.data();
+  s.bvh_normals = s.high_corner_normals.data();
+  return s;
+}
+
+glm::dvec3 low_point(const LowTriangle& lt, const double b[3]) { return b[0] * lt.p[0] + b[1] * lt.p[1] + b[2] * lt.p[2]; }
+
+glm::dvec3 low_ray_normal(const LowTriangle& lt, const double b[3]) {
+  const glm::dvec3 n = b[0] * lt.ray_n[0] + b[1] * lt.ray_n[1] + b[2] * lt.ray_n[2];
+  const double len2 = glm::dot(n, n);
+  if (len2 > 1e-24) return n / std::sqrt(len2);
+  // Opposite corner normals cancel: fall back to the face normal.
+  const glm::dvec3 f = glm::cross(lt.p[1] - lt.p[0], lt.p[2] - lt.p[0]);
+  const double fl = glm::length(f);
+  return fl > 0.0 ? f / fl : glm::dvec3(0, 0, 1);
+}
+
+// How a bake casts its rays (policy.h of the options, with the distances chosen).
+struct RaySetup {
+  float front = 0.0f, rear = 0.0f;
+  bool cage = false, closest = false;
+  double diagonal = 1.0;
+};
+
+// The rays of the sample at barycentrics b of low-poly triangle `tri` (two for the closest-hit
+// policy, else one) and, per ray, the distance from P to its origin along it. Returns the count.
+inline int sample_rays(const Prepared& s, std::size_t tri, const double b[3], const RaySetup& r, raycast::Ray* rays,
+                       double* signed_base) {
+  const LowTriangle& lt = s.low_tris[tri];
+  const glm::dvec3 p = low_point(lt, b);
+  const glm::dvec3 n = low_ray_normal(lt, b);
+  if (r.cage) {
+    glm::dvec3 pc(0.0);
+    for (int c = 0; c < 3; ++c) pc += b[c] * s.cage_corners[3 * tri + c];
+    glm::dvec3 d = p - pc;
+    double len = glm::length(d);
+    // A cage point on the low-poly gives no direction: use the ray normal from P.
+    if (!(len > 1e-9 * r.diagonal)) {
+      d = -n;
+      len = 0.0;
+      pc = p;
+    } else {
+      d /= len;
+    }
+    signed_base[0] = len;
+    rays[0] = {glm::vec3(pc), 0.0f, glm::vec3(d), float(len + r.rear)};
+    return 1;
+  }
+  if (r.closest) {
+    signed_base[0] = signed_base[1] = 0.0;
+    rays[0] = {glm::vec3(p), 0.0f, glm::vec3(n), r.front};
+    rays[1] = {glm::vec3(p), 0.0f, glm::vec3(-n), r.rear};
+    return 2;
+  }
+  signed_base[0] = r.front;
+  rays[0] = {glm::vec3(p + double(r.front) * n), 0.0f, glm::vec3(-n), r.front + r.rear};
+  return 1;
+}
+
+// Of a sample's rays' hits, the one that counts, and its signed distance from the low-poly
+// (positive: outside).
+inline const raycast::Hit& chosen_hit(const raycast::Hit* hits, const double* signed_base, bool closest, double* dist) {
+  if (closest) {
+    const raycast::Hit& out = hits[0];
+    const raycast::Hit& in = hits[1];
+    if (out.hit() && (!in.hit() || out.t <= in.t)) {
+      *dist = out.t;
+      return out;
+    }
+    *dist = -double(in.t);
+    return in;
+  }
+  *dist = signed_base[0] - hits[0].t;
+  return hits[0];
+}
+
+// One sample's value, one at a time: every case, with the fallbacks for degenerate hit normals and
+// frames. encode_hits_per_pixel (shade_batch.h) gives the same bits for the common case, many at a
+// time. `h` indexes the BVH's triangles (s.bvh_index, s.bvh_normals).
+glm::dvec3 shade_sample(const Prepared& s, std::size_t tri, const double b[3], const raycast::Hit& h, const BakeOptions& opt) {
+  const PixelFrame frame = interpolate_frame(s.low_tris[tri].n, s.low_tris[tri].t, b, opt.bitangent);
+  if (!h.hit()) {
+    const double nl = glm::length(frame.n);
+    return opt.space == NormalSpace::tangent ? glm::dvec3(0, 0, 1) : (nl > 0 ? frame.n / nl : glm::dvec3(0, 0, 1));
+  }
+  const std::size_t ht = h.triangle;
+  const double w[3] = {1.0 - double(h.u) - double(h.v), double(h.u), double(h.v)};
+  glm::dvec3 nh(0.0);
+  for (int c = 0; c < 3; ++c) nh += w[c] * glm::dvec3(s.bvh_normals[3 * ht + c]);
+  double len = glm::length(nh);
+  if (!(len > 1e-12)) {
+    const glm::dvec3 q0(s.high_pos[s.bvh_index[3 * ht]]), q1(s.high_pos[s.bvh_index[3 * ht + 1]]),
+        q2(s.high_pos[s.bvh_index[3 * ht + 2]]);
+    nh = glm::cross(q1 - q0, q2 - q0);
+    len = glm::length(nh);
+  }
+  nh = len > 0.0 ? nh / len : glm::normalize(frame.n);
+  return opt.space == NormalSpace::tangent ? encode_tangent_normal(frame, nh) : nh;
 }
 
 }  // namespace
@@ -193,38 +344,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
 
   // Prepare: tangent frames, re-centred coordinates, ray normals, high-poly normals.
   auto t0 = Clock::now();
-  Prepared s;
-  s.frames = compute_tangent_frames(low);
-  st.degenerate_uv_triangles = s.frames.degenerate_uv_triangles;
-  st.degenerate_3d_triangles = s.frames.degenerate_3d_triangles;
-  st.corners_without_tangent = s.frames.corners_without_tangent;
-  {
-    glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
-    grow_box(lo, hi, low.positions, low.position_index);
-    grow_box(lo, hi, high.positions, high.position_index);
-    if (cage) grow_box(lo, hi, cage->positions, cage->position_index);
-    s.centre = 0.5 * (lo + hi);
-    st.centre = s.centre;
-    s.diagonal = glm::length(hi - lo);
-    if (!(s.diagonal > 0.0)) s.diagonal = 1.0;
-    // Float spacing at the largest coordinate: the precision the inputs carry (float positions).
-    const glm::dvec3 far = glm::max(glm::abs(lo), glm::abs(hi));
-    const float largest = float(std::max({far.x, far.y, far.z}));
-    st.largest_coordinate = largest;
-    st.coordinate_spacing = double(std::nextafter(largest, std::numeric_limits<float>::infinity()) - largest) / s.diagonal;
-  }
-  s.low_pos = recentre(low.positions, s.centre);
-  s.high_pos = recentre(high.positions, s.centre);
-  if (cage) s.cage_pos = recentre(cage->positions, s.centre);
-  s.ray_normal = position_averaged_normals(low, s.frames);
-  if (high.has_normals()) {
-    s.high_corner_normals.resize(high.normal_index.size());
-    for (std::size_t c = 0; c < high.normal_index.size(); ++c) s.high_corner_normals[c] = high.normals[high.normal_index[c]];
-  } else {
-    // Welded by value, duplicate faces once, one winding per piece (mesh_topology.h).
-    s.high_corner_normals = compute_high_corner_normals(high, &st.high_faces_reoriented);
-    st.high_normals_computed = true;
-  }
+  Prepared s = prepare(low, high, cage, st);
   for (std::size_t t = 0; t < low.triangle_count(); ++t)
     for (int c = 0; c < 3; ++c) {
       const glm::vec2 uv = low.corner_uv(t, c);
@@ -238,29 +358,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     }
   st.seconds_prepare = seconds_since(t0);
 
-  std::vector<LowTriangle> low_tris(low.triangle_count());
-  for (std::size_t t = 0; t < low.triangle_count(); ++t)
-    for (int c = 0; c < 3; ++c) {
-      const std::uint32_t pi = low.position_index[3 * t + c];
-      low_tris[t].p[c] = glm::dvec3(s.low_pos[pi]);
-      low_tris[t].ray_n[c] = glm::dvec3(s.ray_normal[pi]);
-      low_tris[t].n[c] = glm::dvec3(s.frames.normal[3 * t + c]);
-      low_tris[t].t[c] = glm::dvec4(s.frames.tangent[3 * t + c]);
-    }
-  auto low_point = [&](std::size_t tri, const double b[3]) {
-    const LowTriangle& lt = low_tris[tri];
-    return b[0] * lt.p[0] + b[1] * lt.p[1] + b[2] * lt.p[2];
-  };
-  auto low_ray_normal = [&](std::size_t tri, const double b[3]) {
-    const LowTriangle& lt = low_tris[tri];
-    const glm::dvec3 n = b[0] * lt.ray_n[0] + b[1] * lt.ray_n[1] + b[2] * lt.ray_n[2];
-    const double len2 = glm::dot(n, n);
-    if (len2 > 1e-24) return n / std::sqrt(len2);
-    // Opposite corner normals cancel: fall back to the face normal.
-    const glm::dvec3 f = glm::cross(lt.p[1] - lt.p[0], lt.p[2] - lt.p[0]);
-    const double fl = glm::length(f);
-    return fl > 0.0 ? f / fl : glm::dvec3(0, 0, 1);
-  };
+  const std::vector<LowTriangle>& low_tris = s.low_tris;
 
   // BVH over the high-poly triangles some ray can reach (all of them without culling). Each ray
   // stays within `margin` of its low-poly triangle's box (grown over the cage triangle): front
@@ -333,7 +431,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     std::vector<raycast::Ray> rays;
     for (std::size_t t = 0; t < tris; t += stride)
       for (const auto& b : probe_bary) {
-        const glm::dvec3 p = low_point(t, b), n = low_ray_normal(t, b);
+        const glm::dvec3 p = low_point(low_tris[t], b), n = low_ray_normal(low_tris[t], b);
         rays.push_back({glm::vec3(p), 0.0f, glm::vec3(n), float(reach)});
         rays.push_back({glm::vec3(p), 0.0f, glm::vec3(-n), float(reach)});
       }
@@ -434,29 +532,14 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   std::atomic<bool> cancel{false};
   std::mutex record_mutex;
 
-  // One sample's value, one at a time: every case, with the fallbacks for degenerate hit normals and
-  // frames. encode_hits_per_pixel gives the same bits for the common case, many at a time.
+  // Hits in tangent space with the per-pixel bitangent are shaded many at a time (shade_batch.h).
   const bool batched = opt.space == NormalSpace::tangent && opt.bitangent == BitangentMode::per_pixel;
-  auto shade_one = [&](std::int32_t tri, const double b[3], const raycast::Hit& h) -> glm::dvec3 {
-    const PixelFrame frame = interpolate_frame(low_tris[tri].n, low_tris[tri].t, b, opt.bitangent);
-    if (!h.hit()) {
-      const double nl = glm::length(frame.n);
-      return opt.space == NormalSpace::tangent ? glm::dvec3(0, 0, 1) : (nl > 0 ? frame.n / nl : glm::dvec3(0, 0, 1));
-    }
-    const std::size_t ht = h.triangle;
-    const double w[3] = {1.0 - double(h.u) - double(h.v), double(h.u), double(h.v)};
-    glm::dvec3 nh(0.0);
-    for (int c = 0; c < 3; ++c) nh += w[c] * glm::dvec3(s.bvh_normals[3 * ht + c]);
-    double len = glm::length(nh);
-    if (!(len > 1e-12)) {
-      const glm::dvec3 q0(s.high_pos[s.bvh_index[3 * ht]]), q1(s.high_pos[s.bvh_index[3 * ht + 1]]),
-          q2(s.high_pos[s.bvh_index[3 * ht + 2]]);
-      nh = glm::cross(q1 - q0, q2 - q0);
-      len = glm::length(nh);
-    }
-    nh = len > 0.0 ? nh / len : glm::normalize(frame.n);
-    return opt.space == NormalSpace::tangent ? encode_tangent_normal(frame, nh) : nh;
-  };
+  RaySetup ray_setup;
+  ray_setup.front = st.front;
+  ray_setup.rear = st.rear;
+  ray_setup.cage = cage != nullptr;
+  ray_setup.closest = closest;
+  ray_setup.diagonal = s.diagonal;
 
   auto worker = [&](int id) {
     ThreadStats& ts = tstats[id];
@@ -513,32 +596,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
       for (std::uint32_t si = 0; si < slots.size(); ++si) {
         const Slot& sl = slots[si];
         if (sl.tri < 0) continue;
-        const glm::dvec3 p = low_point(std::size_t(sl.tri), sl.b);
-        const glm::dvec3 n = low_ray_normal(std::size_t(sl.tri), sl.b);
-        if (cage) {
-          glm::dvec3 pc(0.0);
-          for (int c = 0; c < 3; ++c) pc += sl.b[c] * glm::dvec3(s.cage_pos[low.position_index[3 * sl.tri + c]]);
-          glm::dvec3 d = p - pc;
-          double len = glm::length(d);
-          // A cage point on the low-poly gives no direction: use the ray normal from P + front*N.
-          if (!(len > 1e-9 * s.diagonal)) {
-            d = -n;
-            len = 0.0;
-            pc = p;
-          } else {
-            d /= len;
-          }
-          signed_base[ray_count] = len;
-          rays[ray_count++] = {glm::vec3(pc), 0.0f, glm::vec3(d), float(len + st.rear)};
-        } else if (closest) {
-          signed_base[ray_count] = 0.0;
-          rays[ray_count++] = {glm::vec3(p), 0.0f, glm::vec3(n), st.front};
-          signed_base[ray_count] = 0.0;
-          rays[ray_count++] = {glm::vec3(p), 0.0f, glm::vec3(-n), st.rear};
-        } else {
-          signed_base[ray_count] = st.front;
-          rays[ray_count++] = {glm::vec3(p + double(st.front) * n), 0.0f, glm::vec3(-n), st.front + st.rear};
-        }
+        ray_count += std::size_t(sample_rays(s, std::size_t(sl.tri), sl.b, ray_setup, &rays[ray_count], &signed_base[ray_count]));
         slot_of_ray[sample_count++] = si;
       }
       if (ray_count) scene->intersect(rays.data(), hits.data(), ray_count);
@@ -562,21 +620,9 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
       std::fill(miss_count.begin(), miss_count.end(), 0u);
       std::size_t batch_count = 0;
       for (std::size_t r = 0; r < sample_count; ++r) {
-        const raycast::Hit* h = &hits[r * rays_per_sample];
         double dist = 0.0;
-        if (closest) {
-          const raycast::Hit& out = hits[2 * r];
-          const raycast::Hit& in = hits[2 * r + 1];
-          if (out.hit() && (!in.hit() || out.t <= in.t)) {
-            h = &out;
-            dist = out.t;
-          } else {
-            h = &in;
-            dist = -double(in.t);
-          }
-        } else {
-          dist = signed_base[r] - h->t;
-        }
+        const raycast::Hit* h =
+            &chosen_hit(&hits[r * rays_per_sample], &signed_base[r * rays_per_sample], closest, &dist);
         chosen[r] = h;
         batch_of[r] = -1;
         ++ts.covered;
@@ -602,7 +648,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
         const std::uint32_t si = slot_of_ray[r];
         const std::int32_t bi = batch_of[r];
         const glm::dvec3 value =
-            bi >= 0 && !batch_degenerate[std::size_t(bi)] ? batch_value[std::size_t(bi)] : shade_one(slots[si].tri, slots[si].b, *chosen[r]);
+            bi >= 0 && !batch_degenerate[std::size_t(bi)] ? batch_value[std::size_t(bi)] : shade_sample(s, std::size_t(slots[si].tri), slots[si].b, *chosen[r], opt);
         acc[si / S] += glm::dvec4(value, 1.0);
       }
       // Texels: renormalized mean of their covered samples.
@@ -691,5 +737,101 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   st.seconds_padding = seconds_since(t0);
   return result;
 }
+
+// ---- Re-baking chosen texels (for the error estimate, error_estimate.h) ----
+// The bake's own preparation, rays and shading (prepare, sample_rays, chosen_hit, shade_sample)
+// for a list of texels; tests/test_error_estimate.cpp checks both agree texel for texel.
+std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt,
+                                          const BakeStats& st, const std::vector<std::uint32_t>& texels, int samples) {
+  std::vector<glm::dvec3> out(texels.size(), glm::dvec3(0.0));
+  if (texels.empty() || low.triangle_count() == 0 || high.triangle_count() == 0 || !low.has_uvs()) return out;
+  const int threads = opt.threads > 0 ? opt.threads : std::max(1, int(std::thread::hardware_concurrency()));
+  const int W = opt.width, H = opt.height;
+  BakeStats scratch;
+  const Prepared s = prepare(low, high, cage, scratch);
+  // Few rays: a quick BVH build pays off more than a fast one to trace. All triangles: culling
+  // leaves the hits unchanged.
+  raycast::Scene scene(&s.high_pos[0].x, s.high_pos.size(), high.position_index.data(), high.triangle_count(),
+                       raycast::BuildQuality::low, opt.threads);
+  RaySetup ray_setup;
+  ray_setup.front = st.front;
+  ray_setup.rear = st.rear;
+  ray_setup.cage = cage != nullptr;
+  ray_setup.closest = opt.policy == RayPolicy::closest && !cage;
+  ray_setup.diagonal = s.diagonal;
+  const int rays_per_sample = ray_setup.closest ? 2 : 1;
+
+  // Low-poly triangles binned to the tiles that hold a requested texel.
+  const int tiles_x = (W + kTile - 1) / kTile, tiles_y = (H + kTile - 1) / kTile;
+  std::vector<std::int32_t> tile_slot(std::size_t(tiles_x) * tiles_y, -1);
+  std::int32_t used_tiles = 0;
+  for (std::uint32_t t : texels) {
+    const std::size_t tile = std::size_t((t / W) / kTile) * tiles_x + (t % W) / kTile;
+    if (tile_slot[tile] < 0) tile_slot[tile] = used_tiles++;
+  }
+  std::vector<TexelTriangle> texel_tris(low.triangle_count());
+  std::vector<std::vector<std::uint32_t>> bins(static_cast<std::size_t>(used_tiles));
+  for (std::size_t t = 0; t < low.triangle_count(); ++t) {
+    texel_tris[t] = setup_texel_triangle(low.corner_uv(t, 0), low.corner_uv(t, 1), low.corner_uv(t, 2), W, H);
+    const TexelTriangle& tt = texel_tris[t];
+    if (!tt.valid() || tt.xmax < tt.xmin || tt.ymax < tt.ymin) continue;
+    for (int ty = tt.ymin / kTile; ty <= tt.ymax / kTile; ++ty)
+      for (int tx = tt.xmin / kTile; tx <= tt.xmax / kTile; ++tx) {
+        const std::int32_t slot = tile_slot[std::size_t(ty) * tiles_x + tx];
+        if (slot >= 0) bins[std::size_t(slot)].push_back(std::uint32_t(t));  // ascending: the lowest index wins
+      }
+  }
+
+  const std::vector<glm::dvec2> offsets = sample_offsets(samples);
+  std::vector<std::uint8_t> covered(texels.size(), 0);  // each entry written by one thread only
+  std::atomic<std::size_t> next{0};
+  run_parallel(threads, [&](int) {
+    struct Sample {
+      std::size_t texel;  // index into `texels`
+      std::uint32_t tri;
+      double b[3];
+    };
+    std::vector<Sample> work;
+    std::vector<raycast::Ray> rays;
+    std::vector<double> signed_base;
+    std::vector<raycast::Hit> hits;
+    constexpr std::size_t kChunk = 64;
+    for (std::size_t i0; (i0 = next.fetch_add(kChunk)) < texels.size();) {
+      const std::size_t i1 = std::min(texels.size(), i0 + kChunk);
+      work.clear();
+      for (std::size_t i = i0; i < i1; ++i) {
+        const int x = int(texels[i] % W), y = int(texels[i] / W);
+        const auto& bin = bins[std::size_t(tile_slot[std::size_t(y / kTile) * tiles_x + x / kTile])];
+        for (const glm::dvec2& o : offsets)
+          for (std::uint32_t t : bin) {
+            Sample sm{i, t, {0, 0, 0}};
+            if (!covers(texel_tris[t], sample_point(x, y, o.x, o.y), sm.b)) continue;
+            work.push_back(sm);
+            break;
+          }
+      }
+      rays.resize(work.size() * rays_per_sample);
+      signed_base.resize(rays.size());
+      hits.resize(rays.size());
+      for (std::size_t r = 0; r < work.size(); ++r)
+        sample_rays(s, work[r].tri, work[r].b, ray_setup, &rays[r * rays_per_sample], &signed_base[r * rays_per_sample]);
+      if (!rays.empty()) scene.intersect(rays.data(), hits.data(), rays.size());
+      for (std::size_t r = 0; r < work.size(); ++r) {
+        double dist = 0.0;
+        const raycast::Hit& h = chosen_hit(&hits[r * rays_per_sample], &signed_base[r * rays_per_sample], ray_setup.closest, &dist);
+        out[work[r].texel] += shade_sample(s, work[r].tri, work[r].b, h, opt);
+        covered[work[r].texel] = 1;
+      }
+      for (std::size_t i = i0; i < i1; ++i) {
+        if (!covered[i]) continue;
+        const double len = glm::length(out[i]);
+        out[i] = len > 0.0 ? out[i] / len : glm::dvec3(0, 0, 1);
+        if (opt.space == NormalSpace::tangent && opt.green_down) out[i].y = -out[i].y;
+      }
+    }
+  });
+  return out;
+}
+// ---- end of re-baking chosen texels ----
 
 }  // namespace nmbake

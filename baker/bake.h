@@ -115,4 +115,14 @@ std::uint64_t estimate_bake_bytes(const BakeOptions& options);
 // regular grid for square counts, otherwise a stratified (Hammersley) set.
 std::vector<glm::dvec2> sample_offsets(int samples);
 
+// ---- Re-baking chosen texels (for the error estimate, error_estimate.h) ----
+// The unit values bake_normal_map gives texels `texels` (indices y * width + x) with `samples`
+// sample points each (sample_offsets), using the ray distances and centre of a finished bake
+// (`stats`) and otherwise the same rays, shading and averaging as the bake (tangent space with
+// --green down applied, or object space), as n in [-1,1]^3 (not encoded, not snapped to 0).
+// A texel none of whose samples falls in the UV layout gets (0,0,0). Builds its own BVH.
+std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& options,
+                                          const BakeStats& stats, const std::vector<std::uint32_t>& texels, int samples);
+// ---- end of re-baking chosen texels ----
+
 }  // namespace nmbake

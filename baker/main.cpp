@@ -16,6 +16,7 @@
 #include <CLI/CLI.hpp>
 
 #include "bake.h"
+#include "error_estimate.h"
 #include "errors.h"
 #include "image_io.h"
 #include "mesh_io.h"
@@ -50,6 +51,7 @@ struct Args {
   int threads = 0;
   bool quiet = false;
   bool no_cull = false;
+  bool estimate_error = false;
 };
 
 void parse_size(const std::string& text, int& w, int& h) {
@@ -137,6 +139,10 @@ int run(int argc, char** argv) {
   app.add_flag("--no-cull", a.no_cull,
                "Keep high-poly triangles out of every ray's reach in the BVH (default: left out; same map)");
   app.add_flag("--quiet", a.quiet, "No progress bar and no summary line");
+  app.add_flag("--estimate-error", a.estimate_error,
+               "Re-bake 4096 random covered texels (fixed seed) with 64 samples (4x --samples if more) and report the "
+               "angular error of the float map against them (one stderr line, \"error_estimate\" in --report); costs "
+               "about 10% of a 2048^2 1-sample bake (measured on torus_s3 and suz_L4: 0.13-0.31 s, 6-12% of the command)");
   app.set_version_flag("--version", std::string("nmbake ") + NMBAKE_VERSION);
 
   try {
@@ -215,6 +221,21 @@ int run(int argc, char** argv) {
   if (!a.quiet)
     for (const std::string& w : bake_warnings(s, run.high_topology, a.low, a.high)) std::fprintf(stderr, "nmbake: %s\n", w.c_str());
   if (g_interrupted) throw Cancelled();
+  ErrorEstimate estimate;
+  if (a.estimate_error) {
+    ErrorEstimateOptions eo;
+    eo.bits = bits;
+    estimate = estimate_bake_error(low, high, a.cage.empty() ? nullptr : &cage, o, r, eo);
+    // The estimate compares float values; say what the output's bit depth adds on top.
+    char quant[128] = "float output adds no quantisation";
+    if (bits != 32)
+      std::snprintf(quant, sizeof quant, "%d-bit output adds quantisation of mean %.4f deg, max %.4f deg", bits,
+                    estimate.quantization_mean_deg, estimate.quantization_max_deg);
+    std::fprintf(stderr,
+                 "nmbake: error estimate: mean %.4f deg, p95 %.4f deg, max %.4f deg against %d samples on %zu texels "
+                 "(%.2f s); %s\n",
+                 estimate.mean_deg, estimate.p95_deg, estimate.max_deg, estimate.samples, estimate.texels, estimate.seconds, quant);
+  }
 
   // Write.
   t0 = Clock::now();
@@ -238,7 +259,16 @@ int run(int argc, char** argv) {
   run.seconds_total = std::chrono::duration<double>(Clock::now() - start).count();
   run.peak_memory_bytes = peak_memory_bytes();
   run.threads_used = a.threads > 0 ? unsigned(a.threads) : std::max(1u, std::thread::hardware_concurrency());
-  if (!a.report.empty()) write_text_atomically(a.report, make_report(o, s, run).dump(2) + "\n");
+  if (!a.report.empty()) {
+    nlohmann::json report = make_report(o, s, run);
+    if (a.estimate_error)
+      report["error_estimate"] = {{"mean_deg", estimate.mean_deg},
+                                  {"p95_deg", estimate.p95_deg},
+                                  {"max_deg", estimate.max_deg},
+                                  {"texels", estimate.texels},
+                                  {"seconds", estimate.seconds}};
+    write_text_atomically(a.report, report.dump(2) + "\n");
+  }
 
   if (!a.quiet) {
     std::printf(

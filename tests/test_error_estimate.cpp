@@ -1,0 +1,106 @@
+// The --estimate-error machinery: bake_texel_values reproduces the bake texel for texel, and the
+// estimate is ~0 where there is nothing to estimate and close to the true error where there is.
+#include <algorithm>
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "bake.h"
+#include "error_estimate.h"
+#include "test_support.h"
+
+using namespace nmbake;
+using test::angle_deg;
+using test::decode_rgb;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+BakeOptions options(int size, int samples) {
+  BakeOptions o;
+  o.width = o.height = size;
+  o.samples = samples;
+  o.padding = 0;
+  return o;
+}
+
+// z = 0.005 sin(42 pi x) sin(42 pi y) over [-1,1]^2: 42 waves across, 3 texels per wave at 128^2,
+// slopes up to 33 deg. A 1-sample bake aliases it badly.
+Mesh aliasing_height_field() {
+  const double a = 0.005, w = 42 * kPi;
+  return test::make_height_field(
+      504, 504, [&](double x, double y) { return a * std::sin(w * x) * std::sin(w * y); },
+      [&](double x, double y) {
+        return glm::normalize(glm::dvec3(-a * w * std::cos(w * x) * std::sin(w * y), -a * w * std::sin(w * x) * std::cos(w * y), 1.0));
+      });
+}
+
+}  // namespace
+
+TEST(ErrorEstimate, RebakedTexelsMatchTheBake) {
+  const Mesh low = test::make_torus(24, 12);
+  const Mesh high = test::make_torus(96, 48, 1.0f, 0.37f);
+  for (int variant = 0; variant < 3; ++variant) {
+    BakeOptions o = options(96, variant == 1 ? 1 : 4);
+    o.front = o.rear = 0.1f;
+    if (variant == 1) o.policy = RayPolicy::closest;
+    if (variant == 2) o.green_down = true;
+    const BakeResult r = bake_normal_map(low, high, nullptr, o);
+    std::vector<std::uint32_t> texels;
+    for (std::uint32_t i = 0; i < r.coverage.size(); ++i)
+      if (r.coverage[i]) texels.push_back(i);
+    const std::vector<glm::dvec3> v = bake_texel_values(low, high, nullptr, o, r.stats, texels, o.samples);
+    double worst = 0.0;
+    for (std::size_t i = 0; i < texels.size(); ++i) {
+      ASSERT_NE(v[i], glm::dvec3(0.0)) << "texel " << texels[i];
+      worst = std::max(worst, angle_deg(decode_rgb(&r.map.pixels[3 * std::size_t(texels[i])]), v[i]));
+    }
+    EXPECT_LT(worst, 1e-3) << "variant " << variant;  // float encoding only
+  }
+}
+
+TEST(ErrorEstimate, SelfBakeEstimatesZero) {
+  const Mesh m = test::make_torus(64, 32);
+  BakeOptions o = options(128, 1);
+  o.front = o.rear = 0.05f;
+  const BakeResult r = bake_normal_map(m, m, nullptr, o);
+  ErrorEstimateOptions eo;
+  eo.bits = 8;
+  const ErrorEstimate e = estimate_bake_error(m, m, nullptr, o, r, eo);
+  EXPECT_EQ(e.texels, 4096u);
+  EXPECT_EQ(e.samples, 64);
+  EXPECT_LT(e.max_deg, 1e-3);
+  // Flat rounds to (128,128,255), and 128/255 decodes to 0.0039, not 0: 8-bit output is 0.32 deg
+  // off even for a flat map (atan(sqrt(2) * 1/255)).
+  EXPECT_NEAR(e.quantization_max_deg, std::atan(std::sqrt(2.0) / 255.0) * 180.0 / kPi, 1e-3);
+  EXPECT_NEAR(e.quantization_mean_deg, e.quantization_max_deg, 1e-9);
+}
+
+TEST(ErrorEstimate, AliasedBakeEstimateIsCloseToTheTrueError) {
+  const Mesh high = aliasing_height_field();
+  const Mesh low = test::make_grid(1, 1);
+  BakeOptions o = options(128, 1);
+  o.front = o.rear = 0.01f;
+  const BakeResult r = bake_normal_map(low, high, nullptr, o);
+  // True error: every texel against a full 64-sample bake.
+  BakeOptions ref_o = o;
+  ref_o.samples = 64;
+  const BakeResult ref = bake_normal_map(low, high, nullptr, ref_o);
+  std::vector<double> err;
+  for (std::size_t i = 0; i < r.coverage.size(); ++i)
+    err.push_back(angle_deg(decode_rgb(&r.map.pixels[3 * i]), decode_rgb(&ref.map.pixels[3 * i])));
+  double mean = 0.0;
+  for (double e : err) mean += e / double(err.size());
+  std::sort(err.begin(), err.end());
+  const double p95 = err[std::size_t(0.95 * double(err.size() - 1) + 0.5)];
+
+  const ErrorEstimate e = estimate_bake_error(low, high, nullptr, o, r);
+  std::printf("aliased 128^2, 1 sample: true mean %.3f p95 %.3f max %.3f deg; estimate mean %.3f p95 %.3f max %.3f deg on %zu texels, %.3f s\n",
+              mean, p95, err.back(), e.mean_deg, e.p95_deg, e.max_deg, e.texels, e.seconds);
+  EXPECT_EQ(e.texels, 4096u);  // a quarter of the map
+  EXPECT_GT(mean, 1.0);
+  EXPECT_NEAR(e.mean_deg, mean, 0.05 * mean);
+  EXPECT_NEAR(e.p95_deg, p95, 0.1 * p95);
+  EXPECT_LE(e.max_deg, err.back() + 1e-6);
+}
