@@ -224,5 +224,6 @@ std::map<std::string, std::string> read_image_metadata(const std::string& path) 
 }
 
 void preload_image_io() {}  // linked directly: nothing to load
+std::string image_io_problem() { return {}; }
 
 }  // namespace nmbake

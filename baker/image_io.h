@@ -46,6 +46,10 @@ std::map<std::string, std::string> read_image_metadata(const std::string& path);
 // does nothing where it is linked. Optional: the functions above load it when first called.
 void preload_image_io();
 
+// Why images cannot be written, found without waiting for the background load (the module file
+// is missing or already failed to load), or "" (always "" where OpenImageIO is linked).
+std::string image_io_problem();
+
 namespace image_io_detail {
 std::string lower_extension(const std::string& path);  // ".png" for "A/b.PNG"
 }

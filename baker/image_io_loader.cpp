@@ -6,7 +6,10 @@
 #include <dlfcn.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <chrono>
 #include <climits>
+#include <cstring>
 #include <future>
 #include <mutex>
 #include <string>
@@ -88,6 +91,15 @@ const ImageIoModule& module(const std::string& path, ExitCode failure) {
 }  // namespace
 
 void preload_image_io() { start(); }
+
+std::string image_io_problem() {
+  start();
+  if (g_loaded.wait_for(std::chrono::seconds(0)) == std::future_status::ready && !g_loaded.get().module)
+    return g_loaded.get().error;
+  const std::string path = module_path();
+  if (::access(path.c_str(), R_OK) != 0) return "cannot load the image library module " + path + ": " + std::strerror(errno);
+  return {};
+}
 
 void write_image(const std::string& path, const Image& image, const WriteOptions& options) {
   std::string error;

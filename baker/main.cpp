@@ -185,6 +185,7 @@ int run(int argc, char** argv) {
   if (!a.miss_mask.empty()) check_output_path(a.miss_mask, "the miss mask");
   if (!a.report.empty()) check_output_path(a.report, "the report");
   check_output_format(a.output, bits);
+  if (const std::string problem = image_io_problem(); !problem.empty()) throw OutputError(a.output + ": " + problem);
   if (!a.miss_mask.empty()) check_output_format(a.miss_mask, default_bits_for(a.miss_mask));
 
   std::signal(SIGINT, on_sigint);
