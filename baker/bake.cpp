@@ -739,7 +739,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
       for (int c = 0; c < 3; ++c) result.map.pixels[3 * i + c] = flat[c];
   if (opt.space == NormalSpace::tangent)
     for (std::size_t i = 0; i < result.coverage.size(); ++i) st.texels_facing_away += result.coverage[i] && result.map.pixels[3 * i + 2] < 0.5f;
-  st.texels_padded = pad_islands(result.map, result.coverage, opt.padding);
+  st.texels_padded = pad_islands(result.map, result.coverage, opt.padding, threads);
   st.seconds_padding = seconds_since(t0);
   return result;
 }

@@ -57,3 +57,22 @@ TEST(Padding, ZeroPaddingAndEmptyCoverageChangeNothing) {
   EXPECT_EQ(pad_islands(img, one, 0), 0u);
   for (float v : img.pixels) EXPECT_EQ(v, 0.25f);
 }
+
+TEST(Padding, SameResultWithOneOrTwoThreads) {
+  // Wider than one column block and taller than one row part, so both threads get work.
+  std::mt19937 rng(7);
+  const int W = 197, H = 133;
+  Image img(W, H, 3, 0.25f);
+  std::vector<std::uint8_t> cov(std::size_t(W) * H, 0);
+  std::bernoulli_distribution on(0.01);
+  for (int i = 0; i < W * H; ++i)
+    if (on(rng)) {
+      cov[i] = 1;
+      for (int c = 0; c < 3; ++c) img.pixels[3 * std::size_t(i) + c] = float(i * 3 + c);
+    }
+  Image one = img, two = img;
+  const std::size_t n1 = pad_islands(one, cov, 12, 1), n2 = pad_islands(two, cov, 12, 2);
+  EXPECT_GT(n1, 0u);
+  EXPECT_EQ(n1, n2);
+  EXPECT_TRUE(one.pixels == two.pixels);
+}
