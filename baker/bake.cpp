@@ -301,6 +301,11 @@ std::vector<glm::dvec2> sample_offsets(int samples) {
   return out;
 }
 
+raycast::BuildQuality bvh_quality_for(const BakeOptions& o, std::size_t triangles) {
+  const double rays = double(o.width) * double(o.height) * double(o.samples);
+  return rays < 16.0 * double(triangles) ? raycast::BuildQuality::low : raycast::BuildQuality::high;
+}
+
 std::uint64_t estimate_bake_bytes(const BakeOptions& o) {
   const std::uint64_t texels = std::uint64_t(std::max(o.width, 0)) * std::uint64_t(std::max(o.height, 0));
   // map (3 floats) + coverage (1 byte) + padding transform (double + int) + optional miss mask.
@@ -390,15 +395,10 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
       s.bvh_index = s.kept_index.data();
       s.bvh_normals = s.kept_normals.data();
     }
-    // Build quality by measurement (bench, issue 6): with few rays per triangle the quick Morton
-    // build wins end to end (1M triangles at 2048^2, 1 sample: 0.2 s build instead of 0.8 s, the
-    // trace 10% slower); with many, the medium (SAH) build's faster trace wins.
     const std::size_t tris = kept.empty() ? high.triangle_count() : kept.size();
-    const double rays = double(opt.width) * double(opt.height) * double(opt.samples);
-    const raycast::BuildQuality quality =
-        rays < 16.0 * double(tris) ? raycast::BuildQuality::low : raycast::BuildQuality::medium;
+    st.bvh_quality = bvh_quality_for(opt, tris);
     scene.reset();
-    scene.emplace(&s.high_pos[0].x, s.high_pos.size(), s.bvh_index, tris, quality, opt.threads);
+    scene.emplace(&s.high_pos[0].x, s.high_pos.size(), s.bvh_index, tris, st.bvh_quality, opt.threads);
     st.high_triangles_culled = kept.empty() ? 0 : high.triangle_count() - kept.size();
   };
   t0 = Clock::now();

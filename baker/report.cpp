@@ -98,6 +98,9 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
   high["non_manifold_edges"] = t.non_manifold_edges;
   high["inconsistent_winding_faces"] = t.inconsistent_winding_faces;
   high["triangles_culled"] = s.high_triangles_culled;
+  report["bvh_quality"] = s.bvh_quality == raycast::BuildQuality::low      ? "low"
+                          : s.bvh_quality == raycast::BuildQuality::medium ? "medium"
+                                                                           : "high";
   return report;
 }
 

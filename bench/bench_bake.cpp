@@ -101,11 +101,9 @@ std::vector<glm::vec3> recentred(const Mesh& high, const glm::dvec3& centre) {
   return pos;
 }
 
-// The BVH build quality bake.cpp picks, mirrored so the bare loop traces the same kind of tree:
-// the quick build below 16 rays per (kept) high-poly triangle, medium above.
+// The BVH build quality the bake picks (bake.h), so the bare loop traces the same kind of tree.
 raycast::BuildQuality bake_quality(const BakeOptions& o, std::size_t kept_triangles) {
-  const double rays = double(o.width) * double(o.height) * double(o.samples);
-  return rays < 16.0 * double(kept_triangles) ? raycast::BuildQuality::low : raycast::BuildQuality::medium;
+  return bvh_quality_for(o, kept_triangles);
 }
 
 // A bake that records its rays, then pins the distances it chose so the timed rounds skip the
@@ -258,7 +256,7 @@ int main(int argc, char** argv) {
   std::printf("Load average %s.\n\n", load_average().c_str());
   std::printf("Each round runs the bake, then the bare loops, back to back on the rays the bake recorded; CPU = process CPU\n"
               "seconds (all threads), less disturbed by other load than wall time. The bare loops trace a BVH of the build quality\n"
-              "the bake picks (bake.cpp's rule, mirrored: low below 16 rays per triangle, else medium; column \"BVH\").\n"
+              "the bake picks (bvh_quality_for in bake.h: low below 16 rays per triangle, else high; column \"BVH\").\n"
               "Target (issue 6): trace / best bare <= 1.15x\n"
               "(wall) for 1 and 16 samples. raycast.h offers single rays (rtcIntersect1) and 8-wide packets (rtcIntersect8) through\n"
               "Scene::intersect; it has no 16-wide packets and no rtcIntersect1M streams, so those are not measured.\n\n");
@@ -346,7 +344,7 @@ int main(int argc, char** argv) {
                 quality_rows[i].samples > 1 ? "s" : "", quality_name(quality_rows[best].quality));
     BakeOptions o;  // 2048^2, as the sweep
     o.samples = quality_rows[i].samples;
-    std::printf(" (bake.cpp's rule picks %s)", quality_name(bake_quality(o, quality_rows[i].triangles)));
+    std::printf(" (the bake picks %s)", quality_name(bake_quality(o, quality_rows[i].triangles)));
   }
   std::printf(".\n\n");
   flush();
