@@ -505,6 +505,14 @@ std::string cpu_model() {
   return "unknown";
 }
 
+// The 1, 5 and 15 minute load averages: timings taken while other programs ran are slower.
+std::string load_average() {
+  std::ifstream in("/proc/loadavg");
+  std::string a, b, c;
+  in >> a >> b >> c;
+  return in ? a + " " + b + " " + c : std::string("unknown");
+}
+
 std::string git_commit() {
   std::string c = run_capture("git -C " + quote(NMBAKE_SOURCE_DIR) + " describe --always --dirty --abbrev=12 2>/dev/null");
   while (!c.empty() && (c.back() == '\n' || c.back() == '\r')) c.pop_back();
@@ -557,6 +565,7 @@ const char* kUsage =
 
 int main(int argc, char** argv) {
   Args a;
+  const std::string load_at_start = load_average();
   std::string command = "nmbake_accuracy";
   for (int i = 1; i < argc; ++i) {
     const std::string s = argv[i];
@@ -723,7 +732,8 @@ int main(int argc, char** argv) {
       f << "Written by `" << command << "` on " << date << ", commit `" << commit << "`, "
         << std::thread::hardware_concurrency() << " cores (" << cpu_model() << "); the whole run took "
         << fmt("%.0f", run_seconds) << " s"
-        << (a.nmview.empty() ? std::string() : " (" + fmt("%.0f", appearance_seconds) + " s of it in nmview)") << ".\n\n";
+        << (a.nmview.empty() ? std::string() : " (" + fmt("%.0f", appearance_seconds) + " s of it in nmview)")
+        << "; load average " << load_at_start << " at the start, " << load_average() << " at the end.\n\n";
       f << "Angular error in degrees over the texels whose centre lies in the UV layout (analytic scenes: whose 4x4 "
            "Gauss-Legendre points all do), the map and the reference both decoded with the low-poly tangent frame at the "
            "texel centre. Float map unless `bits` says 8 or 16 (the map rounded as the PNG/TIFF writer rounds it). "
