@@ -147,6 +147,9 @@ const Defect kDefects[] = {
     {"huge_facet_count.stl", {"truncated", "4294967295 facets", "134 bytes"}},
     {"huge_index.obj", {"line 5", "malformed vertex index '99999999999999999999'"}},
     {"huge_index_in_range_type.obj", {"line 5", "refers to vertex 4294967297 but the file has 3"}},
+    // Found by the fuzzer (tests/fuzz/corpus/crash_ply_list_count_3e38): an ascii list length
+    // beyond 2^64 was cast to an integer (undefined behaviour) before the size check.
+    {"huge_list_count_ascii.ply", {"truncated: file ends in face 0 of 1"}},
 };
 
 std::string defect_test_name(const ::testing::TestParamInfo<Defect>& info) {
