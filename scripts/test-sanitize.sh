@@ -2,9 +2,13 @@
 # The sanitizer configuration: builds nmbake and its tests with AddressSanitizer and
 # UndefinedBehaviorSanitizer (NMBAKE_SANITIZE, gcc) in build-asan/ (-O1 -g, asserts on, no bench,
 # no viewer) and runs the whole test suite there with ctest, one process per GoogleTest program
-# (NMBAKE_TEST_PER_PROGRAM: an ASan process start costs ~0.5 s CPU, ~190 of them were a third of
-# the run). Any ASan/UBSan report fails the test
-# that triggered it; LeakSanitizer ignores only the known leaks listed in tests/sanitize/lsan.supp.
+# (NMBAKE_TEST_PER_PROGRAM: an ASan process start costs ~0.5 s CPU, and ~190 of them were a third
+# of the run). Any ASan/UBSan report fails the test that triggered it; LeakSanitizer ignores only
+# the known leaks listed in tests/sanitize/lsan.supp.
+# The viewer is off here (not tried under ASan): its tests draw through Mesa's llvmpipe via EGL and
+# GLFW, uninstrumented driver code that is slow on the CPU already and whose allocations would
+# need suppressions of libraries we do not own; the viewer reads meshes and maps through the same
+# mesh_io/image_io that this run covers.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${NMBAKE_ASAN_BUILD_DIR:-$root/build-asan}
