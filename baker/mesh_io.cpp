@@ -138,13 +138,16 @@ void settle_normals(ParsedMesh& parsed, MeshLoadInfo& info) {
     for (std::uint32_t i : m.normal_index) used[i] = true;
     for (std::size_t i = 0; i < m.normals.size(); ++i) {
       if (!used[i]) continue;
-      float length = glm::length(m.normals[i]);
+      // In double: the squared length of a float normal with components near 1e20 or more
+      // overflows float, and dividing by an infinite length would give a zero normal.
+      const glm::dvec3 n(m.normals[i]);
+      const double length = glm::length(n);
       if (length < kZeroNormalLength) {
         ++info.zero_normals;
         continue;
       }
-      if (std::fabs(length - 1.0f) > kUnitTolerance) ++info.normals_renormalized;
-      m.normals[i] /= length;
+      if (std::fabs(length - 1.0) > kUnitTolerance) ++info.normals_renormalized;
+      m.normals[i] = glm::vec3(n / length);
     }
     if (info.zero_normals > 0) {
       keep = false;
@@ -170,7 +173,38 @@ Mesh finish_mesh(ParsedMesh parsed, const std::string& path, const LoadOptions& 
   return std::move(parsed.mesh);
 }
 
+void check_extension(const std::string& path) {
+  std::string ext = lower_extension(path);
+  if (ext != "obj" && ext != "ply" && ext != "off" && ext != "stl")
+    fail(path, (ext.empty() ? std::string("has no file extension") : "unknown file type '." + ext + "'") +
+                   "; supported: .obj .ply .off .stl");
+}
+
+Mesh parse_bytes(const std::string& path, std::string_view bytes, const LoadOptions& options, MeshLoadInfo& info) {
+  const std::string ext = lower_extension(path);
+  if (bytes.empty() || is_whitespace_only(bytes)) fail(path, "file is empty");
+  // Binary STL is the only binary format whose first bytes are arbitrary.
+  if (!(ext == "stl" && mesh_io_detail::is_binary_stl(bytes)) && looks_like_utf16(bytes))
+    fail(path, "looks like UTF-16 text; save it as UTF-8");
+  return finish_mesh(parse_by_extension(path, ext, bytes), path, options, info);
+}
+
 }  // namespace
+
+Mesh load_mesh_from_memory(const std::string& name, std::string_view bytes, const LoadOptions& options,
+                           MeshLoadInfo* info) {
+  MeshLoadInfo local_info;
+  MeshLoadInfo& out_info = info ? *info : local_info;
+  out_info = MeshLoadInfo{};
+  try {
+    check_extension(name);
+    return parse_bytes(name, bytes, options, out_info);
+  } catch (const std::bad_alloc&) {
+    throw ResourceError(name + ": out of memory while loading");
+  } catch (const std::length_error&) {
+    throw ResourceError(name + ": out of memory while loading");
+  }
+}
 
 Mesh load_mesh(const std::string& path, const LoadOptions& options, MeshLoadInfo* info) {
   MeshLoadInfo local_info;
@@ -178,16 +212,8 @@ Mesh load_mesh(const std::string& path, const LoadOptions& options, MeshLoadInfo
   out_info = MeshLoadInfo{};
   try {
     check_regular_file(path);
-    std::string ext = lower_extension(path);
-    if (ext != "obj" && ext != "ply" && ext != "off" && ext != "stl")
-      fail(path, (ext.empty() ? std::string("has no file extension") : "unknown file type '." + ext + "'") +
-                     "; supported: .obj .ply .off .stl");
-    std::string bytes = read_file(path);
-    if (bytes.empty() || is_whitespace_only(bytes)) fail(path, "file is empty");
-    // Binary STL is the only binary format whose first bytes are arbitrary.
-    if (!(ext == "stl" && mesh_io_detail::is_binary_stl(bytes)) && looks_like_utf16(bytes))
-      fail(path, "looks like UTF-16 text; save it as UTF-8");
-    return finish_mesh(parse_by_extension(path, ext, bytes), path, options, out_info);
+    check_extension(path);
+    return parse_bytes(path, read_file(path), options, out_info);
   } catch (const std::bad_alloc&) {
     throw ResourceError(path + ": out of memory while loading");
   } catch (const std::length_error&) {

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 
 #include "mesh.h"
 
@@ -19,5 +20,10 @@ struct LoadOptions {
 // Reads `path`. Throws InputError on a missing, empty, unreadable or invalid file (no faces,
 // non-finite coordinates, indices out of range, truncated binary data, ...).
 Mesh load_mesh(const std::string& path, const LoadOptions& options = {}, MeshLoadInfo* info = nullptr);
+
+// The same checks and parsing on a file's bytes already in memory: `name` picks the reader by its
+// extension and names the file in messages (the fuzz target, tests/fuzz, uses this).
+Mesh load_mesh_from_memory(const std::string& name, std::string_view bytes, const LoadOptions& options = {},
+                           MeshLoadInfo* info = nullptr);
 
 }  // namespace nmbake

@@ -271,6 +271,9 @@ class DataReader {
     double count = read(p.count_type);
     if (count < 0 || count != std::floor(count))
       fail_here("has a list '" + p.name + "' with an invalid length " + number_text(count));
+    // Every item takes at least one byte: a longer list (an ascii 1e30 or inf included) cannot be
+    // in the file, and checking before the cast keeps it defined.
+    if (count > double(data_.size() - pos_)) truncated();
     std::uint64_t n = static_cast<std::uint64_t>(count);
     std::uint64_t item_bytes = encoding_ == Encoding::ascii ? 1 : scalar_size(p.type);
     if (n * item_bytes > data_.size() - pos_) truncated();

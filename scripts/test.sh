@@ -1,9 +1,29 @@
 #!/usr/bin/env bash
-# Command 2: install what is missing, build, and run the whole test suite with ctest.
+# Command 2: install what is missing, then run every test configuration:
+#   unit     the normal Release build (build/) and its whole test suite with ctest
+#   threads  maps byte-identical with --threads 1 and 2 (scripts/test-threads.sh)
+#   asan     an ASan+UBSan build (build-asan/) and the whole test suite again (scripts/test-sanitize.sh)
+#   fuzz     the mesh-loading fuzz target for 60 s (build-fuzz/, scripts/fuzz.sh)
+# NMBAKE_TEST_PARTS picks some of them (default "unit threads asan fuzz"); the first failing part
+# stops the run. Each part's wall time is printed at the end.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${NMBAKE_BUILD_DIR:-$root/build}
+parts=${NMBAKE_TEST_PARTS:-unit threads asan fuzz}
 bash "$root/scripts/install-deps.sh"
-bash "$root/scripts/build.sh"
-cd "$build"
-ctest --output-on-failure -j "$(nproc 2>/dev/null || echo 2)" --timeout 900
+summary=()
+for part in $parts; do
+  start=$(date +%s)
+  echo "=== test.sh: $part"
+  case "$part" in
+    unit)
+      bash "$root/scripts/build.sh"
+      (cd "$build" && ctest --output-on-failure -j "$(nproc 2>/dev/null || echo 2)" --timeout 900) ;;
+    threads) bash "$root/scripts/test-threads.sh" ;;
+    asan) bash "$root/scripts/test-sanitize.sh" ;;
+    fuzz) bash "$root/scripts/fuzz.sh" ;;
+    *) echo "error: test.sh: unknown part '$part' in NMBAKE_TEST_PARTS (unit threads asan fuzz)" >&2; exit 1 ;;
+  esac
+  summary+=("$part $(($(date +%s) - start))s")
+done
+echo "=== test.sh: all passed ($(IFS=','; echo "${summary[*]}" | sed 's/,/, /g'))"

@@ -127,6 +127,29 @@ const Defect kDefects[] = {
     {"four_vertex_facet.stl", {"facet 0 has 4 vertices"}},
     {"truncated_ascii.stl", {"truncated", "facet 1"}},
     {"truncated_binary.stl", {"truncated", "5 facets", "134 bytes"}},
+    // Issue 5, hostile input: one of each defect in every format that can carry it.
+    {"zero_bytes.ply", {"file is empty"}},
+    {"zero_bytes.off", {"file is empty"}},
+    {"zero_bytes.stl", {"file is empty"}},
+    {"nan_vertex_binary.ply", {"vertex 1 has a non-finite coordinate"}},
+    {"inf_vertex_binary.ply", {"vertex 2 has a non-finite coordinate"}},
+    {"inf_vertex.off", {"line 4", "vertex 1 has a non-finite coordinate"}},
+    {"inf_vertex_binary.stl", {"facet 0 has a non-finite coordinate"}},
+    {"non_numeric_count.ply", {"header line 3", "needs a name and a count"}},
+    {"overflow_count.ply", {"header line 3", "needs a name and a count"}},
+    {"truncated_header.ply", {"no end_header"}},
+    {"huge_list_count_binary.ply", {"truncated: file ends in face 0 of 1"}},
+    {"negative_list_count.ply", {"face 0", "invalid length -3"}},
+    {"float_index.ply", {"face 0 refers to vertex 1.5"}},
+    {"non_numeric.off", {"line 4", "vertex 1 has a malformed number 'x'"}},
+    {"non_numeric_count.off", {"line 2", "malformed vertex or face count 'four'"}},
+    {"non_numeric.stl", {"line 5", "facet 0", "malformed vertex coordinate 'zero'"}},
+    {"huge_facet_count.stl", {"truncated", "4294967295 facets", "134 bytes"}},
+    {"huge_index.obj", {"line 5", "malformed vertex index '99999999999999999999'"}},
+    {"huge_index_in_range_type.obj", {"line 5", "refers to vertex 4294967297 but the file has 3"}},
+    // Found by the fuzzer (tests/fuzz/corpus/crash_ply_list_count_3e38): an ascii list length
+    // beyond 2^64 was cast to an integer (undefined behaviour) before the size check.
+    {"huge_list_count_ascii.ply", {"truncated: file ends in face 0 of 1"}},
 };
 
 std::string defect_test_name(const ::testing::TestParamInfo<Defect>& info) {
@@ -195,6 +218,20 @@ TEST(MeshIo, NormalsAreRenormalized) {
   EXPECT_EQ(info.normals_renormalized, 2u);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(glm::length(m.corner_normal(0, c)), 1.0f, 1e-6f);
   EXPECT_NEAR(m.corner_normal(0, 1).y, std::sqrt(0.5f), 1e-6f);
+}
+
+// Found by the fuzzer (tests/fuzz/corpus/crash_ply_huge_normal): a normal whose squared length
+// overflows float came out as (0,0,0). Lengths are now taken in double.
+TEST(MeshIo, HugeNormalsAreRenormalizedNotZeroed) {
+  MeshLoadInfo info;
+  Mesh m = load_mesh(data_path("defects/huge_normals.ply"), {}, &info);
+  ASSERT_TRUE(m.has_normals());
+  EXPECT_EQ(info.normals_renormalized, 3u);
+  EXPECT_EQ(info.zero_normals, 0u);
+  const float h = std::sqrt(0.5f), t = std::sqrt(1.0f / 3.0f);
+  const glm::vec3 expected[3] = {{h, 0, h}, {0, 1, 0}, {-t, -t, -t}};
+  for (int c = 0; c < 3; ++c)
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(m.corner_normal(0, c)[k], expected[c][k], 1e-6f) << "corner " << c;
 }
 
 TEST(MeshIo, ObjRelativeIndices) {

@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer target fuzz_mesh_load (tests/fuzz) with clang, ASan and UBSan in
+# build-fuzz/ and runs it for a bounded time (NMBAKE_FUZZ_SECONDS, default 60) from the corpus in
+# tests/fuzz/corpus. New inputs go to build-fuzz/fuzz-run/corpus, never into the repository. A
+# crash, leak, timeout or out-of-memory stops the run with a non-zero exit; the input is saved in
+# build-fuzz/fuzz-run/artifacts/ (minimise it with `fuzz_mesh_load -minimize_crash=1 FILE`, fix
+# the loader, and add it to tests/fuzz/corpus and data/defects).
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=${NMBAKE_FUZZ_BUILD_DIR:-$root/build-fuzz}
+seconds=${NMBAKE_FUZZ_SECONDS:-60}
+jobs=$(nproc 2>/dev/null || echo 2)
+cxx=${NMBAKE_FUZZ_CXX:-$(command -v clang++-14 || command -v clang++ || true)}
+[ -n "$cxx" ] || { echo "error: fuzz: clang++ not found (scripts/packages.txt lists clang-14)" >&2; exit 1; }
+cmake -S "$root" -B "$build" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DNMBAKE_FUZZ=ON \
+  -DNMBAKE_TESTS=OFF -DNMBAKE_BENCH=OFF -DNMBAKE_VIEWER=OFF >/dev/null
+cmake --build "$build" -j "$jobs" --target fuzz_mesh_load
+run=$build/fuzz-run
+rm -rf "$run" && mkdir -p "$run/corpus" "$run/artifacts"
+echo "fuzz: running fuzz_mesh_load for ${seconds}s from tests/fuzz/corpus ($(ls "$root/tests/fuzz/corpus" | wc -l) seeds)"
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+"$build/tests/fuzz/fuzz_mesh_load" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=8192 \
+  -use_value_profile=1 -dict="$root/tests/fuzz/mesh.dict" -artifact_prefix="$run/artifacts/" \
+  -print_final_stats=1 "$run/corpus" "$root/tests/fuzz/corpus" 2>"$run/log.txt" || {
+  code=$?
+  tail -n 60 "$run/log.txt"
+  echo "error: fuzz: fuzz_mesh_load failed (exit $code); inputs: $(ls "$run/artifacts")" >&2
+  exit 1
+}
+grep -E '^(#[0-9]+[[:space:]]+DONE|Done|stat::)' "$run/log.txt" || tail -n 5 "$run/log.txt"
+echo "fuzz: no crash, leak or hang in ${seconds}s; $(ls "$run/corpus" | wc -l) new corpus inputs (not kept)"
