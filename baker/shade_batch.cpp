@@ -3,16 +3,20 @@
 #include <algorithm>
 #include <cmath>
 
-// The helpers below are always inlined into each clone of encode_hits_per_pixel, so no vector value
-// crosses a call and the ABI note GCC gives for 32-byte vectors does not apply.
-#pragma GCC diagnostic ignored "-Wpsabi"
+// GCC 12 reports the vectors filled lane by lane in `lanes` as "maybe uninitialized" in the AVX2
+// clone; every lane is written before use (all four are assigned at once).
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 
 namespace nmbake {
 namespace {
 
 // Four doubles, one per sample. Plain IEEE operations lane by lane: no reassociation and no fused
 // multiply-add (the project builds with ISO C++, where GCC does not contract), so each lane rounds
-// exactly as the scalar code does.
+// exactly as the scalar code does. The helpers take and give vectors by reference only: a 32-byte
+// vector passed by value would change the calling convention between the AVX2 and baseline clones
+// (clang refuses that outright).
 typedef double V __attribute__((vector_size(32)));
 constexpr int kLanes = 4;
 
@@ -20,21 +24,21 @@ struct V3 {
   V x, y, z;
 };
 
-[[gnu::always_inline]] inline V3 cross(const V3& a, const V3& b) {  // glm::cross, term for term
-  return {a.y * b.z - b.y * a.z, a.z * b.x - b.z * a.x, a.x * b.y - b.x * a.y};
+[[gnu::always_inline]] inline void cross(V3& r, const V3& a, const V3& b) {  // glm::cross, term for term
+  r.x = a.y * b.z - b.y * a.z;
+  r.y = a.z * b.x - b.z * a.x;
+  r.z = a.x * b.y - b.x * a.y;
 }
-[[gnu::always_inline]] inline V dot(const V3& a, const V3& b) {  // glm::dot: (x + y) + z of the products
-  return a.x * b.x + a.y * b.y + a.z * b.z;
+[[gnu::always_inline]] inline void dot(V& r, const V3& a, const V3& b) {  // glm::dot: (x + y) + z of the products
+  r = a.x * b.x + a.y * b.y + a.z * b.z;
 }
 // One vector from four scalars, built in registers.
 template <typename F>
-[[gnu::always_inline]] inline V lanes(F f) {
-  return V{f(0), f(1), f(2), f(3)};
+[[gnu::always_inline]] inline void lanes(V& r, F f) {
+  r = V{f(0), f(1), f(2), f(3)};
 }
-[[gnu::always_inline]] inline V vsqrt(V a) {
-  V r;
+[[gnu::always_inline]] inline void vsqrt(V& r, const V& a) {
   for (int k = 0; k < kLanes; ++k) r[k] = std::sqrt(a[k]);
-  return r;
 }
 
 }  // namespace
@@ -59,16 +63,21 @@ __attribute__((target_clones("avx2", "default"))) void encode_hits_per_pixel(
     V b[3]{}, tw[3]{};
     V3 n[3]{}, t[3]{}, hn[3]{};
     for (int c = 0; c < 3; ++c) {
-      b[c] = lanes([&](int k) { return sp[k]->b[c]; });
-      n[c] = {lanes([&](int k) { return lp[k]->n[c].x; }), lanes([&](int k) { return lp[k]->n[c].y; }),
-              lanes([&](int k) { return lp[k]->n[c].z; })};
-      t[c] = {lanes([&](int k) { return lp[k]->t[c].x; }), lanes([&](int k) { return lp[k]->t[c].y; }),
-              lanes([&](int k) { return lp[k]->t[c].z; })};
-      tw[c] = lanes([&](int k) { return lp[k]->t[c].w; });
-      hn[c] = {lanes([&](int k) { return double(hp[k][c].x); }), lanes([&](int k) { return double(hp[k][c].y); }),
-               lanes([&](int k) { return double(hp[k][c].z); })};
+      lanes(b[c], [&](int k) { return sp[k]->b[c]; });
+      lanes(n[c].x, [&](int k) { return lp[k]->n[c].x; });
+      lanes(n[c].y, [&](int k) { return lp[k]->n[c].y; });
+      lanes(n[c].z, [&](int k) { return lp[k]->n[c].z; });
+      lanes(t[c].x, [&](int k) { return lp[k]->t[c].x; });
+      lanes(t[c].y, [&](int k) { return lp[k]->t[c].y; });
+      lanes(t[c].z, [&](int k) { return lp[k]->t[c].z; });
+      lanes(tw[c], [&](int k) { return lp[k]->t[c].w; });
+      lanes(hn[c].x, [&](int k) { return double(hp[k][c].x); });
+      lanes(hn[c].y, [&](int k) { return double(hp[k][c].y); });
+      lanes(hn[c].z, [&](int k) { return double(hp[k][c].z); });
     }
-    const V u = lanes([&](int k) { return double(sp[k]->u); }), v = lanes([&](int k) { return double(sp[k]->v); });
+    V u, v;
+    lanes(u, [&](int k) { return double(sp[k]->u); });
+    lanes(v, [&](int k) { return double(sp[k]->v); });
     const V hw[3] = {1.0 - u - v, u, v};
     // interpolate_frame, per-pixel bitangent: sums start from zero as there.
     V3 fn{zero, zero, zero}, ft{zero, zero, zero};
@@ -82,7 +91,8 @@ __attribute__((target_clones("avx2", "default"))) void encode_hits_per_pixel(
       ft.z += b[c] * t[c].z;
       sign += b[c] * tw[c];
     }
-    const V3 nt = cross(fn, ft);
+    V3 nt;
+    cross(nt, fn, ft);
     const V3 fb{sign * nt.x, sign * nt.y, sign * nt.z};
     // The hit normal, interpolated with the hit's barycentrics and normalized.
     V3 h{zero, zero, zero};
@@ -91,15 +101,29 @@ __attribute__((target_clones("avx2", "default"))) void encode_hits_per_pixel(
       h.y += hw[c] * hn[c].y;
       h.z += hw[c] * hn[c].z;
     }
-    const V hlen = vsqrt(dot(h, h));
+    V hh, hlen;
+    dot(hh, h, h);
+    vsqrt(hlen, hh);
     h = {h.x / hlen, h.y / hlen, h.z / hlen};
     // encode_tangent_normal.
-    const V3 bxn = cross(fb, fn), nxt = cross(fn, ft), txb = cross(ft, fb);
-    const V det = dot(ft, bxn);
-    const V scale2 = dot(ft, ft) * dot(fb, fb) * dot(fn, fn);
-    V3 x{dot(h, bxn), dot(h, nxt), dot(h, txb)};
+    V3 bxn, nxt, txb;
+    cross(bxn, fb, fn);
+    cross(nxt, fn, ft);
+    cross(txb, ft, fb);
+    V det, tt, bb, nn;
+    dot(det, ft, bxn);
+    dot(tt, ft, ft);
+    dot(bb, fb, fb);
+    dot(nn, fn, fn);
+    const V scale2 = tt * bb * nn;
+    V3 x;
+    dot(x.x, h, bxn);
+    dot(x.y, h, nxt);
+    dot(x.z, h, txb);
     x = {x.x / det, x.y / det, x.z / det};
-    const V len = vsqrt(dot(x, x));
+    V xx, len;
+    dot(xx, x, x);
+    vsqrt(len, xx);
     const V3 r{x.x / len, x.y / len, x.z / len};
     for (int k = 0; k < kLanes && i + k < count; ++k) {
       const bool bad = !(hlen[k] > 1e-12) || !(det[k] * det[k] > 1e-24 * scale2[k]) || !std::isfinite(det[k]) ||
