@@ -33,6 +33,7 @@
 #include "bake.h"
 #include "image_io.h"
 #include "mesh_io.h"
+#include "procedural.h"
 #include "rasterize.h"
 #include "raycast.h"
 #include "tangent_frames.h"
@@ -114,36 +115,6 @@ Mesh make_height_field(int nx, int ny, const std::function<double(double, double
   return m;
 }
 
-// A latitude-longitude sphere, u = phi / 2 pi, v = 1 - theta / pi (as in tests/test_bake.cpp).
-Mesh make_sphere(int nphi, int ntheta, const std::function<double(double, double)>& radius,
-                 const std::function<glm::dvec3(double, double)>& normal) {
-  Mesh m;
-  m.source = "sphere";
-  for (int j = 0; j <= ntheta; ++j)
-    for (int i = 0; i <= nphi; ++i) {
-      const double th = kPi * j / ntheta, ph = 2 * kPi * (i % nphi) / nphi;
-      const glm::dvec3 dir(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th));
-      m.positions.push_back(glm::vec3(dir * radius(th, ph)));
-      m.normals.push_back(glm::vec3(normal(th, ph)));
-      m.uvs.push_back({float(i) / float(nphi), 1.0f - float(j) / float(ntheta)});
-    }
-  auto id = [&](int i, int j) { return std::uint32_t(j * (nphi + 1) + i); };
-  for (int j = 0; j < ntheta; ++j)
-    for (int i = 0; i < nphi; ++i) {
-      const std::uint32_t a = id(i, j), b = id(i, j + 1), c = id(i + 1, j + 1), d = id(i + 1, j);
-      std::vector<std::uint32_t> tri;
-      if (j == 0) tri = {a, b, c};
-      else if (j == ntheta - 1) tri = {a, b, d};
-      else tri = {a, b, d, b, c, d};
-      for (std::uint32_t v : tri) {
-        m.position_index.push_back(v);
-        m.uv_index.push_back(v);
-        m.normal_index.push_back(v);
-      }
-    }
-  m.source_face.assign(m.triangle_count(), 0);
-  return m;
-}
 
 Scene height_field_scene(bool quick) {
   // z = 0.05 sin(2 pi x) sin(3 pi y) on [-1,1]^2, 513 x 513 vertices, analytic normals (issue 2).
@@ -186,8 +157,8 @@ Scene displaced_sphere_scene(bool quick) {
   s.description = "r = 1 + 0.03 sin(41 theta) sin(41 phi), " + std::to_string(nphi) + "x" + std::to_string(nphi / 2) +
                   " lat-long grid with analytic normals, over a 48x24 lat-long sphere";
   s.reference = "analytic";
-  s.high = make_sphere(nphi, nphi / 2, radius, normal);
-  s.low = make_sphere(48, 24, [](double, double) { return 1.0; }, unit);
+  s.high = procedural::make_sphere(nphi, nphi / 2, radius, normal);
+  s.low = procedural::make_sphere(48, 24, [](double, double) { return 1.0; }, unit);
   s.front = s.rear = 0.05f;
   // The low-poly's vertices are unit vectors and its normals equal them, so the interpolated ray
   // normal is parallel to P: every ray is radial and meets the surface in direction P / |P|.

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "bake.h"
+#include "procedural.h"
 #include "rasterize.h"
 #include "raycast.h"
 #include "test_support.h"
@@ -12,6 +13,7 @@
 using namespace nmbake;
 using test::angle_deg;
 using test::decode_rgb;
+using procedural::make_sphere;
 
 namespace {
 
@@ -170,65 +172,6 @@ TEST(Bake, AutoDistancesCoverTheOffset) {
   EXPECT_NEAR(r.stats.hit_distance_mean, 0.03, 1e-5);
 }
 
-namespace {
-
-// A latitude-longitude sphere: nphi x ntheta quads (triangles at the poles), u = phi / 2 pi,
-// v = 1 - theta / pi, radius(theta, phi) and normal(theta, phi) given.
-template <typename R, typename N>
-Mesh make_sphere(int nphi, int ntheta, R radius, N normal) {
-  Mesh m;
-  m.source = "sphere";
-  for (int j = 0; j <= ntheta; ++j)
-    for (int i = 0; i <= nphi; ++i) {
-      const double theta = kPi * j / ntheta, phi = 2 * kPi * (i % nphi) / nphi;
-      const glm::dvec3 dir(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
-      m.positions.push_back(glm::vec3(dir * radius(theta, phi)));
-      m.normals.push_back(glm::vec3(normal(theta, phi)));
-      m.uvs.push_back({float(i) / float(nphi), 1.0f - float(j) / float(ntheta)});
-    }
-  auto id = [&](int i, int j) { return std::uint32_t(j * (nphi + 1) + i); };
-  for (int j = 0; j < ntheta; ++j)
-    for (int i = 0; i < nphi; ++i) {
-      const std::uint32_t a = id(i, j), b = id(i, j + 1), c = id(i + 1, j + 1), d = id(i + 1, j);
-      std::vector<std::uint32_t> tri;
-      if (j == 0)
-        tri = {a, b, c};  // a and d are the north pole
-      else if (j == ntheta - 1)
-        tri = {a, b, d};  // b and c are the south pole
-      else
-        tri = {a, b, d, b, c, d};
-      for (std::uint32_t v : tri) {
-        m.position_index.push_back(v);
-        m.uv_index.push_back(v);
-        m.normal_index.push_back(v);
-      }
-    }
-  m.source_face.assign(m.triangle_count(), 0);
-  return m;
-}
-
-// For every texel centre covered by `low`, the baked map decoded to a world normal with the frame
-// of the covering triangle, and the low-poly point. Calls fn(x, y, world, point).
-template <typename Fn>
-void for_each_decoded_texel(const Mesh& low, const Image& map, Fn fn) {
-  const TangentFrames frames = compute_tangent_frames(low);
-  const auto owner = rasterize_texel_triangles(low, map.width, map.height);
-  for (int y = 0; y < map.height; ++y)
-    for (int x = 0; x < map.width; ++x) {
-      const std::int32_t t = owner[std::size_t(y) * map.width + x];
-      if (t < 0) continue;
-      double b[3];
-      const TexelTriangle tri = setup_texel_triangle(low.corner_uv(t, 0), low.corner_uv(t, 1), low.corner_uv(t, 2), map.width, map.height);
-      if (!covers(tri, sample_point(x, y, 0.5, 0.5), b)) continue;
-      glm::dvec3 p(0.0);
-      for (int c = 0; c < 3; ++c) p += b[c] * glm::dvec3(low.corner_position(std::size_t(t), c));
-      const glm::dvec3 world = decode_tangent_normal(interpolate_frame(frames, std::size_t(t), b), decode_rgb(map.at(x, y)));
-      fn(x, y, world, p);
-    }
-}
-
-}  // namespace
-
 TEST(Bake, DisplacedSphereMatchesAnalyticNormal) {
   // r = 1 + a sin(k theta) sin(k phi); n ~ r e_r - r_theta e_theta - (r_phi / sin theta) e_phi.
   const double a = 0.03, k = 5;
@@ -259,7 +202,7 @@ TEST(Bake, DisplacedSphereMatchesAnalyticNormal) {
   raycast::Scene scene(&pos[0].x, pos.size(), high.position_index.data(), high.triangle_count());
   double sum = 0, worst = 0, worst_mid = 0;
   std::size_t n = 0;
-  for_each_decoded_texel(low, r.map, [&](int, int, const glm::dvec3& world, const glm::dvec3& p) {
+  test::for_each_decoded_texel(low, r.map, [&](int, int, const glm::dvec3& world, const glm::dvec3& p, std::size_t) {
     const glm::dvec3 dir = glm::normalize(p);
     const raycast::Hit h = scene.intersect({glm::vec3(p + 0.1 * dir), 0.0f, glm::vec3(-dir), 0.2f});
     if (!h.hit()) return;

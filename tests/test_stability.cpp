@@ -57,26 +57,6 @@ bool all_finite(const Image& img) {
   return true;
 }
 
-// For every texel centre covered by `low` (the lowest triangle index wins, as in the bake), the map
-// decoded to a world normal with the covering triangle's frame. fn(x, y, world, P, triangle).
-template <typename Fn>
-void for_each_decoded_texel(const Mesh& low, const Image& map, Fn fn) {
-  const TangentFrames frames = compute_tangent_frames(low);
-  const auto owner = rasterize_texel_triangles(low, map.width, map.height);
-  for (int y = 0; y < map.height; ++y)
-    for (int x = 0; x < map.width; ++x) {
-      const std::int32_t t = owner[std::size_t(y) * map.width + x];
-      if (t < 0) continue;
-      double b[3];
-      const TexelTriangle tri = setup_texel_triangle(low.corner_uv(t, 0), low.corner_uv(t, 1), low.corner_uv(t, 2), map.width, map.height);
-      if (!covers(tri, sample_point(x, y, 0.5, 0.5), b)) continue;
-      glm::dvec3 p(0.0);
-      for (int c = 0; c < 3; ++c) p += b[c] * glm::dvec3(low.corner_position(std::size_t(t), c));
-      const glm::dvec3 world = decode_tangent_normal(interpolate_frame(frames, std::size_t(t), b), decode_rgb(map.at(x, y)));
-      fn(x, y, world, p, std::size_t(t));
-    }
-}
-
 // The high-poly's interpolated normal where the ray from `origin` along `dir` first meets it.
 struct HighProbe {
   explicit HighProbe(const Mesh& m) : mesh(m), pos(m.positions), scene(&pos[0].x, pos.size(), m.position_index.data(), m.triangle_count()) {}
@@ -176,7 +156,7 @@ TEST(Stability, ZeroArea3dTrianglesDecodeToTheHighNormal) {
   const glm::dvec3 expect = glm::normalize(glm::dvec3(-0.2, -0.1, 1.0));
   double worst = 0.0;
   std::size_t on_degenerate = 0;
-  for_each_decoded_texel(low, r.map, [&](int, int, const glm::dvec3& world, const glm::dvec3&, std::size_t t) {
+  test::for_each_decoded_texel(low, r.map, [&](int, int, const glm::dvec3& world, const glm::dvec3&, std::size_t t) {
     worst = std::max(worst, angle_deg(world, expect));
     on_degenerate += t >= 32;
   });
@@ -259,7 +239,7 @@ TEST(Stability, SliversInOneSpaceDecodeToTheHighNormal) {
       EXPECT_NEAR(glm::dot(glm::vec3(f.tangent[c]), f.normal[c]), 0.0f, 1e-5f) << name;
     }
     double worst = 0.0;
-    for_each_decoded_texel(low, r.map, [&](int, int, const glm::dvec3& world, const glm::dvec3& p, std::size_t) {
+    test::for_each_decoded_texel(low, r.map, [&](int, int, const glm::dvec3& world, const glm::dvec3& p, std::size_t) {
       glm::dvec3 n;
       ASSERT_TRUE(probe.normal_at(p + glm::dvec3(0, 0, 0.1), {0, 0, -1}, 0.2f, n));
       worst = std::max(worst, angle_deg(world, n));
@@ -278,7 +258,7 @@ TEST(Stability, MirroredAndRotatedIslandsDecodeToTheSameWorldNormals) {
   const Mesh base_low = load_low("island_low.obj");
   const BakeResult base = bake_normal_map(base_low, high, nullptr, options(S, 0.2f));
   std::vector<glm::dvec3> base_world(std::size_t(S) * S, glm::dvec3(0.0));
-  for_each_decoded_texel(base_low, base.map, [&](int x, int y, const glm::dvec3& w, const glm::dvec3&, std::size_t) {
+  test::for_each_decoded_texel(base_low, base.map, [&](int x, int y, const glm::dvec3& w, const glm::dvec3&, std::size_t) {
     base_world[std::size_t(y) * S + x] = w;
   });
   struct Variant {
@@ -291,14 +271,14 @@ TEST(Stability, MirroredAndRotatedIslandsDecodeToTheSameWorldNormals) {
     const Mesh low = load_low(v.file);
     const BakeResult r = bake_normal_map(low, high, nullptr, options(S, 0.2f));
     std::vector<glm::dvec3> world(std::size_t(S) * S, glm::dvec3(0.0));
-    for_each_decoded_texel(low, r.map, [&](int x, int y, const glm::dvec3& w, const glm::dvec3&, std::size_t) {
+    test::for_each_decoded_texel(low, r.map, [&](int x, int y, const glm::dvec3& w, const glm::dvec3&, std::size_t) {
       world[std::size_t(y) * S + x] = w;
     });
     // 8-bit copy of the variant map, decoded the same way.
     Image q = r.map;
     for (float& c : q.pixels) c = float(double(quantize8(c)) / 255.0);
     std::vector<glm::dvec3> world8(std::size_t(S) * S, glm::dvec3(0.0));
-    for_each_decoded_texel(low, q, [&](int x, int y, const glm::dvec3& w, const glm::dvec3&, std::size_t) {
+    test::for_each_decoded_texel(low, q, [&](int x, int y, const glm::dvec3& w, const glm::dvec3&, std::size_t) {
       world8[std::size_t(y) * S + x] = w;
     });
     double worst = 0.0, worst8 = 0.0;
@@ -436,7 +416,7 @@ TEST(Stability, GrazingRaysHitTheSteepFacesWithoutLeaks) {
   EXPECT_TRUE(all_finite(r.map));
   double worst = 0.0;
   std::size_t n_rising = 0, n = 0;
-  for_each_decoded_texel(low, r.map, [&](int, int, const glm::dvec3& w, const glm::dvec3&, std::size_t) {
+  test::for_each_decoded_texel(low, r.map, [&](int, int, const glm::dvec3& w, const glm::dvec3&, std::size_t) {
     const double a = angle_deg(w, rising), b = angle_deg(w, falling);
     worst = std::max(worst, std::min(a, b));
     n_rising += a < b;
@@ -506,7 +486,7 @@ TEST(Stability, HighPolyInsideOrOutsideTheLowPoly) {
     EXPECT_EQ(h.stats.misses, 0u) << name;
     const HighProbe probe(high);
     double worst = 0.0;
-    for_each_decoded_texel(low, h.map, [&](int, int, const glm::dvec3& w, const glm::dvec3& p, std::size_t) {
+    test::for_each_decoded_texel(low, h.map, [&](int, int, const glm::dvec3& w, const glm::dvec3& p, std::size_t) {
       // The ray direction is the interpolated position-averaged normal; on this sphere that is the
       // interpolated radial normal, close to normalize(p). Compare with the high normal along it.
       glm::dvec3 n;
@@ -533,7 +513,7 @@ TEST(Stability, TwoLayersFollowThePolicyDeterministically) {
   const glm::dvec3 upper = glm::normalize(glm::dvec3(0.3, 0, 1)), lower = glm::normalize(glm::dvec3(0, 0.3, 1));
   auto check_all = [&](const BakeResult& r, const glm::dvec3& expect, const char* what) {
     double worst = 0.0;
-    for_each_decoded_texel(low, r.map, [&](int, int, const glm::dvec3& w, const glm::dvec3&, std::size_t) {
+    test::for_each_decoded_texel(low, r.map, [&](int, int, const glm::dvec3& w, const glm::dvec3&, std::size_t) {
       worst = std::max(worst, angle_deg(w, expect));
     });
     EXPECT_LT(worst, 1e-3) << what;
@@ -572,7 +552,7 @@ TEST(Stability, UvTilesBakeOnlyTheMapRegionAndWarn) {
   EXPECT_EQ(r.stats.texels_covered, covered);
   const glm::dvec3 expect = glm::normalize(glm::dvec3(-0.2, -0.1, 1.0));
   double worst = 0.0;
-  for_each_decoded_texel(low, r.map, [&](int, int, const glm::dvec3& w, const glm::dvec3&, std::size_t) {
+  test::for_each_decoded_texel(low, r.map, [&](int, int, const glm::dvec3& w, const glm::dvec3&, std::size_t) {
     worst = std::max(worst, angle_deg(w, expect));
   });
   EXPECT_LT(worst, 1e-3);
@@ -622,10 +602,10 @@ TEST(Stability, HardEdgesOpenNoGapsAndNoCracks) {
     EXPECT_TRUE(all_finite(r.map)) << name;
     // Along a row, the azimuth of the decoded normal (the cylinder's radial normal where the ray
     // hit) must rise steadily through 360 degrees: split rays at an edge would jump back ~23 deg.
-    for_each_decoded_texel(low, r.map, [](int, int, const glm::dvec3&, const glm::dvec3&, std::size_t) {});
+    test::for_each_decoded_texel(low, r.map, [](int, int, const glm::dvec3&, const glm::dvec3&, std::size_t) {});
     std::vector<double> az(128, 0.0);
     std::vector<double> z(128, 0.0);
-    for_each_decoded_texel(low, r.map, [&](int x, int y, const glm::dvec3& w, const glm::dvec3&, std::size_t) {
+    test::for_each_decoded_texel(low, r.map, [&](int x, int y, const glm::dvec3& w, const glm::dvec3&, std::size_t) {
       if (y != 16) return;
       az[std::size_t(x)] = std::atan2(w.y, w.x) * 180.0 / 3.14159265358979323846;
       z[std::size_t(x)] = w.z;
@@ -676,7 +656,7 @@ TEST(Stability, NonManifoldFinsGiveTheFirstHit) {
   EXPECT_TRUE(all_finite(r.map));
   const glm::dvec3 fin = glm::normalize(glm::dvec3(0.9, 0, -0.6));
   std::size_t wrong = 0;
-  for_each_decoded_texel(low, r.map, [&](int, int, const glm::dvec3& w, const glm::dvec3& p, std::size_t) {
+  test::for_each_decoded_texel(low, r.map, [&](int, int, const glm::dvec3& w, const glm::dvec3& p, std::size_t) {
     // 0 < x < 0.2: the slanted fin lies above the plane; elsewhere the plane (+Z).
     const glm::dvec3 expect = (p.x > 0.0 && p.x < 0.2) ? fin : glm::dvec3(0, 0, 1);
     wrong += angle_deg(w, expect) > 1e-3;

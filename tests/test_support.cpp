@@ -5,6 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include "rasterize.h"
+#include "tangent_frames.h"
+
 namespace nmbake::test {
 
 std::string data_path(const std::string& relative) { return std::string(NMBAKE_DATA_DIR) + "/" + relative; }
@@ -91,6 +94,25 @@ glm::dvec3 decode_rgb(const float* c) {
   const glm::dvec3 v(2.0 * c[0] - 1.0, 2.0 * c[1] - 1.0, 2.0 * c[2] - 1.0);
   const double len = glm::length(v);
   return len > 0.0 ? v / len : v;
+}
+
+void for_each_decoded_texel(
+    const Mesh& low, const Image& map,
+    const std::function<void(int x, int y, const glm::dvec3& world, const glm::dvec3& point, std::size_t triangle)>& fn) {
+  const TangentFrames frames = compute_tangent_frames(low);
+  const auto owner = rasterize_texel_triangles(low, map.width, map.height);
+  for (int y = 0; y < map.height; ++y)
+    for (int x = 0; x < map.width; ++x) {
+      const std::int32_t t = owner[std::size_t(y) * map.width + x];
+      if (t < 0) continue;
+      double b[3];
+      const TexelTriangle tri = setup_texel_triangle(low.corner_uv(t, 0), low.corner_uv(t, 1), low.corner_uv(t, 2), map.width, map.height);
+      if (!covers(tri, sample_point(x, y, 0.5, 0.5), b)) continue;
+      glm::dvec3 p(0.0);
+      for (int c = 0; c < 3; ++c) p += b[c] * glm::dvec3(low.corner_position(std::size_t(t), c));
+      const glm::dvec3 world = decode_tangent_normal(interpolate_frame(frames, std::size_t(t), b), decode_rgb(map.at(x, y)));
+      fn(x, y, world, p, std::size_t(t));
+    }
 }
 
 }  // namespace nmbake::test

@@ -1,7 +1,13 @@
 // Helpers shared by the test programs: data paths, scratch folders, procedural meshes.
 #pragma once
 
+#include <cstddef>
+#include <functional>
 #include <string>
+
+#include <glm/glm.hpp>
+
+#include "image.h"
 
 #include "mesh.h"
 
@@ -44,5 +50,12 @@ double angle_deg(const glm::dvec3& a, const glm::dvec3& b);
 
 // Decodes an encoded map value c in [0,1]^3 to a unit tangent-space vector.
 glm::dvec3 decode_rgb(const float* c);
+
+// For every texel centre covered by `low` (the lowest triangle index wins, as in the bake), the
+// tangent-space `map` decoded to a world normal with the covering triangle's frame: calls
+// fn(x, y, world, P, triangle) with P the low-poly point under the texel centre.
+void for_each_decoded_texel(
+    const Mesh& low, const Image& map,
+    const std::function<void(int x, int y, const glm::dvec3& world, const glm::dvec3& point, std::size_t triangle)>& fn);
 
 }  // namespace nmbake::test

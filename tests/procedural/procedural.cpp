@@ -1,0 +1,43 @@
+#include "procedural.h"
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+namespace nmbake::procedural {
+
+Mesh make_sphere(int nphi, int ntheta, const std::function<double(double, double)>& radius,
+                 const std::function<glm::dvec3(double, double)>& normal) {
+  constexpr double kPi = 3.14159265358979323846;
+  Mesh m;
+  m.source = "sphere";
+  for (int j = 0; j <= ntheta; ++j)
+    for (int i = 0; i <= nphi; ++i) {
+      const double theta = kPi * j / ntheta, phi = 2 * kPi * (i % nphi) / nphi;
+      const glm::dvec3 dir(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
+      m.positions.push_back(glm::vec3(dir * radius(theta, phi)));
+      m.normals.push_back(glm::vec3(normal(theta, phi)));
+      m.uvs.push_back({float(i) / float(nphi), 1.0f - float(j) / float(ntheta)});
+    }
+  auto id = [&](int i, int j) { return std::uint32_t(j * (nphi + 1) + i); };
+  for (int j = 0; j < ntheta; ++j)
+    for (int i = 0; i < nphi; ++i) {
+      const std::uint32_t a = id(i, j), b = id(i, j + 1), c = id(i + 1, j + 1), d = id(i + 1, j);
+      std::vector<std::uint32_t> tri;
+      if (j == 0)
+        tri = {a, b, c};  // a and d are the north pole
+      else if (j == ntheta - 1)
+        tri = {a, b, d};  // b and c are the south pole
+      else
+        tri = {a, b, d, b, c, d};
+      for (std::uint32_t v : tri) {
+        m.position_index.push_back(v);
+        m.uv_index.push_back(v);
+        m.normal_index.push_back(v);
+      }
+    }
+  m.source_face.assign(m.triangle_count(), 0);
+  return m;
+}
+
+}  // namespace nmbake::procedural

@@ -1,0 +1,18 @@
+// Procedural meshes shared by the tests and the benchmarks (no test framework here, so the bench
+// programs can link it with the tests switched off).
+#pragma once
+
+#include <functional>
+
+#include <glm/glm.hpp>
+
+#include "mesh.h"
+
+namespace nmbake::procedural {
+
+// A latitude-longitude sphere: nphi x ntheta quads (triangles at the poles), u = phi / 2 pi,
+// v = 1 - theta / pi, with radius(theta, phi) and per-vertex normal(theta, phi).
+Mesh make_sphere(int nphi, int ntheta, const std::function<double(double theta, double phi)>& radius,
+                 const std::function<glm::dvec3(double theta, double phi)>& normal);
+
+}  // namespace nmbake::procedural
