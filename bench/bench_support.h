@@ -26,9 +26,13 @@ struct Timing {
   void keep_min(const Timing& t) { keep_min(t.wall, t.cpu); }
 };
 
-// Casts `rays` with `threads` threads in chunks of 4096, nothing but Embree calls: one
-// rtcIntersect1 per ray (packets = false) or Scene::intersect's 8-wide packets.
-Timing bare_loop(const raycast::Scene& scene, const std::vector<raycast::Ray>& rays, int threads, bool packets);
+// How a bare loop hands the rays to Embree: one rtcIntersect1 per ray, 8-wide packets filled from
+// the Ray structs (Scene::intersect(const Ray*, ...)), or 8-wide packets from rays already held as
+// arrays (raycast::RayBatch, the bake's own layout; the arrays are filled before the clock starts).
+enum class Bare { single, packets, arrays };
+
+// Casts `rays` with `threads` threads in chunks of 4096, nothing but Embree calls.
+Timing bare_loop(const raycast::Scene& scene, const std::vector<raycast::Ray>& rays, int threads, Bare mode);
 
 // What the run is measured on: date, CPU, cores, memory, load, the commit of the source tree.
 struct Machine {

@@ -148,4 +148,58 @@ void Scene::intersect(const Ray* rays, Hit* hits, std::size_t count) const {
   }
 }
 
+void Scene::intersect(const RayBatch& rays, const HitBatch& hits, std::size_t count) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  alignas(32) RTCRayHit8 rh;
+  alignas(32) int valid[8];
+  // Fields no ray sets, once.
+  for (int k = 0; k < 8; ++k) {
+    rh.ray.time[k] = 0.0f;
+    rh.ray.mask[k] = 0xffffffffu;
+    rh.ray.id[k] = unsigned(k);
+    rh.ray.flags[k] = 0;
+  }
+  for (std::size_t base = 0; base < count; base += 8) {
+    const std::size_t n = std::min<std::size_t>(8, count - base);
+    auto fill = [&](float* to, const float* from) {
+      if (n == 8) {
+        std::memcpy(to, from + base, 8 * sizeof(float));
+      } else {
+        for (std::size_t k = 0; k < 8; ++k) to[k] = from[base + std::min(k, n - 1)];  // a short last packet repeats its last ray
+      }
+    };
+    fill(rh.ray.org_x, rays.org_x);
+    fill(rh.ray.org_y, rays.org_y);
+    fill(rh.ray.org_z, rays.org_z);
+    fill(rh.ray.dir_x, rays.dir_x);
+    fill(rh.ray.dir_y, rays.dir_y);
+    fill(rh.ray.dir_z, rays.dir_z);
+    fill(rh.ray.tnear, rays.tnear);
+    fill(rh.ray.tfar, rays.tfar);
+    for (std::size_t k = 0; k < 8; ++k) {
+      valid[k] = k < n ? -1 : 0;
+      rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect8(valid, impl_->scene, &context, &rh);
+    for (std::size_t k = 0; k < 8; ++k)
+      rh.hit.primID[k] = rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID ? rh.hit.primID[k] : no_hit;
+    if (n == 8) {
+      std::memcpy(hits.triangle + base, rh.hit.primID, 8 * sizeof(std::uint32_t));
+      std::memcpy(hits.t + base, rh.ray.tfar, 8 * sizeof(float));
+      std::memcpy(hits.u + base, rh.hit.u, 8 * sizeof(float));
+      std::memcpy(hits.v + base, rh.hit.v, 8 * sizeof(float));
+    } else {
+      for (std::size_t k = 0; k < n; ++k) {
+        hits.triangle[base + k] = rh.hit.primID[k];
+        hits.t[base + k] = rh.ray.tfar[k];
+        hits.u[base + k] = rh.hit.u[k];
+        hits.v[base + k] = rh.hit.v[k];
+      }
+    }
+  }
+}
+
 }  // namespace nmbake::raycast

@@ -31,6 +31,19 @@ struct Hit {
   bool hit() const { return triangle != no_hit; }
 };
 
+// Many rays as a structure of arrays (each array `count` long), the layout Embree's packets use,
+// so a batch goes to Embree 8 rays at a time without rearranging each ray's fields.
+struct RayBatch {
+  const float *org_x, *org_y, *org_z;
+  const float *dir_x, *dir_y, *dir_z;  // need not be unit; t is in units of |direction|
+  const float *tnear, *tfar;
+};
+// Their hits, the same way: triangle[i] is no_hit for a miss (t, u, v then unspecified).
+struct HitBatch {
+  std::uint32_t* triangle;
+  float *t, *u, *v;
+};
+
 enum class BuildQuality { low, medium, high };
 
 class Scene {
@@ -47,6 +60,8 @@ class Scene {
   Hit intersect(const Ray& ray) const;
   // `count` independent rays, traced as 8-wide packets (rays need not be coherent). Thread-safe.
   void intersect(const Ray* rays, Hit* hits, std::size_t count) const;
+  // The same for rays and hits held as arrays. Thread-safe.
+  void intersect(const RayBatch& rays, const HitBatch& hits, std::size_t count) const;
 
   std::size_t triangle_count() const;
 
