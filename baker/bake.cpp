@@ -20,8 +20,6 @@
 #include "normals.h"
 #include "padding.h"
 #include "rasterize.h"
-#include "rasterize_batch.h"
-#include "ray_batch.h"
 #include "raycast.h"
 #include "shade_batch.h"
 
@@ -527,8 +525,6 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   if (opt.miss_mask) result.miss_mask = Image(W, H, 1, 0.0f);
   const std::vector<glm::dvec2> offsets = sample_offsets(opt.samples);
   const int S = int(offsets.size());
-  std::vector<double> offset_x, offset_y;  // the offsets' coordinates, for cover_tile
-  for (const glm::dvec2& o : offsets) offset_x.push_back(o.x), offset_y.push_back(o.y);
   const bool closest = opt.policy == RayPolicy::closest && !cage;
   const int rays_per_sample = closest ? 2 : 1;
 
@@ -556,41 +552,21 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
 
   auto worker = [&](int id) {
     ThreadStats& ts = tstats[id];
-    const std::size_t slot_count = std::size_t(kTile) * kTile * S;
-    std::vector<std::int32_t> slot_tri(slot_count);  // per sample slot: its triangle, or -1
-    std::vector<double> slot_bary(3 * slot_count);    // per sample slot: its barycentrics
-    const TileSlots slots{slot_tri.data(), slot_bary.data()};
+    struct Slot {
+      std::int32_t tri;
+      double b[3];
+    };
+    std::vector<Slot> slots(std::size_t(kTile) * kTile * S);
     // Sized once for a full tile; each tile fills the first `ray_count` / `sample_count` entries.
-    // Per covered sample, in slot order: its slot, triangle, barycentrics, the hit that counts
-    // and its shaded value (other = 1: take the one-at-a-time path).
-    std::vector<std::uint32_t> cs_slot(slot_count), cs_tri(slot_count);
-    std::vector<double> cs_b0(slot_count), cs_b1(slot_count), cs_b2(slot_count), cs_value(3 * slot_count);
-    std::vector<std::uint8_t> cs_other(slot_count);
-    std::vector<std::uint32_t> ch_tri(slot_count);
-    std::vector<float> ch_u(slot_count), ch_v(slot_count);
-    std::vector<double> ch_dist(slot_count);  // signed distance of the hit from the low-poly (positive: outside)
-    // Per ray, as arrays, and its distance from P to the ray origin along the ray.
-    const std::size_t ray_capacity = slot_count * std::size_t(rays_per_sample);
-    std::vector<float> ray_field(8 * ray_capacity), hit_field(3 * ray_capacity);
-    std::vector<std::uint32_t> hit_tri(ray_capacity);
-    std::vector<double> signed_base(ray_capacity);
-    float* rf = ray_field.data();
-    const RayArrays ray_arrays{rf, rf + ray_capacity, rf + 2 * ray_capacity, rf + 3 * ray_capacity, rf + 4 * ray_capacity,
-                               rf + 5 * ray_capacity, rf + 6 * ray_capacity, rf + 7 * ray_capacity};
-    const raycast::RayBatch ray_batch{ray_arrays.org_x, ray_arrays.org_y, ray_arrays.org_z, ray_arrays.dir_x,
-                                      ray_arrays.dir_y, ray_arrays.dir_z, ray_arrays.tnear, ray_arrays.tfar};
-    const raycast::HitBatch hit_batch{hit_tri.data(), hit_field.data(), hit_field.data() + ray_capacity,
-                                      hit_field.data() + 2 * ray_capacity};
-    auto set_ray = [&](std::size_t i, const raycast::Ray& r) {
-      ray_arrays.org_x[i] = r.origin.x, ray_arrays.org_y[i] = r.origin.y, ray_arrays.org_z[i] = r.origin.z;
-      ray_arrays.dir_x[i] = r.direction.x, ray_arrays.dir_y[i] = r.direction.y, ray_arrays.dir_z[i] = r.direction.z;
-      ray_arrays.tnear[i] = r.tnear, ray_arrays.tfar[i] = r.tfar;
-    };
-    auto hit_of = [&](std::size_t i) {
-      raycast::Hit h;
-      if (hit_tri[i] != raycast::no_hit) h = {hit_tri[i], hit_batch.t[i], hit_batch.u[i], hit_batch.v[i]};
-      return h;
-    };
+    std::vector<raycast::Ray> rays(slots.size() * rays_per_sample);
+    std::vector<raycast::Hit> hits(rays.size());
+    std::vector<std::uint32_t> slot_of_ray(slots.size());  // per covered sample: its slot
+    std::vector<double> signed_base(rays.size());  // per ray: distance from P to the ray origin along the ray
+    std::vector<const raycast::Hit*> chosen(slots.size());  // per covered sample: the hit that counts
+    std::vector<std::int32_t> batch_of(slots.size());       // per covered sample: its batch entry, or -1
+    std::vector<HitSample> batch(slots.size());
+    std::vector<glm::dvec3> batch_value(slots.size());
+    std::vector<std::uint8_t> batch_degenerate(slots.size());
     std::vector<glm::dvec4> acc(std::size_t(kTile) * kTile);  // xyz sum, w = covered samples
     std::vector<std::uint32_t> miss_count(std::size_t(kTile) * kTile);
     for (std::size_t tile; !cancel.load(std::memory_order_relaxed) && (tile = next_tile.fetch_add(1)) < tile_count;) {
@@ -601,103 +577,91 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
         ++tiles_done;
         continue;  // no triangle touches this tile: it costs nothing
       }
-      std::fill(slot_tri.begin(), slot_tri.end(), -1);
+      for (Slot& sl : slots) sl.tri = -1;
       // Rasterize: the lowest triangle index wins a sample covered twice (overlapping islands).
       for (std::uint32_t bi = b0; bi < b1; ++bi) {
         const std::uint32_t t = bin_tris[bi];
         const TexelTriangle& tt = texel_tris[t];
         const int x0 = std::max(tt.xmin, tx0), x1 = std::min(tt.xmax, tx0 + tw - 1);
         const int y0 = std::max(tt.ymin, ty0), y1 = std::min(tt.ymax, ty0 + th - 1);
-        if (x0 <= x1 && y0 <= y1)
-          ts.overlaps += cover_tile(tt, std::int32_t(t), tx0, ty0, kTile, x0, x1, y0, y1, offset_x.data(), offset_y.data(), S, slots);
+        for (int y = y0; y <= y1; ++y)
+          for (int x = x0; x <= x1; ++x)
+            for (int k = 0; k < S; ++k) {
+              double b[3];
+              if (!covers(tt, sample_point(x, y, offsets[k].x, offsets[k].y), b)) continue;
+              Slot& sl = slots[(std::size_t(y - ty0) * kTile + (x - tx0)) * S + k];
+              if (sl.tri >= 0) {
+                ++ts.overlaps;
+                continue;
+              }
+              sl.tri = std::int32_t(t);
+              sl.b[0] = b[0];
+              sl.b[1] = b[1];
+              sl.b[2] = b[2];
+            }
       }
-      // The covered samples, in slot order.
-      std::size_t sample_count = 0;
-      for (std::uint32_t si = 0; si < slot_count; ++si) {
-        if (slot_tri[si] < 0) continue;
-        cs_slot[sample_count] = si;
-        cs_tri[sample_count] = std::uint32_t(slot_tri[si]);
-        cs_b0[sample_count] = slot_bary[3 * si];
-        cs_b1[sample_count] = slot_bary[3 * si + 1];
-        cs_b2[sample_count] = slot_bary[3 * si + 2];
-        ++sample_count;
+      // Rays for the covered samples.
+      std::size_t ray_count = 0, sample_count = 0;
+      for (std::uint32_t si = 0; si < slots.size(); ++si) {
+        const Slot& sl = slots[si];
+        if (sl.tri < 0) continue;
+        ray_count += std::size_t(sample_rays(s, std::size_t(sl.tri), sl.b, ray_setup, &rays[ray_count], &signed_base[ray_count]));
+        slot_of_ray[sample_count++] = si;
       }
-      const SampleArrays cs{cs_tri.data(), cs_b0.data(), cs_b1.data(), cs_b2.data()};
-      // Their rays: the default policy many at a time (ray_batch.h), the others and the fallbacks
-      // one at a time.
-      const std::size_t ray_count = sample_count * std::size_t(rays_per_sample);
-      auto one_sample_rays = [&](std::size_t r) {
-        raycast::Ray two[2];
-        const double b[3] = {cs_b0[r], cs_b1[r], cs_b2[r]};
-        const int n = sample_rays(s, cs_tri[r], b, ray_setup, two, &signed_base[r * rays_per_sample]);
-        for (int j = 0; j < n; ++j) set_ray(r * rays_per_sample + std::size_t(j), two[j]);
-      };
-      if (!cage && !closest) {
-        surface_rays(low_tris.data(), cs, sample_count, st.front, st.rear, ray_arrays, cs_other.data());
-        for (std::size_t r = 0; r < sample_count; ++r) {
-          signed_base[r] = double(st.front);
-          if (cs_other[r]) one_sample_rays(r);
-        }
-      } else {
-        for (std::size_t r = 0; r < sample_count; ++r) one_sample_rays(r);
-      }
-      if (ray_count) scene->intersect(ray_batch, hit_batch, ray_count);
+      if (ray_count) scene->intersect(rays.data(), hits.data(), ray_count);
       if (opt.record_rays) {
         std::lock_guard<std::mutex> lock(record_mutex);
-        for (std::size_t i = 0; i < ray_count; ++i)
-          opt.record_rays->push_back({{ray_batch.org_x[i], ray_batch.org_y[i], ray_batch.org_z[i]}, ray_batch.tnear[i],
-                                      {ray_batch.dir_x[i], ray_batch.dir_y[i], ray_batch.dir_z[i]}, ray_batch.tfar[i]});
+        opt.record_rays->insert(opt.record_rays->end(), rays.begin(), rays.begin() + std::ptrdiff_t(ray_count));
       }
       ts.rays += ray_count;
       // The hit triangles' corner normals are scattered over the high-poly: ask for them all before
       // shading needs the first, so the cache misses overlap.
       for (std::size_t r = 0; r < ray_count; ++r)
-        if (hit_tri[r] != raycast::no_hit) {
-          const char* line = reinterpret_cast<const char*>(&s.bvh_normals[3 * std::size_t(hit_tri[r])]);
+        if (hits[r].hit()) {
+          const char* line = reinterpret_cast<const char*>(&s.bvh_normals[3 * std::size_t(hits[r].triangle)]);
           __builtin_prefetch(line);
           __builtin_prefetch(line + sizeof(glm::vec3) * 3 - 1);
         }
-      // Which ray's hit counts, per sample, and its signed distance from the low-poly.
-      for (std::size_t r = 0; r < sample_count; ++r) {
-        raycast::Hit pair[2];
-        for (int j = 0; j < rays_per_sample; ++j) pair[j] = hit_of(r * rays_per_sample + std::size_t(j));
-        const raycast::Hit& h = chosen_hit(pair, &signed_base[r * rays_per_sample], closest, &ch_dist[r]);
-        ch_tri[r] = h.triangle, ch_u[r] = h.u, ch_v[r] = h.v;
-      }
-      // Shade: the high-poly normal at the hit, in the low-poly's tangent frame at P; the common
-      // case (tangent space, per-pixel bitangent) for all hits at once (shade_batch.h); then, in
-      // sample order, the statistics and each sample's value into its texel.
-      if (batched && sample_count)
-        encode_hits_per_pixel(low_tris.data(), s.bvh_normals, cs, {ch_tri.data(), ch_u.data(), ch_v.data()}, sample_count,
-                              cs_value.data(), cs_other.data());
+      // Shade: the high-poly normal at the hit, in the low-poly's tangent frame at P. First, in
+      // sample order, which ray's hit counts and the hit statistics; then the common case (tangent
+      // space, per-pixel bitangent) for all hits at once; then each sample's value into its texel.
       std::fill(acc.begin(), acc.end(), glm::dvec4(0.0));
       std::fill(miss_count.begin(), miss_count.end(), 0u);
+      std::size_t batch_count = 0;
       double dsum = 0.0;
       for (std::size_t r = 0; r < sample_count; ++r) {
-        const std::uint32_t si = cs_slot[r];
+        double dist = 0.0;
+        const raycast::Hit* h =
+            &chosen_hit(&hits[r * rays_per_sample], &signed_base[r * rays_per_sample], closest, &dist);
+        chosen[r] = h;
+        batch_of[r] = -1;
         ++ts.covered;
-        raycast::Hit h;
-        if (ch_tri[r] != raycast::no_hit) {
-          const double dist = ch_dist[r];
+        if (h->hit()) {
           ++ts.hits;
           ts.dmin = std::min(ts.dmin, dist);
           ts.dmax = std::max(ts.dmax, dist);
           dsum += dist;
-          h.triangle = ch_tri[r], h.u = ch_u[r], h.v = ch_v[r];
+          if (batched) {
+            const Slot& sl = slots[slot_of_ray[r]];
+            batch_of[r] = std::int32_t(batch_count);
+            batch[batch_count++] = {{sl.b[0], sl.b[1], sl.b[2]}, std::uint32_t(sl.tri), h->triangle, h->u, h->v};
+          }
         } else {
           ++ts.misses;
-          ++miss_count[si / S];
+          ++miss_count[slot_of_ray[r] / S];
         }
-        glm::dvec3 value;
-        if (batched && !cs_other[r]) {
-          value = glm::dvec3(cs_value[3 * r], cs_value[3 * r + 1], cs_value[3 * r + 2]);
-        } else {
-          const double b[3] = {cs_b0[r], cs_b1[r], cs_b2[r]};
-          value = shade_sample(s, cs_tri[r], b, h, opt);
-        }
-        acc[si / S] += glm::dvec4(value, 1.0);
       }
       tile_dsum[tile] = dsum;
+      if (batch_count)
+        encode_hits_per_pixel(low_tris.data(), s.bvh_normals, batch.data(), batch_count,
+                              batch_value.data(), batch_degenerate.data());
+      for (std::size_t r = 0; r < sample_count; ++r) {
+        const std::uint32_t si = slot_of_ray[r];
+        const std::int32_t bi = batch_of[r];
+        const glm::dvec3 value =
+            bi >= 0 && !batch_degenerate[std::size_t(bi)] ? batch_value[std::size_t(bi)] : shade_sample(s, std::size_t(slots[si].tri), slots[si].b, *chosen[r], opt);
+        acc[si / S] += glm::dvec4(value, 1.0);
+      }
       // Texels: renormalized mean of their covered samples.
       for (int y = 0; y < th; ++y)
         for (int x = 0; x < tw; ++x) {

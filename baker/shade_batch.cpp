@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "raycast.h"
-
 // GCC 12 reports the vectors filled lane by lane in `lanes` as "maybe uninitialized" in the AVX2
 // clone; every lane is written before use (all four are assigned at once).
 #if defined(__GNUC__) && !defined(__clang__)
@@ -39,8 +37,6 @@ template <typename F>
 [[gnu::always_inline]] inline void lanes(V& r, F f) {
   r = V{f(0), f(1), f(2), f(3)};
 }
-// One scalar in every lane (a broadcast, not 0 + x, which would turn -0 into +0).
-[[gnu::always_inline]] inline void splat(V& r, double x) { r = V{x, x, x, x}; }
 [[gnu::always_inline]] inline void vsqrt(V& r, const V& a) {
   for (int k = 0; k < kLanes; ++k) r[k] = std::sqrt(a[k]);
 }
@@ -50,59 +46,38 @@ template <typename F>
 // Two versions, chosen once at load time by the CPU: AVX2 (4 lanes per instruction) and the
 // baseline (2 lanes per SSE2 instruction). Neither uses FMA, so both give the scalar code's bits.
 __attribute__((target_clones("avx2", "default"))) void encode_hits_per_pixel(
-    const LowTriangle* low, const glm::vec3* high_corner_normals, const SampleArrays& samples, const SampleHits& hits,
-    std::size_t count, double* value, std::uint8_t* other) {
+    const LowTriangle* low, const glm::vec3* high_corner_normals, const HitSample* samples, std::size_t count,
+    glm::dvec3* value, std::uint8_t* degenerate) {
   const V zero = {0.0, 0.0, 0.0, 0.0};
-  static const glm::vec3 no_normals[3] = {};  // read for a missed sample's lane (flagged, never used)
   for (std::size_t i = 0; i < count; i += kLanes) {
     // Gather, building each vector from four scalars in registers (lane stores followed by a
     // vector load would stall on store forwarding). A short last block repeats its last sample.
-    std::size_t idx[kLanes];
+    const HitSample* sp[kLanes];
+    const LowTriangle* lp[kLanes];
     const glm::vec3* hp[kLanes];
     for (int k = 0; k < kLanes; ++k) {
-      idx[k] = std::min(i + std::size_t(k), count - 1);
-      const std::uint32_t ht = hits.tri[idx[k]];
-      hp[k] = ht == raycast::no_hit ? no_normals : &high_corner_normals[3 * std::size_t(ht)];
+      sp[k] = &samples[std::min(i + std::size_t(k), count - 1)];
+      lp[k] = &low[sp[k]->low_tri];
+      hp[k] = &high_corner_normals[3 * std::size_t(sp[k]->high_tri)];
     }
     V b[3]{}, tw[3]{};
     V3 n[3]{}, t[3]{}, hn[3]{};
-    lanes(b[0], [&](int k) { return samples.b0[idx[k]]; });
-    lanes(b[1], [&](int k) { return samples.b1[idx[k]]; });
-    lanes(b[2], [&](int k) { return samples.b2[idx[k]]; });
-    const std::uint32_t t0 = samples.tri[idx[0]];
-    if (samples.tri[idx[1]] == t0 && samples.tri[idx[2]] == t0 && samples.tri[idx[3]] == t0) {
-      // The common case, four samples of one triangle: its corners in every lane.
-      const LowTriangle& lt = low[t0];
-      for (int c = 0; c < 3; ++c) {
-        splat(n[c].x, lt.n[c].x);
-        splat(n[c].y, lt.n[c].y);
-        splat(n[c].z, lt.n[c].z);
-        splat(t[c].x, lt.t[c].x);
-        splat(t[c].y, lt.t[c].y);
-        splat(t[c].z, lt.t[c].z);
-        splat(tw[c], lt.t[c].w);
-      }
-    } else {
-      const LowTriangle* lp[kLanes];
-      for (int k = 0; k < kLanes; ++k) lp[k] = &low[samples.tri[idx[k]]];
-      for (int c = 0; c < 3; ++c) {
-        lanes(n[c].x, [&](int k) { return lp[k]->n[c].x; });
-        lanes(n[c].y, [&](int k) { return lp[k]->n[c].y; });
-        lanes(n[c].z, [&](int k) { return lp[k]->n[c].z; });
-        lanes(t[c].x, [&](int k) { return lp[k]->t[c].x; });
-        lanes(t[c].y, [&](int k) { return lp[k]->t[c].y; });
-        lanes(t[c].z, [&](int k) { return lp[k]->t[c].z; });
-        lanes(tw[c], [&](int k) { return lp[k]->t[c].w; });
-      }
-    }
     for (int c = 0; c < 3; ++c) {
+      lanes(b[c], [&](int k) { return sp[k]->b[c]; });
+      lanes(n[c].x, [&](int k) { return lp[k]->n[c].x; });
+      lanes(n[c].y, [&](int k) { return lp[k]->n[c].y; });
+      lanes(n[c].z, [&](int k) { return lp[k]->n[c].z; });
+      lanes(t[c].x, [&](int k) { return lp[k]->t[c].x; });
+      lanes(t[c].y, [&](int k) { return lp[k]->t[c].y; });
+      lanes(t[c].z, [&](int k) { return lp[k]->t[c].z; });
+      lanes(tw[c], [&](int k) { return lp[k]->t[c].w; });
       lanes(hn[c].x, [&](int k) { return double(hp[k][c].x); });
       lanes(hn[c].y, [&](int k) { return double(hp[k][c].y); });
       lanes(hn[c].z, [&](int k) { return double(hp[k][c].z); });
     }
     V u, v;
-    lanes(u, [&](int k) { return double(hits.u[idx[k]]); });
-    lanes(v, [&](int k) { return double(hits.v[idx[k]]); });
+    lanes(u, [&](int k) { return double(sp[k]->u); });
+    lanes(v, [&](int k) { return double(sp[k]->v); });
     const V hw[3] = {1.0 - u - v, u, v};
     // interpolate_frame, per-pixel bitangent: sums start from zero as there.
     V3 fn{zero, zero, zero}, ft{zero, zero, zero};
@@ -153,10 +128,8 @@ __attribute__((target_clones("avx2", "default"))) void encode_hits_per_pixel(
     for (int k = 0; k < kLanes && i + k < count; ++k) {
       const bool bad = !(hlen[k] > 1e-12) || !(det[k] * det[k] > 1e-24 * scale2[k]) || !std::isfinite(det[k]) ||
                        !(len[k] > 0.0) || !std::isfinite(len[k]);
-      other[i + k] = bad || hits.tri[i + k] == raycast::no_hit;
-      value[3 * (i + k)] = r.x[k];
-      value[3 * (i + k) + 1] = r.y[k];
-      value[3 * (i + k) + 2] = r.z[k];
+      degenerate[i + k] = bad;
+      value[i + k] = glm::dvec3(r.x[k], r.y[k], r.z[k]);
     }
   }
 }

@@ -22,25 +22,19 @@ struct LowTriangle {
   glm::dvec4 t[3];
 };
 
-// Samples, as arrays: low-poly triangle and barycentrics (weights of corners 0, 1, 2).
-struct SampleArrays {
-  const std::uint32_t* tri;
-  const double *b0, *b1, *b2;
+// One hit sample to shade.
+struct HitSample {
+  double b[3];             // barycentrics of the sample on its low-poly triangle
+  std::uint32_t low_tri;   // the low-poly triangle
+  std::uint32_t high_tri;  // the high-poly triangle hit
+  float u, v;              // the hit's barycentrics of corners 1 and 2 (Embree's convention)
 };
 
-// Their hits: the high-poly triangle (raycast::no_hit for a miss) and the hit's barycentrics of
-// corners 1 and 2 (Embree's convention).
-struct SampleHits {
-  const std::uint32_t* tri;
-  const float *u, *v;
-};
-
-// For i < count: value[3i..3i+2] = encode_tangent_normal(interpolate_frame(low[tri], b, per_pixel),
-// normalize(interpolated high-poly normal)), and other[i] = 0; or other[i] = 1 (value unspecified)
-// when the sample missed, or the interpolated hit normal is shorter than 1e-12, or the frame is
-// singular, or the result not finite: those take the one-at-a-time path, which has the fallbacks.
-// high_corner_normals holds 3 normals per high-poly triangle.
-void encode_hits_per_pixel(const LowTriangle* low, const glm::vec3* high_corner_normals, const SampleArrays& samples,
-                           const SampleHits& hits, std::size_t count, double* value, std::uint8_t* other);
+// For i < count: value[i] = encode_tangent_normal(interpolate_frame(low[low_tri], b, per_pixel),
+// normalize(interpolated high-poly normal)), and degenerate[i] = 0; or degenerate[i] = 1 (value[i]
+// unspecified) when the interpolated hit normal is shorter than 1e-12 or the frame is singular or
+// the result not finite. high_corner_normals holds 3 normals per high-poly triangle.
+void encode_hits_per_pixel(const LowTriangle* low, const glm::vec3* high_corner_normals, const HitSample* samples,
+                           std::size_t count, glm::dvec3* value, std::uint8_t* degenerate);
 
 }  // namespace nmbake

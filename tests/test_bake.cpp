@@ -123,6 +123,12 @@ TEST(Bake, ResultsDoNotDependOnThreadCount) {
   ASSERT_EQ(a.map.pixels.size(), b.map.pixels.size());
   EXPECT_TRUE(a.map.pixels == b.map.pixels);
   EXPECT_TRUE(a.coverage == b.coverage);
+  // The report's statistics too, to the last bit: the mean hit distance is summed per tile, then
+  // over tiles in order, whichever thread took which tile.
+  EXPECT_EQ(a.stats.hits, b.stats.hits);
+  EXPECT_EQ(a.stats.hit_distance_mean, b.stats.hit_distance_mean);
+  EXPECT_EQ(a.stats.hit_distance_min, b.stats.hit_distance_min);
+  EXPECT_EQ(a.stats.hit_distance_max, b.stats.hit_distance_max);
 }
 
 TEST(Bake, MissesAreCountedFlatAndMasked) {
