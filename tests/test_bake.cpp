@@ -179,20 +179,10 @@ TEST(Bake, AutoDistancesCoverTheOffset) {
 }
 
 TEST(Bake, DisplacedSphereMatchesAnalyticNormal) {
-  // r = 1 + a sin(k theta) sin(k phi); n ~ r e_r - r_theta e_theta - (r_phi / sin theta) e_phi.
+  // r = 1 + a sin(k theta) sin(k phi) with its analytic normal (procedural.h).
   const double a = 0.03, k = 5;
-  auto radius = [&](double th, double ph) { return 1.0 + a * std::sin(k * th) * std::sin(k * ph); };
-  auto normal = [&](double th, double ph) {
-    const glm::dvec3 er(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th));
-    const glm::dvec3 et(std::cos(th) * std::cos(ph), std::cos(th) * std::sin(ph), -std::sin(th));
-    const glm::dvec3 ep(-std::sin(ph), std::cos(ph), 0.0);
-    const double r_t = a * k * std::cos(k * th) * std::sin(k * ph);
-    // sin(k theta) / sin(theta) tends to k at the poles (k odd).
-    const double s = std::sin(th);
-    const double ratio = std::abs(s) > 1e-9 ? std::sin(k * th) / s : k * std::cos(k * th) / std::cos(th);
-    const double r_p_over_s = a * k * ratio * std::cos(k * ph);
-    return glm::normalize(radius(th, ph) * er - r_t * et - r_p_over_s * ep);
-  };
+  auto radius = [&](double th, double ph) { return procedural::displaced_sphere_radius(a, k, th, ph); };
+  auto normal = [&](double th, double ph) { return procedural::displaced_sphere_normal(a, k, th, ph); };
   auto unit = [](double th, double ph) {
     return glm::dvec3(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th));
   };

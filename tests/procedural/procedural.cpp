@@ -40,4 +40,19 @@ Mesh make_sphere(int nphi, int ntheta, const std::function<double(double, double
   return m;
 }
 
+double displaced_sphere_radius(double a, double k, double th, double ph) {
+  return 1.0 + a * std::sin(k * th) * std::sin(k * ph);
+}
+
+glm::dvec3 displaced_sphere_normal(double a, double k, double th, double ph) {
+  const glm::dvec3 er(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th));
+  const glm::dvec3 et(std::cos(th) * std::cos(ph), std::cos(th) * std::sin(ph), -std::sin(th));
+  const glm::dvec3 ep(-std::sin(ph), std::cos(ph), 0.0);
+  const double r_t = a * k * std::cos(k * th) * std::sin(k * ph);
+  const double s = std::sin(th);
+  const double ratio = std::abs(s) > 1e-9 ? std::sin(k * th) / s : k * std::cos(k * th) / std::cos(th);
+  const double r_p_over_s = a * k * ratio * std::cos(k * ph);
+  return glm::normalize(displaced_sphere_radius(a, k, th, ph) * er - r_t * et - r_p_over_s * ep);
+}
+
 }  // namespace nmbake::procedural

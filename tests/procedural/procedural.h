@@ -15,4 +15,10 @@ namespace nmbake::procedural {
 Mesh make_sphere(int nphi, int ntheta, const std::function<double(double theta, double phi)>& radius,
                  const std::function<glm::dvec3(double theta, double phi)>& normal);
 
+// The displaced sphere r = 1 + a sin(k theta) sin(k phi), k odd, and its exact unit normal
+// (n ~ r e_r - r_theta e_theta - (r_phi / sin theta) e_phi; at the poles sin(k theta) / sin theta
+// takes its limit).
+double displaced_sphere_radius(double a, double k, double theta, double phi);
+glm::dvec3 displaced_sphere_normal(double a, double k, double theta, double phi);
+
 }  // namespace nmbake::procedural
