@@ -185,7 +185,7 @@ glm::dvec3 low_point(const LowTriangle& lt, const double b[3]) { return b[0] * l
 glm::dvec3 low_ray_normal(const LowTriangle& lt, const double b[3]) {
   const glm::dvec3 n = b[0] * lt.ray_n[0] + b[1] * lt.ray_n[1] + b[2] * lt.ray_n[2];
   const double len2 = glm::dot(n, n);
-  if (len2 > 1e-24) return n / std::sqrt(len2);
+  if (len2 > 1e-24) return n * (1.0 / std::sqrt(len2));
   // Opposite corner normals cancel: fall back to the face normal.
   const glm::dvec3 f = glm::cross(lt.p[1] - lt.p[0], lt.p[2] - lt.p[0]);
   const double fl = glm::length(f);
@@ -627,19 +627,19 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
       // space, per-pixel bitangent) for all hits at once; then each sample's value into its texel.
       std::fill(acc.begin(), acc.end(), glm::dvec4(0.0));
       std::fill(miss_count.begin(), miss_count.end(), 0u);
-      std::size_t batch_count = 0;
-      double dsum = 0.0;
+      std::size_t batch_count = 0, tile_hits = 0;
+      // In registers for the tile: the batch stores below could alias the thread's counters.
+      double dsum = 0.0, dmin = ts.dmin, dmax = ts.dmax;
       for (std::size_t r = 0; r < sample_count; ++r) {
         double dist = 0.0;
         const raycast::Hit* h =
             &chosen_hit(&hits[r * rays_per_sample], &signed_base[r * rays_per_sample], closest, &dist);
         chosen[r] = h;
         batch_of[r] = -1;
-        ++ts.covered;
         if (h->hit()) {
-          ++ts.hits;
-          ts.dmin = std::min(ts.dmin, dist);
-          ts.dmax = std::max(ts.dmax, dist);
+          ++tile_hits;
+          dmin = std::min(dmin, dist);
+          dmax = std::max(dmax, dist);
           dsum += dist;
           if (batched) {
             const Slot& sl = slots[slot_of_ray[r]];
@@ -647,10 +647,14 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
             batch[batch_count++] = {{sl.b[0], sl.b[1], sl.b[2]}, std::uint32_t(sl.tri), h->triangle, h->u, h->v};
           }
         } else {
-          ++ts.misses;
           ++miss_count[slot_of_ray[r] / S];
         }
       }
+      ts.covered += sample_count;
+      ts.hits += tile_hits;
+      ts.misses += sample_count - tile_hits;
+      ts.dmin = dmin;
+      ts.dmax = dmax;
       tile_dsum[tile] = dsum;
       if (batch_count)
         encode_hits_per_pixel(low_tris.data(), s.bvh_normals, batch.data(), batch_count,
@@ -669,7 +673,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
           if (acc[lt].w == 0.0) continue;
           glm::dvec3 v(acc[lt]);
           const double len = glm::length(v);
-          v = len > 0.0 ? v / len : glm::dvec3(0, 0, 1);
+          v = len > 0.0 ? v * (1.0 / len) : glm::dvec3(0, 0, 1);
           if (opt.space == NormalSpace::tangent && opt.green_down) v.y = -v.y;
           for (int c = 0; c < 3; ++c)
             if (std::abs(v[c]) < kSnap) v[c] = 0.0;
@@ -837,7 +841,7 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
       for (std::size_t i = i0; i < i1; ++i) {
         if (!covered[i]) continue;
         const double len = glm::length(out[i]);
-        out[i] = len > 0.0 ? out[i] / len : glm::dvec3(0, 0, 1);
+        out[i] = len > 0.0 ? out[i] * (1.0 / len) : glm::dvec3(0, 0, 1);
         if (opt.space == NormalSpace::tangent && opt.green_down) out[i].y = -out[i].y;
       }
     }

@@ -3,7 +3,12 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 namespace nmbake {
 
@@ -14,12 +19,31 @@ struct Image {
   std::vector<float> pixels;  // width * height * channels, row-major from the top row
 
   Image() = default;
-  Image(int w, int h, int c, float fill = 0.0f)
-      : width(w), height(h), channels(c), pixels(static_cast<std::size_t>(w) * h * c, fill) {}
+  Image(int w, int h, int c, float fill = 0.0f) : width(w), height(h), channels(c) {
+    const std::size_t n = static_cast<std::size_t>(w) * h * c;
+    pixels.reserve(n);
+    advise_huge_pages(pixels.data(), n * sizeof(float));
+    pixels.resize(n, fill);
+  }
 
   float* at(int x, int y) { return &pixels[(static_cast<std::size_t>(y) * width + x) * channels]; }
   const float* at(int x, int y) const {
     return &pixels[(static_cast<std::size_t>(y) * width + x) * channels];
+  }
+
+  // A map of a few MiB or more is written once, texel by texel: backed by 2 MiB pages where the
+  // system allows it (transparent huge pages in "madvise" mode), it takes one page fault per 2 MiB
+  // instead of per 4 KiB. Only a hint: nothing changes where it is not granted.
+  static void advise_huge_pages(void* data, std::size_t bytes) {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    constexpr std::uintptr_t kHuge = std::uintptr_t(2) << 20;
+    const std::uintptr_t lo = (reinterpret_cast<std::uintptr_t>(data) + kHuge - 1) & ~(kHuge - 1);
+    const std::uintptr_t hi = (reinterpret_cast<std::uintptr_t>(data) + bytes) & ~(kHuge - 1);
+    if (hi > lo) madvise(reinterpret_cast<void*>(lo), hi - lo, MADV_HUGEPAGE);
+#else
+    (void)data;
+    (void)bytes;
+#endif
   }
 };
 

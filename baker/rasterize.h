@@ -27,6 +27,7 @@ struct TexelTriangle {
   // `d`, and the signed value of the opposite corner (`side`) in that edge function.
   glm::dvec2 edge_a[3], edge_d[3];
   double edge_side[3] = {0, 0, 0};
+  double edge_inv_side[3] = {0, 0, 0};  // 1 / edge_side: the barycentric weights multiply by it
   int xmin = 0, xmax = -1, ymin = 0, ymax = -1;  // inclusive texel bounding box, clipped to image
   bool valid() const { return area2 != 0.0; }
 };
@@ -47,11 +48,12 @@ inline bool covers(const TexelTriangle& tri, glm::dvec2 q, double bary[3]) {
     // Strictly inside, or on the edge and this triangle lies on the edge's positive side: of two
     // triangles sharing an edge exactly one does.
     if (side > 0.0 ? e < 0.0 : e >= 0.0) return false;
-    w[(k + 2) % 3] = e / side;
+    w[(k + 2) % 3] = e * tri.edge_inv_side[k];
   }
   const double sum = w[0] + w[1] + w[2];
   if (!(sum > 0.0) || !std::isfinite(sum)) return false;
-  for (int k = 0; k < 3; ++k) bary[k] = w[k] / sum;
+  const double inv_sum = 1.0 / sum;
+  for (int k = 0; k < 3; ++k) bary[k] = w[k] * inv_sum;
   // A sample on an edge (a texel centre on a UV edge) lies on the 3D edge too, where a high-poly
   // with the same edge (coincident, or hard-edged) ties between two triangles and the ray may take
   // the neighbour's normal. Moving it kEdgeInset inside its own triangle breaks the tie; samples
