@@ -31,6 +31,7 @@ struct Image {
     return &pixels[(static_cast<std::size_t>(y) * width + x) * channels];
   }
 
+ private:
   // A map of a few MiB or more is written once, texel by texel: backed by 2 MiB pages where the
   // system allows it (transparent huge pages in "madvise" mode), it takes one page fault per 2 MiB
   // instead of per 4 KiB. Only a hint: nothing changes where it is not granted.

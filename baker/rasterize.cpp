@@ -35,11 +35,12 @@ TexelTriangle setup_texel_triangle(glm::vec2 uv0, glm::vec2 uv1, glm::vec2 uv2, 
     t.edge_a[k] = a;
     t.edge_d[k] = b - a;
     t.edge_side[k] = t.edge_d[k].x * (c.y - a.y) - t.edge_d[k].y * (c.x - a.x);
-    t.edge_inv_side[k] = 1.0 / t.edge_side[k];
-    if (t.edge_side[k] == 0.0 || !std::isfinite(t.edge_inv_side[k])) {  // collinear in texel space after rounding: covers nothing
+    if (t.edge_side[k] == 0.0) {  // collinear in texel space after rounding: covers nothing
       t.area2 = 0.0;
       return t;
     }
+    // Finite: edge_side is a difference of products of float-derived coordinates, never near 1e-308.
+    t.edge_inv_side[k] = 1.0 / t.edge_side[k];
   }
   const double minx = std::min({t.p[0].x, t.p[1].x, t.p[2].x}), maxx = std::max({t.p[0].x, t.p[1].x, t.p[2].x});
   const double miny = std::min({t.p[0].y, t.p[1].y, t.p[2].y}), maxy = std::max({t.p[0].y, t.p[1].y, t.p[2].y});

@@ -33,18 +33,7 @@ void Timing::keep_min(double w, double c) {
 Timing bare_loop(const raycast::Scene& scene, const std::vector<raycast::Ray>& rays, int threads, Bare mode) {
   // Everything the loop writes or reads besides Embree is made and touched here, outside the timing.
   std::vector<raycast::Hit> hits(rays.size());
-  const std::size_t count = rays.size();
-  std::vector<float> field(mode == Bare::arrays ? 11 * count : 0);
-  std::vector<std::uint32_t> hit_tri(mode == Bare::arrays ? count : 0);
-  float* f = field.data();
-  const raycast::RayBatch batch{f, f + count, f + 2 * count, f + 3 * count, f + 4 * count, f + 5 * count, f + 6 * count, f + 7 * count};
-  const raycast::HitBatch hit_batch{hit_tri.data(), f + 8 * count, f + 9 * count, f + 10 * count};
-  if (mode == Bare::arrays)
-    for (std::size_t i = 0; i < count; ++i) {
-      const raycast::Ray& r = rays[i];
-      const float v[8] = {r.origin.x, r.origin.y, r.origin.z, r.direction.x, r.direction.y, r.direction.z, r.tnear, r.tfar};
-      for (int k = 0; k < 8; ++k) f[std::size_t(k) * count + i] = v[k];
-    }
+  raycast::RayArrays arrays(rays.data(), mode == Bare::arrays ? rays.size() : 0);
   std::atomic<std::size_t> next{0};
   const std::size_t chunk = 4096;
   const auto t0 = Clock::now();
@@ -53,9 +42,7 @@ Timing bare_loop(const raycast::Scene& scene, const std::vector<raycast::Ray>& r
     for (std::size_t i; (i = next.fetch_add(chunk)) < rays.size();) {
       const std::size_t n = std::min(chunk, rays.size() - i);
       if (mode == Bare::arrays) {
-        const raycast::RayBatch b{batch.org_x + i, batch.org_y + i, batch.org_z + i, batch.dir_x + i,
-                                  batch.dir_y + i, batch.dir_z + i, batch.tnear + i, batch.tfar + i};
-        scene.intersect(b, {hit_batch.triangle + i, hit_batch.t + i, hit_batch.u + i, hit_batch.v + i}, n);
+        scene.intersect(arrays.rays(i), arrays.hits(i), n);
       } else if (mode == Bare::packets) {
         scene.intersect(&rays[i], &hits[i], n);
       } else {

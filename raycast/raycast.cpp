@@ -33,6 +33,26 @@ void check_device(RTCDevice device) {
 
 }  // namespace
 
+RayArrays::RayArrays(const Ray* rays, std::size_t count) : count_(count), fields_(11 * count), triangle_(count) {
+  for (std::size_t i = 0; i < count; ++i) {
+    const Ray& r = rays[i];
+    const float v[8] = {r.origin.x, r.origin.y, r.origin.z, r.direction.x, r.direction.y, r.direction.z, r.tnear, r.tfar};
+    for (std::size_t k = 0; k < 8; ++k) fields_[k * count + i] = v[k];
+  }
+}
+
+RayBatch RayArrays::rays(std::size_t first) const {
+  const float* f = fields_.data() + first;
+  const std::size_t n = count_;
+  return {f, f + n, f + 2 * n, f + 3 * n, f + 4 * n, f + 5 * n, f + 6 * n, f + 7 * n};
+}
+
+HitBatch RayArrays::hits(std::size_t first) {
+  float* f = fields_.data() + first;
+  const std::size_t n = count_;
+  return {triangle_.data() + first, f + 8 * n, f + 9 * n, f + 10 * n};
+}
+
 struct Scene::Impl {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -42,6 +43,22 @@ struct RayBatch {
 struct HitBatch {
   std::uint32_t* triangle;
   float *t, *u, *v;
+};
+
+// Rays copied from Ray structs into arrays, with room for their hits: the arrays for
+// Scene::intersect(RayBatch, HitBatch), for callers that start from Ray structs.
+class RayArrays {
+ public:
+  RayArrays(const Ray* rays, std::size_t count);
+  std::size_t size() const { return count_; }
+  // The rays and hits from ray `first` on.
+  RayBatch rays(std::size_t first = 0) const;
+  HitBatch hits(std::size_t first = 0);
+
+ private:
+  std::size_t count_;
+  std::vector<float> fields_;  // 8 ray fields, then the hits' t, u, v: count_ each
+  std::vector<std::uint32_t> triangle_;
 };
 
 enum class BuildQuality { low, medium, high };

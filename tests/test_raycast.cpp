@@ -26,16 +26,9 @@ void compare_on_random_rays(const Mesh& m, unsigned seed, int count) {
   std::vector<raycast::Hit> packet(rays.size());
   scene.intersect(rays.data(), packet.data(), rays.size());
   // The same rays as arrays (count not a multiple of 8: the last packet is short).
-  const std::size_t n = rays.size();
-  std::vector<float> f(11 * n);
-  std::vector<std::uint32_t> batch_tri(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const raycast::Ray& r = rays[i];
-    const float v[8] = {r.origin.x, r.origin.y, r.origin.z, r.direction.x, r.direction.y, r.direction.z, r.tnear, r.tfar};
-    for (std::size_t k = 0; k < 8; ++k) f[k * n + i] = v[k];
-  }
-  scene.intersect(raycast::RayBatch{&f[0], &f[n], &f[2 * n], &f[3 * n], &f[4 * n], &f[5 * n], &f[6 * n], &f[7 * n]},
-                  raycast::HitBatch{batch_tri.data(), &f[8 * n], &f[9 * n], &f[10 * n]}, n);
+  raycast::RayArrays arrays(rays.data(), rays.size());
+  scene.intersect(arrays.rays(), arrays.hits(), arrays.size());
+  const raycast::HitBatch batch = arrays.hits();
   int hits = 0;
   for (std::size_t i = 0; i < rays.size(); ++i) {
     const raycast::Hit e = scene.intersect(rays[i]);
@@ -43,11 +36,11 @@ void compare_on_random_rays(const Mesh& m, unsigned seed, int count) {
     // Packets, arrays and single rays agree exactly.
     EXPECT_EQ(packet[i].triangle, e.triangle) << "ray " << i;
     EXPECT_EQ(packet[i].t, e.t) << "ray " << i;
-    ASSERT_EQ(batch_tri[i], e.triangle) << "ray " << i;
+    ASSERT_EQ(batch.triangle[i], e.triangle) << "ray " << i;
     if (e.hit()) {
-      EXPECT_EQ(f[8 * n + i], e.t) << "ray " << i;
-      EXPECT_EQ(f[9 * n + i], e.u) << "ray " << i;
-      EXPECT_EQ(f[10 * n + i], e.v) << "ray " << i;
+      EXPECT_EQ(batch.t[i], e.t) << "ray " << i;
+      EXPECT_EQ(batch.u[i], e.u) << "ray " << i;
+      EXPECT_EQ(batch.v[i], e.v) << "ray " << i;
     }
     ASSERT_EQ(e.hit(), r.hit()) << "ray " << i << " embree t " << e.t << " reference t " << r.t;
     if (!e.hit()) continue;
