@@ -22,6 +22,7 @@
 #include "rasterize.h"
 #include "raycast.h"
 #include "shade_batch.h"
+#include "tile_kernels.h"
 
 namespace nmbake {
 
@@ -234,21 +235,43 @@ inline int sample_rays(const Prepared& s, std::size_t tri, const double b[3], co
   return 1;
 }
 
-// Of a sample's rays' hits, the one that counts, and its signed distance from the low-poly
-// (positive: outside).
-inline const raycast::Hit& chosen_hit(const raycast::Hit* hits, const double* signed_base, bool closest, double* dist) {
+// Of a sample's rays' hits (its rays start at `first`), the index of the one that counts, and its
+// signed distance from the low-poly (positive: outside).
+inline std::size_t chosen_hit(const raycast::HitBatch& hits, std::size_t first, const double* signed_base, bool closest,
+                              double* dist) {
   if (closest) {
-    const raycast::Hit& out = hits[0];
-    const raycast::Hit& in = hits[1];
-    if (out.hit() && (!in.hit() || out.t <= in.t)) {
-      *dist = out.t;
+    const std::size_t out = first, in = first + 1;
+    const bool out_hit = hits.triangle[out] != raycast::no_hit, in_hit = hits.triangle[in] != raycast::no_hit;
+    if (out_hit && (!in_hit || hits.t[out] <= hits.t[in])) {
+      *dist = hits.t[out];
       return out;
     }
-    *dist = -double(in.t);
+    *dist = -double(hits.t[in]);
     return in;
   }
-  *dist = signed_base[0] - hits[0].t;
-  return hits[0];
+  *dist = signed_base[first] - hits.t[first];
+  return first;
+}
+
+raycast::Hit get_hit(const raycast::HitBatch& hits, std::size_t i) {
+  return {hits.triangle[i], hits.t[i], hits.u[i], hits.v[i]};
+}
+raycast::Ray get_ray(const raycast::RayBatch& rays, std::size_t i) {
+  return {{rays.org_x[i], rays.org_y[i], rays.org_z[i]}, rays.tnear[i], {rays.dir_x[i], rays.dir_y[i], rays.dir_z[i]}, rays.tfar[i]};
+}
+// A tile's rays as writable arrays, the layout raycast::RayBatch reads.
+struct RayFields {
+  float *org_x, *org_y, *org_z, *dir_x, *dir_y, *dir_z, *tnear, *tfar;
+};
+void set_ray(const RayFields& rays, std::size_t i, const raycast::Ray& r) {
+  rays.org_x[i] = r.origin.x;
+  rays.org_y[i] = r.origin.y;
+  rays.org_z[i] = r.origin.z;
+  rays.dir_x[i] = r.direction.x;
+  rays.dir_y[i] = r.direction.y;
+  rays.dir_z[i] = r.direction.z;
+  rays.tnear[i] = r.tnear;
+  rays.tfar[i] = r.tfar;
 }
 
 // One sample's value, one at a time: every case, with the fallbacks for degenerate hit normals and
@@ -531,6 +554,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   // One cache line each: the counters change per sample, and shared lines would serialize threads.
   struct alignas(64) ThreadStats {
     std::uint64_t rays = 0, hits = 0, misses = 0, covered = 0, overlaps = 0;
+    Clock::duration intersect{0}, tiles{0};
     double dmin = std::numeric_limits<double>::infinity(), dmax = -std::numeric_limits<double>::infinity();
   };
   std::vector<ThreadStats> tstats(threads);
@@ -552,23 +576,48 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
 
   auto worker = [&](int id) {
     ThreadStats& ts = tstats[id];
-    struct Slot {
-      std::int32_t tri;
-      double b[3];
-    };
-    std::vector<Slot> slots(std::size_t(kTile) * kTile * S);
-    // Sized once for a full tile; each tile fills the first `ray_count` / `sample_count` entries.
-    std::vector<raycast::Ray> rays(slots.size() * rays_per_sample);
-    std::vector<raycast::Hit> hits(rays.size());
-    std::vector<std::uint32_t> slot_of_ray(slots.size());  // per covered sample: its slot
-    std::vector<double> signed_base(rays.size());  // per ray: distance from P to the ray origin along the ray
-    std::vector<const raycast::Hit*> chosen(slots.size());  // per covered sample: the hit that counts
-    std::vector<std::int32_t> batch_of(slots.size());       // per covered sample: its batch entry, or -1
-    std::vector<HitSample> batch(slots.size());
-    std::vector<glm::dvec3> batch_value(slots.size());
-    std::vector<std::uint8_t> batch_degenerate(slots.size());
-    std::vector<glm::dvec4> acc(std::size_t(kTile) * kTile);  // xyz sum, w = covered samples
-    std::vector<std::uint32_t> miss_count(std::size_t(kTile) * kTile);
+    // Sample slots of a tile: sample k of tile texel (x, y) is slot (k * kTile + y) * kTile + x, so
+    // a texel row is contiguous for the coverage kernel.
+    constexpr std::size_t kTexels = std::size_t(kTile) * kTile;
+    const std::size_t slot_count = kTexels * std::size_t(S);
+    const bool default_rays = !ray_setup.cage && !ray_setup.closest;
+    std::vector<std::int32_t> slot_tri(slot_count);
+    std::vector<double> slot_b(3 * slot_count);
+    std::vector<float> slot_ray(6 * slot_count);
+    std::vector<std::uint8_t> slot_fallback(slot_count);
+    const SampleSlots slots{slot_tri.data(),
+                            {&slot_b[0], &slot_b[slot_count], &slot_b[2 * slot_count]},
+                            {slot_ray.data(), slot_ray.data() + slot_count, slot_ray.data() + 2 * slot_count},
+                            {slot_ray.data() + 3 * slot_count, slot_ray.data() + 4 * slot_count, slot_ray.data() + 5 * slot_count},
+                            slot_fallback.data()};
+    const DefaultRays default_ray_setup{default_rays ? low_tris.data() : nullptr, ray_setup.front};
+    // The covered samples, texel by texel (row-major) and within a texel by sample index: triangle,
+    // barycentrics, texel in the tile. This order fixes how each texel's samples are summed.
+    std::vector<std::int32_t> sample_tri(slot_count);
+    std::vector<double> sample_b(3 * slot_count);
+    double* const sb[3] = {&sample_b[0], &sample_b[slot_count], &sample_b[2 * slot_count]};
+    std::vector<std::uint16_t> sample_texel(slot_count);
+    std::vector<std::uint8_t> sample_fallback(slot_count, 1);  // per covered sample: its ray is made one at a time
+    // Rays and hits as arrays, the layout Embree's packets take; sample r casts rays
+    // r * rays_per_sample onwards.
+    const std::size_t max_rays = slot_count * std::size_t(rays_per_sample);
+    std::vector<float> ray_fields(8 * max_rays);
+    const RayFields rays{&ray_fields[0],            &ray_fields[max_rays],     &ray_fields[2 * max_rays],
+                         &ray_fields[3 * max_rays], &ray_fields[4 * max_rays], &ray_fields[5 * max_rays],
+                         &ray_fields[6 * max_rays], &ray_fields[7 * max_rays]};
+    const raycast::RayBatch ray_batch{rays.org_x, rays.org_y, rays.org_z, rays.dir_x, rays.dir_y, rays.dir_z, rays.tnear, rays.tfar};
+    std::vector<std::uint32_t> hit_tri(max_rays);
+    std::vector<float> hit_fields(3 * max_rays);
+    const raycast::HitBatch hits{hit_tri.data(), &hit_fields[0], &hit_fields[max_rays], &hit_fields[2 * max_rays]};
+    std::vector<double> signed_base(max_rays);  // per ray: distance from P to the ray origin along the ray
+    std::vector<std::uint32_t> chosen(slot_count);      // per covered sample: the ray whose hit counts
+    std::vector<std::int32_t> batch_of(slot_count);     // per covered sample: its batch entry, or -1
+    std::vector<HitSample> batch(slot_count);
+    std::vector<glm::dvec3> batch_value(slot_count);
+    std::vector<std::uint8_t> batch_degenerate(slot_count);
+    std::vector<double> acc(4 * kTexels);  // per texel of the tile: x, y, z sums and covered samples, as arrays
+    const TexelSums sums{{&acc[0], &acc[kTexels], &acc[2 * kTexels]}, &acc[3 * kTexels]};
+    std::vector<std::uint32_t> miss_count(kTexels);
     for (std::size_t tile; !cancel.load(std::memory_order_relaxed) && (tile = next_tile.fetch_add(1)) < tile_count;) {
       const int tx0 = int(tile % tiles_x) * kTile, ty0 = int(tile / tiles_x) * kTile;
       const int tw = std::min(kTile, W - tx0), th = std::min(kTile, H - ty0);
@@ -577,77 +626,93 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
         ++tiles_done;
         continue;  // no triangle touches this tile: it costs nothing
       }
-      for (Slot& sl : slots) sl.tri = -1;
+      const auto tile_start = Clock::now();
+      std::fill(slot_tri.begin(), slot_tri.end(), -1);
       // Rasterize: the lowest triangle index wins a sample covered twice (overlapping islands).
       for (std::uint32_t bi = b0; bi < b1; ++bi) {
         const std::uint32_t t = bin_tris[bi];
         const TexelTriangle& tt = texel_tris[t];
         const int x0 = std::max(tt.xmin, tx0), x1 = std::min(tt.xmax, tx0 + tw - 1);
         const int y0 = std::max(tt.ymin, ty0), y1 = std::min(tt.ymax, ty0 + th - 1);
-        for (int y = y0; y <= y1; ++y)
-          for (int x = x0; x <= x1; ++x)
-            for (int k = 0; k < S; ++k) {
-              double b[3];
-              if (!covers(tt, sample_point(x, y, offsets[k].x, offsets[k].y), b)) continue;
-              Slot& sl = slots[(std::size_t(y - ty0) * kTile + (x - tx0)) * S + k];
-              if (sl.tri >= 0) {
-                ++ts.overlaps;
-                continue;
-              }
-              sl.tri = std::int32_t(t);
-              sl.b[0] = b[0];
-              sl.b[1] = b[1];
-              sl.b[2] = b[2];
-            }
+        if (x1 < x0 || y1 < y0) continue;
+        for (int k = 0; k < S; ++k)
+          ts.overlaps += cover_rect(tt, std::int32_t(t), x0, x1, y0, y1, offsets[k].x, offsets[k].y, default_ray_setup, slots,
+                                    (std::size_t(k) * kTile + std::size_t(y0 - ty0)) * kTile + std::size_t(x0 - tx0), kTile);
       }
-      // Rays for the covered samples.
-      std::size_t ray_count = 0, sample_count = 0;
-      for (std::uint32_t si = 0; si < slots.size(); ++si) {
-        const Slot& sl = slots[si];
-        if (sl.tri < 0) continue;
-        ray_count += std::size_t(sample_rays(s, std::size_t(sl.tri), sl.b, ray_setup, &rays[ray_count], &signed_base[ray_count]));
-        slot_of_ray[sample_count++] = si;
+      // The covered samples, in order, with the rays the coverage made (the default policy).
+      std::size_t sample_count = 0;
+      const float tfar = ray_setup.front + ray_setup.rear;
+      for (std::size_t lt = 0; lt < kTexels; ++lt)
+        for (int k = 0; k < S; ++k) {
+          const std::size_t si = std::size_t(k) * kTexels + lt;
+          if (slot_tri[si] < 0) continue;
+          const std::size_t r = sample_count++;
+          sample_tri[r] = slot_tri[si];
+          for (int c = 0; c < 3; ++c) sb[c][r] = slots.b[c][si];
+          sample_texel[r] = std::uint16_t(lt);
+          if (!default_rays) continue;
+          sample_fallback[r] = slot_fallback[si];
+          rays.org_x[r] = slots.org[0][si];
+          rays.org_y[r] = slots.org[1][si];
+          rays.org_z[r] = slots.org[2][si];
+          rays.dir_x[r] = slots.dir[0][si];
+          rays.dir_y[r] = slots.dir[1][si];
+          rays.dir_z[r] = slots.dir[2][si];
+          rays.tnear[r] = 0.0f;
+          rays.tfar[r] = tfar;
+          signed_base[r] = double(ray_setup.front);
+        }
+      // The other rays one at a time: other policies, and the special cases of the default one.
+      const std::size_t ray_count = sample_count * std::size_t(rays_per_sample);
+      for (std::size_t r = 0; r < sample_count; ++r) {
+        if (!sample_fallback[r]) continue;
+        raycast::Ray one[2];
+        const double b[3] = {sb[0][r], sb[1][r], sb[2][r]};
+        const int n = sample_rays(s, std::size_t(sample_tri[r]), b, ray_setup, one, &signed_base[r * rays_per_sample]);
+        for (int j = 0; j < n; ++j) set_ray(rays, r * rays_per_sample + std::size_t(j), one[j]);
       }
-      if (ray_count) scene->intersect(rays.data(), hits.data(), ray_count);
+      if (ray_count) {
+        const auto cast_start = Clock::now();
+        scene->intersect(ray_batch, hits, ray_count);
+        ts.intersect += Clock::now() - cast_start;
+      }
       if (opt.record_rays) {
         std::lock_guard<std::mutex> lock(record_mutex);
-        opt.record_rays->insert(opt.record_rays->end(), rays.begin(), rays.begin() + std::ptrdiff_t(ray_count));
+        for (std::size_t r = 0; r < ray_count; ++r) opt.record_rays->push_back(get_ray(ray_batch, r));
       }
       ts.rays += ray_count;
       // The hit triangles' corner normals are scattered over the high-poly: ask for them all before
       // shading needs the first, so the cache misses overlap.
       for (std::size_t r = 0; r < ray_count; ++r)
-        if (hits[r].hit()) {
-          const char* line = reinterpret_cast<const char*>(&s.bvh_normals[3 * std::size_t(hits[r].triangle)]);
+        if (hit_tri[r] != raycast::no_hit) {
+          const char* line = reinterpret_cast<const char*>(&s.bvh_normals[3 * std::size_t(hit_tri[r])]);
           __builtin_prefetch(line);
           __builtin_prefetch(line + sizeof(glm::vec3) * 3 - 1);
         }
       // Shade: the high-poly normal at the hit, in the low-poly's tangent frame at P. First, in
       // sample order, which ray's hit counts and the hit statistics; then the common case (tangent
       // space, per-pixel bitangent) for all hits at once; then each sample's value into its texel.
-      std::fill(acc.begin(), acc.end(), glm::dvec4(0.0));
+      std::fill(acc.begin(), acc.end(), 0.0);
       std::fill(miss_count.begin(), miss_count.end(), 0u);
       std::size_t batch_count = 0, tile_hits = 0;
       // In registers for the tile: the batch stores below could alias the thread's counters.
       double dsum = 0.0, dmin = ts.dmin, dmax = ts.dmax;
       for (std::size_t r = 0; r < sample_count; ++r) {
         double dist = 0.0;
-        const raycast::Hit* h =
-            &chosen_hit(&hits[r * rays_per_sample], &signed_base[r * rays_per_sample], closest, &dist);
-        chosen[r] = h;
+        const std::size_t h = chosen_hit(hits, r * rays_per_sample, signed_base.data(), closest, &dist);
+        chosen[r] = std::uint32_t(h);
         batch_of[r] = -1;
-        if (h->hit()) {
+        if (hit_tri[h] != raycast::no_hit) {
           ++tile_hits;
           dmin = std::min(dmin, dist);
           dmax = std::max(dmax, dist);
           dsum += dist;
           if (batched) {
-            const Slot& sl = slots[slot_of_ray[r]];
             batch_of[r] = std::int32_t(batch_count);
-            batch[batch_count++] = {{sl.b[0], sl.b[1], sl.b[2]}, std::uint32_t(sl.tri), h->triangle, h->u, h->v};
+            batch[batch_count++] = {{sb[0][r], sb[1][r], sb[2][r]}, std::uint32_t(sample_tri[r]), hit_tri[h], hits.u[h], hits.v[h]};
           }
         } else {
-          ++miss_count[slot_of_ray[r] / S];
+          ++miss_count[sample_texel[r]];
         }
       }
       ts.covered += sample_count;
@@ -660,29 +725,29 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
         encode_hits_per_pixel(low_tris.data(), s.bvh_normals, batch.data(), batch_count,
                               batch_value.data(), batch_degenerate.data());
       for (std::size_t r = 0; r < sample_count; ++r) {
-        const std::uint32_t si = slot_of_ray[r];
         const std::int32_t bi = batch_of[r];
-        const glm::dvec3 value =
-            bi >= 0 && !batch_degenerate[std::size_t(bi)] ? batch_value[std::size_t(bi)] : shade_sample(s, std::size_t(slots[si].tri), slots[si].b, *chosen[r], opt);
-        acc[si / S] += glm::dvec4(value, 1.0);
+        glm::dvec3 value;
+        if (bi >= 0 && !batch_degenerate[std::size_t(bi)]) {
+          value = batch_value[std::size_t(bi)];
+        } else {
+          const double b[3] = {sb[0][r], sb[1][r], sb[2][r]};
+          value = shade_sample(s, std::size_t(sample_tri[r]), b, get_hit(hits, chosen[r]), opt);
+        }
+        const std::size_t lt = sample_texel[r];
+        for (int c = 0; c < 3; ++c) sums.sum[c][lt] += value[c];
+        sums.count[lt] += 1.0;
       }
       // Texels: renormalized mean of their covered samples.
-      for (int y = 0; y < th; ++y)
-        for (int x = 0; x < tw; ++x) {
-          const std::size_t lt = std::size_t(y) * kTile + x;
-          if (acc[lt].w == 0.0) continue;
-          glm::dvec3 v(acc[lt]);
-          const double len = glm::length(v);
-          v = len > 0.0 ? v * (1.0 / len) : glm::dvec3(0, 0, 1);
-          if (opt.space == NormalSpace::tangent && opt.green_down) v.y = -v.y;
-          for (int c = 0; c < 3; ++c)
-            if (std::abs(v[c]) < kSnap) v[c] = 0.0;
-          const std::size_t gi = std::size_t(ty0 + y) * W + (tx0 + x);
-          float* px = result.map.at(tx0 + x, ty0 + y);
-          for (int c = 0; c < 3; ++c) px[c] = float(v[c] * 0.5 + 0.5);
-          result.coverage[gi] = 1;
-          if (opt.miss_mask) result.miss_mask.pixels[gi] = float(miss_count[lt]) / float(acc[lt].w);
-        }
+      const bool flip_y = opt.space == NormalSpace::tangent && opt.green_down;
+      for (int y = 0; y < th; ++y) {
+        const std::size_t first = std::size_t(y) * kTile, gi = std::size_t(ty0 + y) * W + std::size_t(tx0);
+        write_texel_row(sums, first, tw, flip_y, kSnap, result.map.at(tx0, ty0 + y), &result.coverage[gi]);
+        if (opt.miss_mask)
+          for (int x = 0; x < tw; ++x)
+            if (sums.count[first + x] > 0.0)
+              result.miss_mask.pixels[gi + x] = float(miss_count[first + x]) / float(sums.count[first + x]);
+      }
+      ts.tiles += Clock::now() - tile_start;
       ++tiles_done;
     }
   };
@@ -720,6 +785,8 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     total.misses += ts.misses;
     total.covered += ts.covered;
     total.overlaps += ts.overlaps;
+    st.thread_seconds_intersect += std::chrono::duration<double>(ts.intersect).count();
+    st.thread_seconds_tiles += std::chrono::duration<double>(ts.tiles).count();
     total.dmin = std::min(total.dmin, ts.dmin);
     total.dmax = std::max(total.dmax, ts.dmax);
   }
@@ -810,7 +877,6 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
     std::vector<Sample> work;
     std::vector<raycast::Ray> rays;
     std::vector<double> signed_base;
-    std::vector<raycast::Hit> hits;
     constexpr std::size_t kChunk = 64;
     for (std::size_t i0; (i0 = next.fetch_add(kChunk)) < texels.size();) {
       const std::size_t i1 = std::min(texels.size(), i0 + kChunk);
@@ -828,14 +894,15 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
       }
       rays.resize(work.size() * rays_per_sample);
       signed_base.resize(rays.size());
-      hits.resize(rays.size());
       for (std::size_t r = 0; r < work.size(); ++r)
         sample_rays(s, work[r].tri, work[r].b, ray_setup, &rays[r * rays_per_sample], &signed_base[r * rays_per_sample]);
-      if (!rays.empty()) scene.intersect(rays.data(), hits.data(), rays.size());
+      raycast::RayArrays arrays(rays.data(), rays.size());
+      const raycast::HitBatch hits = arrays.hits();
+      if (!rays.empty()) scene.intersect(arrays.rays(), hits, rays.size());
       for (std::size_t r = 0; r < work.size(); ++r) {
         double dist = 0.0;
-        const raycast::Hit& h = chosen_hit(&hits[r * rays_per_sample], &signed_base[r * rays_per_sample], ray_setup.closest, &dist);
-        out[work[r].texel] += shade_sample(s, work[r].tri, work[r].b, h, opt);
+        const std::size_t h = chosen_hit(hits, r * rays_per_sample, signed_base.data(), ray_setup.closest, &dist);
+        out[work[r].texel] += shade_sample(s, work[r].tri, work[r].b, get_hit(hits, h), opt);
         covered[work[r].texel] = 1;
       }
       for (std::size_t i = i0; i < i1; ++i) {

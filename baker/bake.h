@@ -92,6 +92,10 @@ struct BakeStats {
   // Seconds per stage.
   double seconds_prepare = 0, seconds_bvh = 0, seconds_distances = 0, seconds_trace = 0, seconds_padding = 0;
   double cpu_seconds_trace = 0;  // process CPU time of the trace stage (all threads)
+  // Of the trace stage's thread time (all threads), the seconds spent inside Embree's intersection
+  // calls, and the seconds spent working on tiles in all (rasterizing, making rays, casting them,
+  // shading, writing texels): the rest of a tile's time is the bake's own arithmetic.
+  double thread_seconds_intersect = 0, thread_seconds_tiles = 0;
 };
 
 struct BakeResult {

@@ -34,6 +34,20 @@ struct TexelTriangle {
 
 TexelTriangle setup_texel_triangle(glm::vec2 uv0, glm::vec2 uv1, glm::vec2 uv2, int width, int height);
 
+// A sample on an edge (a texel centre on a UV edge) lies on the 3D edge too, where a high-poly
+// with the same edge (coincident, or hard-edged) ties between two triangles and the ray may take
+// the neighbour's normal. Moving it kEdgeInset inside its own triangle breaks the tie; samples
+// farther inside are untouched.
+constexpr double kEdgeInset = 1e-5;
+// Returns whether it moved the sample.
+inline bool inset_from_edges(double bary[3]) {
+  if (!(bary[0] < kEdgeInset || bary[1] < kEdgeInset || bary[2] < kEdgeInset)) return false;
+  double s = 0.0;
+  for (int k = 0; k < 3; ++k) s += (bary[k] = std::max(bary[k], kEdgeInset));
+  for (int k = 0; k < 3; ++k) bary[k] /= s;
+  return true;
+}
+
 // True when sample point q (texel space) is covered; then bary receives the weights of corners
 // 0, 1, 2 (they sum to 1 and are each in [0,1]). A sample on an edge gets weights of at least 1e-5
 // (moved just inside its triangle, so a coincident high-poly cannot tie with the neighbour).
@@ -54,16 +68,7 @@ inline bool covers(const TexelTriangle& tri, glm::dvec2 q, double bary[3]) {
   if (!(sum > 0.0) || !std::isfinite(sum)) return false;
   const double inv_sum = 1.0 / sum;
   for (int k = 0; k < 3; ++k) bary[k] = w[k] * inv_sum;
-  // A sample on an edge (a texel centre on a UV edge) lies on the 3D edge too, where a high-poly
-  // with the same edge (coincident, or hard-edged) ties between two triangles and the ray may take
-  // the neighbour's normal. Moving it kEdgeInset inside its own triangle breaks the tie; samples
-  // farther inside are untouched.
-  constexpr double kEdgeInset = 1e-5;
-  if (bary[0] < kEdgeInset || bary[1] < kEdgeInset || bary[2] < kEdgeInset) {
-    double s = 0.0;
-    for (int k = 0; k < 3; ++k) s += (bary[k] = std::max(bary[k], kEdgeInset));
-    for (int k = 0; k < 3; ++k) bary[k] /= s;
-  }
+  inset_from_edges(bary);
   return true;
 }
 

@@ -3,45 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
-// GCC 12 reports the vectors filled lane by lane in `lanes` as "maybe uninitialized" in the AVX2
-// clone; every lane is written before use (all four are assigned at once).
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
+#include "lanes.h"
 
 namespace nmbake {
-namespace {
 
-// Four doubles, one per sample. Plain IEEE operations lane by lane: no reassociation and no fused
-// multiply-add (the project builds with ISO C++, where GCC does not contract), so each lane rounds
-// exactly as the scalar code does. The helpers take and give vectors by reference only: a 32-byte
-// vector passed by value would change the calling convention between the AVX2 and baseline clones
-// (clang refuses that outright).
-typedef double V __attribute__((vector_size(32)));
-constexpr int kLanes = 4;
-
-struct V3 {
-  V x, y, z;
-};
-
-[[gnu::always_inline]] inline void cross(V3& r, const V3& a, const V3& b) {  // glm::cross, term for term
-  r.x = a.y * b.z - b.y * a.z;
-  r.y = a.z * b.x - b.z * a.x;
-  r.z = a.x * b.y - b.x * a.y;
-}
-[[gnu::always_inline]] inline void dot(V& r, const V3& a, const V3& b) {  // glm::dot: (x + y) + z of the products
-  r = a.x * b.x + a.y * b.y + a.z * b.z;
-}
-// One vector from four scalars, built in registers.
-template <typename F>
-[[gnu::always_inline]] inline void lanes(V& r, F f) {
-  r = V{f(0), f(1), f(2), f(3)};
-}
-[[gnu::always_inline]] inline void vsqrt(V& r, const V& a) {
-  for (int k = 0; k < kLanes; ++k) r[k] = std::sqrt(a[k]);
-}
-
-}  // namespace
+using namespace lanes;
 
 // Two versions, chosen once at load time by the CPU: AVX2 (4 lanes per instruction) and the
 // baseline (2 lanes per SSE2 instruction). Neither uses FMA, so both give the scalar code's bits.
@@ -63,21 +29,21 @@ __attribute__((target_clones("avx2", "default"))) void encode_hits_per_pixel(
     V b[3]{}, tw[3]{};
     V3 n[3]{}, t[3]{}, hn[3]{};
     for (int c = 0; c < 3; ++c) {
-      lanes(b[c], [&](int k) { return sp[k]->b[c]; });
-      lanes(n[c].x, [&](int k) { return lp[k]->n[c].x; });
-      lanes(n[c].y, [&](int k) { return lp[k]->n[c].y; });
-      lanes(n[c].z, [&](int k) { return lp[k]->n[c].z; });
-      lanes(t[c].x, [&](int k) { return lp[k]->t[c].x; });
-      lanes(t[c].y, [&](int k) { return lp[k]->t[c].y; });
-      lanes(t[c].z, [&](int k) { return lp[k]->t[c].z; });
-      lanes(tw[c], [&](int k) { return lp[k]->t[c].w; });
-      lanes(hn[c].x, [&](int k) { return double(hp[k][c].x); });
-      lanes(hn[c].y, [&](int k) { return double(hp[k][c].y); });
-      lanes(hn[c].z, [&](int k) { return double(hp[k][c].z); });
+      gather(b[c], [&](int k) { return sp[k]->b[c]; });
+      gather(n[c].x, [&](int k) { return lp[k]->n[c].x; });
+      gather(n[c].y, [&](int k) { return lp[k]->n[c].y; });
+      gather(n[c].z, [&](int k) { return lp[k]->n[c].z; });
+      gather(t[c].x, [&](int k) { return lp[k]->t[c].x; });
+      gather(t[c].y, [&](int k) { return lp[k]->t[c].y; });
+      gather(t[c].z, [&](int k) { return lp[k]->t[c].z; });
+      gather(tw[c], [&](int k) { return lp[k]->t[c].w; });
+      gather(hn[c].x, [&](int k) { return double(hp[k][c].x); });
+      gather(hn[c].y, [&](int k) { return double(hp[k][c].y); });
+      gather(hn[c].z, [&](int k) { return double(hp[k][c].z); });
     }
     V u, v;
-    lanes(u, [&](int k) { return double(sp[k]->u); });
-    lanes(v, [&](int k) { return double(sp[k]->v); });
+    gather(u, [&](int k) { return double(sp[k]->u); });
+    gather(v, [&](int k) { return double(sp[k]->v); });
     const V hw[3] = {1.0 - u - v, u, v};
     // interpolate_frame, per-pixel bitangent: sums start from zero as there.
     V3 fn{zero, zero, zero}, ft{zero, zero, zero};

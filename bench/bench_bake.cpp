@@ -260,11 +260,14 @@ int main(int argc, char** argv) {
               "Targets (wall, trace / best bare): issue 2 <= 1.3x for 1 and 4 samples, issue 6 <= 1.15x for 1 and 16 samples.\n"
               "Bare loops: one rtcIntersect1 per ray; 8-wide packets (rtcIntersect8) filled from Ray structs; 8-wide packets from\n"
               "arrays already in Embree's packet layout (filled before the clock starts; the bake writes its rays this way). The\n"
-              "bake uses 8-wide packets; raycast.h has no 16-wide packets or rtcIntersect1M streams, so those are not measured.\n\n");
+              "bake uses 8-wide packets; raycast.h has no 16-wide packets or rtcIntersect1M streams, so those are not measured.\n"
+              "\"Own / Embree\": of the fastest bake's thread seconds on tiles (all threads), those outside and inside Embree's calls\n"
+              "(BakeStats::thread_seconds_tiles, thread_seconds_intersect): the bake's own rasterizing, ray making, shading and\n"
+              "writing, against its casting.\n\n");
   std::printf("| scene | samples | high tris | BVH | load s | bvh s | trace s (CPU) | pad s | rays | Mrays/s | bare 1-ray s (CPU) | "
-              "bare 8-packet s (CPU) | bare 8-packet from arrays s (CPU) | trace / best bare, wall (CPU) | issue 2 <= 1.3x | "
-              "issue 6 <= 1.15x | map hash |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+              "bare 8-packet s (CPU) | bare 8-packet from arrays s (CPU) | trace / best bare, wall (CPU) | own / Embree thread s | "
+              "issue 2 <= 1.3x | issue 6 <= 1.15x | map hash |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   flush();
   std::vector<QualityRow> quality_rows;
   const std::vector<int> ratio_samples = args.quick ? std::vector<int>{1} : std::vector<int>{1, 4, 16};
@@ -281,11 +284,15 @@ int main(int argc, char** argv) {
       const raycast::BuildQuality quality = bake_quality(rec.options, high.triangle_count() - rec.culled);
       raycast::Scene scene(&rec.positions[0].x, rec.positions.size(), high.position_index.data(), high.triangle_count(), quality);
       Timing trace, bare1, bare8, bare_arrays;
-      double bvh = 0, pad = 0;
+      double bvh = 0, pad = 0, own = 0, embree = 0;
       std::string hash;
       for (int round = 0; round < args.rounds; ++round) {
         const BakeResult r = bake_normal_map(low, high, nullptr, rec.options);
-        if (r.stats.seconds_trace < trace.wall) bvh = r.stats.seconds_bvh, pad = r.stats.seconds_padding;
+        if (r.stats.seconds_trace < trace.wall) {
+          bvh = r.stats.seconds_bvh, pad = r.stats.seconds_padding;
+          embree = r.stats.thread_seconds_intersect;
+          own = r.stats.thread_seconds_tiles - embree;
+        }
         trace.keep_min(r.stats.seconds_trace, r.stats.cpu_seconds_trace);
         const std::string h = hex(pixel_hash(r.map.pixels));
         hash = round == 0 ? h : (h == hash ? hash : hash + " VARIES between rounds");
@@ -297,12 +304,12 @@ int main(int argc, char** argv) {
       const double best_cpu = std::min({bare1.cpu, bare8.cpu, bare_arrays.cpu});
       const double ratio = trace.wall / best_wall, ratio_cpu = trace.cpu / best_cpu;
       const bool judged6 = samples == 1 || samples == 16, judged2 = samples == 1 || samples == 4;
-      std::printf("| %s | %d | %zu%s | %s | %.3f | %.3f | %.3f (%.3f) | %.3f | %.2fM | %.2f | %.3f (%.3f) | %.3f (%.3f) | %.3f (%.3f) | %.2fx (%.2fx) | %s | %s | %s |\n",
+      std::printf("| %s | %d | %zu%s | %s | %.3f | %.3f | %.3f (%.3f) | %.3f | %.2fM | %.2f | %.3f (%.3f) | %.3f (%.3f) | %.3f (%.3f) | %.2fx (%.2fx) | %.3f / %.3f | %s | %s | %s |\n",
                   name.c_str(), samples, high.triangle_count(),
                   rec.culled ? (" (" + std::to_string(rec.culled) + " culled by the bake, traced by the bare loop)").c_str() : "",
                   quality_name(quality), load, bvh, trace.wall, trace.cpu, pad, double(rec.rays.size()) / 1e6,
                   double(rec.rays.size()) / trace.wall / 1e6, bare1.wall, bare1.cpu, bare8.wall, bare8.cpu, bare_arrays.wall,
-                  bare_arrays.cpu, ratio, ratio_cpu, judged2 ? verdict(ratio <= 1.3) : "-", judged6 ? verdict(ratio <= 1.15) : "-",
+                  bare_arrays.cpu, ratio, ratio_cpu, own, embree, judged2 ? verdict(ratio <= 1.3) : "-", judged6 ? verdict(ratio <= 1.15) : "-",
                   hash.c_str());
       flush();
       const std::string what = "tracing " + name + " 2048^2 " + std::to_string(samples) + " sample" + (samples > 1 ? "s" : "");

@@ -1,0 +1,52 @@
+// Four doubles per vector, for the bake's per-sample arithmetic (shade_batch.cpp, tile_kernels.cpp).
+//
+// Plain IEEE operations lane by lane: no reassociation and no fused multiply-add (the project
+// builds with ISO C++, where GCC does not contract), so each lane rounds exactly as the scalar code
+// it mirrors does. The helpers take and give vectors by reference only: a 32-byte vector passed by
+// value would change the calling convention between the AVX2 and baseline clones (clang refuses
+// that outright). Internal to the baker core; include only from its .cpp files.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+// GCC 12 reports vectors built by gather() as "maybe uninitialized" in the AVX2 clones; every lane
+// is written before use (all four are assigned at once). Off for the kernel files that include this.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+
+namespace nmbake::lanes {
+
+typedef double V __attribute__((vector_size(32)));
+typedef std::int64_t M __attribute__((vector_size(32)));  // comparison results: all ones or zero per lane
+typedef float F __attribute__((vector_size(16)));
+constexpr int kLanes = 4;
+
+struct V3 {
+  V x, y, z;
+};
+
+[[gnu::always_inline]] inline void cross(V3& r, const V3& a, const V3& b) {  // glm::cross, term for term
+  r.x = a.y * b.z - b.y * a.z;
+  r.y = a.z * b.x - b.z * a.x;
+  r.z = a.x * b.y - b.x * a.y;
+}
+[[gnu::always_inline]] inline void dot(V& r, const V3& a, const V3& b) {  // glm::dot: (x + y) + z of the products
+  r = a.x * b.x + a.y * b.y + a.z * b.z;
+}
+// One vector from four scalars, built in registers (lane stores followed by a vector load would
+// stall on store forwarding).
+template <typename Fn>
+[[gnu::always_inline]] inline void gather(V& r, Fn f) {
+  r = V{f(0), f(1), f(2), f(3)};
+}
+[[gnu::always_inline]] inline void vsqrt(V& r, const V& a) {
+  for (int k = 0; k < kLanes; ++k) r[k] = std::sqrt(a[k]);
+}
+// Bit k set for each lane k whose mask is set.
+[[gnu::always_inline]] inline unsigned bits(const M& m) {
+  return unsigned(m[0] != 0) | unsigned(m[1] != 0) << 1 | unsigned(m[2] != 0) << 2 | unsigned(m[3] != 0) << 3;
+}
+
+}  // namespace nmbake::lanes

@@ -1,0 +1,185 @@
+// The trace loop's vector kernels (tile_kernels.h) give exactly the bits of their one-sample
+// definitions: cover_rect against covers() and the default-policy ray, write_texel_row against the
+// texel formula, including the cases each flags or special-cases.
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "rasterize.h"
+#include "tile_kernels.h"
+
+using namespace nmbake;
+
+namespace {
+
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+bool same_bits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+// A rectangle of slots with the arrays SampleSlots points into.
+struct Slots {
+  explicit Slots(std::size_t n) : tri(n, -1), b(3 * n), ray(6 * n), fallback(n, 9) {
+    view = {tri.data(), {&b[0], &b[n], &b[2 * n]}, {&ray[0], &ray[n], &ray[2 * n]}, {&ray[3 * n], &ray[4 * n], &ray[5 * n]},
+            fallback.data()};
+  }
+  std::vector<std::int32_t> tri;
+  std::vector<double> b;
+  std::vector<float> ray;
+  std::vector<std::uint8_t> fallback;
+  SampleSlots view{};
+};
+
+// The default-policy ray by its definition (the bake's sample_rays): P and the normalized ray
+// normal interpolated in double, origin P + front N, direction -N, rounded to float.
+void reference_ray(const LowTriangle& lt, const double b[3], float front, glm::vec3& org, glm::vec3& dir) {
+  const glm::dvec3 p = b[0] * lt.p[0] + b[1] * lt.p[1] + b[2] * lt.p[2];
+  glm::dvec3 n = b[0] * lt.ray_n[0] + b[1] * lt.ray_n[1] + b[2] * lt.ray_n[2];
+  n = n * (1.0 / std::sqrt(glm::dot(n, n)));
+  org = glm::vec3(p + double(front) * n);
+  dir = glm::vec3(-n);
+}
+
+LowTriangle random_low_triangle(std::mt19937& rng) {
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  LowTriangle lt{};
+  for (int c = 0; c < 3; ++c) {
+    lt.p[c] = glm::dvec3(u(rng), u(rng), u(rng));
+    lt.ray_n[c] = glm::dvec3(glm::normalize(glm::vec3(u(rng), u(rng), 1.0f)));
+  }
+  return lt;
+}
+
+// Checks one cover_rect call over the triangle's whole box against covers() sample by sample.
+// Returns the covered samples; `moved` counts those covers() moved in from an edge.
+std::size_t check_triangle(const TexelTriangle& tt, const LowTriangle* low, float front, double ox, double oy,
+                           std::size_t* moved) {
+  const int w = tt.xmax - tt.xmin + 1, h = tt.ymax - tt.ymin + 1;
+  if (w <= 0 || h <= 0) return 0;
+  const std::size_t stride = std::size_t(w) + 3;  // rows not packed, as in a tile
+  Slots slots(stride * std::size_t(h));
+  const DefaultRays rays{low, front};
+  EXPECT_EQ(cover_rect(tt, 0, tt.xmin, tt.xmax, tt.ymin, tt.ymax, ox, oy, rays, slots.view, 0, stride), 0u);
+  std::size_t covered = 0;
+  for (int y = tt.ymin; y <= tt.ymax; ++y)
+    for (int x = tt.xmin; x <= tt.xmax; ++x) {
+      const std::size_t i = std::size_t(y - tt.ymin) * stride + std::size_t(x - tt.xmin);
+      double b[3];
+      const bool c = covers(tt, sample_point(x, y, ox, oy), b);
+      EXPECT_EQ(slots.tri[i], c ? 0 : -1) << x << "," << y;
+      if (!c) continue;
+      ++covered;
+      for (int k = 0; k < 3; ++k) EXPECT_TRUE(same_bits(slots.b[std::size_t(k) * slots.tri.size() + i], b[k])) << x << "," << y;
+      if (!low) continue;
+      // The ray is made from the unmoved barycentrics: a moved sample must be flagged.
+      double unmoved[3];
+      const glm::dvec2 q = sample_point(x, y, ox, oy);
+      bool was_moved = false;
+      for (int k = 0; k < 3; ++k) {
+        const int e = (k + 1) % 3;  // w[k] comes from edge k + 1
+        const double ev = tt.edge_d[e].x * (q.y - tt.edge_a[e].y) - tt.edge_d[e].y * (q.x - tt.edge_a[e].x);
+        unmoved[k] = ev * tt.edge_inv_side[e];
+      }
+      const double sum = unmoved[0] + unmoved[1] + unmoved[2];
+      for (double& u : unmoved) u = u * (1.0 / sum);
+      for (int k = 0; k < 3; ++k) was_moved |= !same_bits(unmoved[k], b[k]);
+      *moved += was_moved;
+      if (was_moved) {
+        EXPECT_EQ(slots.fallback[i], 1) << x << "," << y;
+        continue;
+      }
+      EXPECT_EQ(slots.fallback[i], 0) << x << "," << y;
+      glm::vec3 org, dir;
+      reference_ray(*low, b, front, org, dir);
+      const std::size_t n = slots.tri.size();
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_TRUE(same_bits(slots.ray[std::size_t(k) * n + i], org[k])) << x << "," << y << " origin " << k;
+        EXPECT_TRUE(same_bits(slots.ray[std::size_t(3 + k) * n + i], dir[k])) << x << "," << y << " direction " << k;
+      }
+    }
+  return covered;
+}
+
+}  // namespace
+
+TEST(TileKernels, CoverRectIsCoversBitForBit) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  std::size_t covered = 0, moved = 0;
+  for (int i = 0; i < 200; ++i) {
+    glm::vec2 uv[3];
+    for (glm::vec2& c : uv) c = {u(rng), u(rng)};
+    if (i % 4 == 0)  // corners on texel centres and edges through them: ties and edge insets
+      for (glm::vec2& c : uv) c = (glm::floor(c * 40.0f) + 0.5f) / 40.0f;
+    const TexelTriangle tt = setup_texel_triangle(uv[0], uv[1], uv[2], 40, 40);  // either winding
+    const LowTriangle lt = random_low_triangle(rng);
+    covered += check_triangle(tt, &lt, 0.01f * float(i % 7), i % 3 ? 0.5 : 0.125, i % 5 ? 0.5 : 0.875, &moved);
+    covered += check_triangle(tt, nullptr, 0.0f, 0.5, 0.5, &moved);  // coverage alone
+  }
+  EXPECT_GT(covered, 10000u);
+  EXPECT_GT(moved, 20u);  // the edge cases were reached
+}
+
+TEST(TileKernels, CoverRectKeepsTheFirstTriangleAndCountsTheRest) {
+  const TexelTriangle tt = setup_texel_triangle({0.0f, 0.0f}, {1.0f, 0.0f}, {0.0f, 1.0f}, 8, 8);
+  Slots slots(64);
+  const std::size_t first = cover_rect(tt, 3, 0, 7, 0, 7, 0.5, 0.5, DefaultRays{}, slots.view, 0, 8);
+  EXPECT_EQ(first, 0u);
+  const std::vector<std::int32_t> after_first = slots.tri;
+  std::size_t covered = 0;
+  for (std::int32_t t : after_first) covered += t == 3;
+  EXPECT_EQ(covered, 36u);  // texel centres strictly below the diagonal plus the tie-broken ones on it
+  EXPECT_EQ(cover_rect(tt, 5, 0, 7, 0, 7, 0.5, 0.5, DefaultRays{}, slots.view, 0, 8), covered);
+  EXPECT_EQ(slots.tri, after_first);
+}
+
+TEST(TileKernels, DegenerateRayNormalsAreFlagged) {
+  LowTriangle lt{};
+  for (int c = 0; c < 3; ++c) lt.p[c] = glm::dvec3(c, c * c, 1.0);  // ray normals all zero
+  const TexelTriangle tt = setup_texel_triangle({0.1f, 0.1f}, {0.9f, 0.2f}, {0.3f, 0.8f}, 16, 16);
+  Slots slots(256);
+  cover_rect(tt, 0, tt.xmin, tt.xmax, tt.ymin, tt.ymax, 0.5, 0.5, DefaultRays{&lt, 0.1f}, slots.view,
+             std::size_t(tt.ymin) * 16 + std::size_t(tt.xmin), 16);
+  std::size_t covered = 0;
+  for (std::size_t i = 0; i < 256; ++i)
+    if (slots.tri[i] >= 0) {
+      ++covered;
+      EXPECT_EQ(slots.fallback[i], 1) << i;
+    }
+  EXPECT_GT(covered, 40u);
+}
+
+TEST(TileKernels, WriteTexelRowIsTheTexelFormula) {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  for (int width = 1; width <= 16; ++width)
+    for (int flip = 0; flip < 2; ++flip) {
+      std::vector<double> acc(4 * 16);
+      const TexelSums sums{{&acc[0], &acc[16], &acc[32]}, &acc[48]};
+      for (int x = 0; x < 16; ++x) {
+        for (int c = 0; c < 3; ++c) sums.sum[c][x] = u(rng);
+        sums.count[x] = double(x % 5);  // some texels without samples
+        if (x % 7 == 3) sums.sum[0][x] = sums.sum[1][x] = sums.sum[2][x] = 0.0;       // zero sum
+        if (x % 6 == 2) sums.sum[1][x] = 1e-9 * sums.sum[0][x];                       // snaps to 0
+        if (x % 8 == 5) sums.sum[2][x] = -0.0;                                         // a negative zero
+      }
+      std::vector<float> rgb(3 * 16, -7.0f);
+      std::vector<std::uint8_t> covered(16, 0);
+      write_texel_row(sums, 0, width, flip != 0, 1e-6, rgb.data(), covered.data());
+      for (int x = 0; x < 16; ++x) {
+        if (x >= width || sums.count[x] == 0.0) {
+          EXPECT_EQ(covered[x], 0) << x;
+          for (int c = 0; c < 3; ++c) EXPECT_EQ(rgb[3 * x + c], -7.0f) << x;
+          continue;
+        }
+        EXPECT_EQ(covered[x], 1) << x;
+        glm::dvec3 v(sums.sum[0][x], sums.sum[1][x], sums.sum[2][x]);
+        const double len = glm::length(v);
+        v = len > 0.0 ? v * (1.0 / len) : glm::dvec3(0, 0, 1);
+        if (flip) v.y = -v.y;
+        for (int c = 0; c < 3; ++c)
+          if (std::abs(v[c]) < 1e-6) v[c] = 0.0;
+        for (int c = 0; c < 3; ++c) EXPECT_TRUE(same_bits(rgb[3 * x + c], float(v[c] * 0.5 + 0.5))) << x << " " << c;
+      }
+    }
+}
