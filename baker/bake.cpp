@@ -253,27 +253,6 @@ inline std::size_t chosen_hit(const raycast::HitBatch& hits, std::size_t first, 
   return first;
 }
 
-raycast::Hit get_hit(const raycast::HitBatch& hits, std::size_t i) {
-  return {hits.triangle[i], hits.t[i], hits.u[i], hits.v[i]};
-}
-raycast::Ray get_ray(const raycast::RayBatch& rays, std::size_t i) {
-  return {{rays.org_x[i], rays.org_y[i], rays.org_z[i]}, rays.tnear[i], {rays.dir_x[i], rays.dir_y[i], rays.dir_z[i]}, rays.tfar[i]};
-}
-// A tile's rays as writable arrays, the layout raycast::RayBatch reads.
-struct RayFields {
-  float *org_x, *org_y, *org_z, *dir_x, *dir_y, *dir_z, *tnear, *tfar;
-};
-void set_ray(const RayFields& rays, std::size_t i, const raycast::Ray& r) {
-  rays.org_x[i] = r.origin.x;
-  rays.org_y[i] = r.origin.y;
-  rays.org_z[i] = r.origin.z;
-  rays.dir_x[i] = r.direction.x;
-  rays.dir_y[i] = r.direction.y;
-  rays.dir_z[i] = r.direction.z;
-  rays.tnear[i] = r.tnear;
-  rays.tfar[i] = r.tfar;
-}
-
 // One sample's value, one at a time: every case, with the fallbacks for degenerate hit normals and
 // frames. encode_hits_per_pixel (shade_batch.h) gives the same bits for the common case, many at a
 // time. `h` indexes the BVH's triangles (s.bvh_index, s.bvh_normals).
@@ -600,16 +579,9 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     std::vector<std::uint8_t> sample_fallback(slot_count, 1);  // per covered sample: its ray is made one at a time
     // Rays and hits as arrays, the layout Embree's packets take; sample r casts rays
     // r * rays_per_sample onwards.
-    const std::size_t max_rays = slot_count * std::size_t(rays_per_sample);
-    std::vector<float> ray_fields(8 * max_rays);
-    const RayFields rays{&ray_fields[0],            &ray_fields[max_rays],     &ray_fields[2 * max_rays],
-                         &ray_fields[3 * max_rays], &ray_fields[4 * max_rays], &ray_fields[5 * max_rays],
-                         &ray_fields[6 * max_rays], &ray_fields[7 * max_rays]};
-    const raycast::RayBatch ray_batch{rays.org_x, rays.org_y, rays.org_z, rays.dir_x, rays.dir_y, rays.dir_z, rays.tnear, rays.tfar};
-    std::vector<std::uint32_t> hit_tri(max_rays);
-    std::vector<float> hit_fields(3 * max_rays);
-    const raycast::HitBatch hits{hit_tri.data(), &hit_fields[0], &hit_fields[max_rays], &hit_fields[2 * max_rays]};
-    std::vector<double> signed_base(max_rays);  // per ray: distance from P to the ray origin along the ray
+    raycast::RayArrays rays(slot_count * std::size_t(rays_per_sample));
+    const raycast::HitBatch hits = rays.hits();
+    std::vector<double> signed_base(rays.size());  // per ray: distance from P to the ray origin along the ray
     std::vector<std::uint32_t> chosen(slot_count);      // per covered sample: the ray whose hit counts
     std::vector<std::int32_t> batch_of(slot_count);     // per covered sample: its batch entry, or -1
     std::vector<HitSample> batch(slot_count);
@@ -652,14 +624,10 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
           sample_texel[r] = std::uint16_t(lt);
           if (!default_rays) continue;
           sample_fallback[r] = slot_fallback[si];
-          rays.org_x[r] = slots.org[0][si];
-          rays.org_y[r] = slots.org[1][si];
-          rays.org_z[r] = slots.org[2][si];
-          rays.dir_x[r] = slots.dir[0][si];
-          rays.dir_y[r] = slots.dir[1][si];
-          rays.dir_z[r] = slots.dir[2][si];
-          rays.tnear[r] = 0.0f;
-          rays.tfar[r] = tfar;
+          rays.set(r, {{slots.org[0][si], slots.org[1][si], slots.org[2][si]},
+                       0.0f,
+                       {slots.dir[0][si], slots.dir[1][si], slots.dir[2][si]},
+                       tfar});
           signed_base[r] = double(ray_setup.front);
         }
       // The other rays one at a time: other policies, and the special cases of the default one.
@@ -669,23 +637,23 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
         raycast::Ray one[2];
         const double b[3] = {sb[0][r], sb[1][r], sb[2][r]};
         const int n = sample_rays(s, std::size_t(sample_tri[r]), b, ray_setup, one, &signed_base[r * rays_per_sample]);
-        for (int j = 0; j < n; ++j) set_ray(rays, r * rays_per_sample + std::size_t(j), one[j]);
+        for (int j = 0; j < n; ++j) rays.set(r * rays_per_sample + std::size_t(j), one[j]);
       }
       if (ray_count) {
         const auto cast_start = Clock::now();
-        scene->intersect(ray_batch, hits, ray_count);
+        scene->intersect(rays.rays(), hits, ray_count);
         ts.intersect += Clock::now() - cast_start;
       }
       if (opt.record_rays) {
         std::lock_guard<std::mutex> lock(record_mutex);
-        for (std::size_t r = 0; r < ray_count; ++r) opt.record_rays->push_back(get_ray(ray_batch, r));
+        for (std::size_t r = 0; r < ray_count; ++r) opt.record_rays->push_back(rays.ray(r));
       }
       ts.rays += ray_count;
       // The hit triangles' corner normals are scattered over the high-poly: ask for them all before
       // shading needs the first, so the cache misses overlap.
       for (std::size_t r = 0; r < ray_count; ++r)
-        if (hit_tri[r] != raycast::no_hit) {
-          const char* line = reinterpret_cast<const char*>(&s.bvh_normals[3 * std::size_t(hit_tri[r])]);
+        if (hits.triangle[r] != raycast::no_hit) {
+          const char* line = reinterpret_cast<const char*>(&s.bvh_normals[3 * std::size_t(hits.triangle[r])]);
           __builtin_prefetch(line);
           __builtin_prefetch(line + sizeof(glm::vec3) * 3 - 1);
         }
@@ -702,14 +670,14 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
         const std::size_t h = chosen_hit(hits, r * rays_per_sample, signed_base.data(), closest, &dist);
         chosen[r] = std::uint32_t(h);
         batch_of[r] = -1;
-        if (hit_tri[h] != raycast::no_hit) {
+        if (hits.triangle[h] != raycast::no_hit) {
           ++tile_hits;
           dmin = std::min(dmin, dist);
           dmax = std::max(dmax, dist);
           dsum += dist;
           if (batched) {
             batch_of[r] = std::int32_t(batch_count);
-            batch[batch_count++] = {{sb[0][r], sb[1][r], sb[2][r]}, std::uint32_t(sample_tri[r]), hit_tri[h], hits.u[h], hits.v[h]};
+            batch[batch_count++] = {{sb[0][r], sb[1][r], sb[2][r]}, std::uint32_t(sample_tri[r]), hits.triangle[h], hits.u[h], hits.v[h]};
           }
         } else {
           ++miss_count[sample_texel[r]];
@@ -731,7 +699,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
           value = batch_value[std::size_t(bi)];
         } else {
           const double b[3] = {sb[0][r], sb[1][r], sb[2][r]};
-          value = shade_sample(s, std::size_t(sample_tri[r]), b, get_hit(hits, chosen[r]), opt);
+          value = shade_sample(s, std::size_t(sample_tri[r]), b, rays.hit(chosen[r]), opt);
         }
         const std::size_t lt = sample_texel[r];
         for (int c = 0; c < 3; ++c) sums.sum[c][lt] += value[c];
@@ -902,7 +870,7 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
       for (std::size_t r = 0; r < work.size(); ++r) {
         double dist = 0.0;
         const std::size_t h = chosen_hit(hits, r * rays_per_sample, signed_base.data(), ray_setup.closest, &dist);
-        out[work[r].texel] += shade_sample(s, work[r].tri, work[r].b, get_hit(hits, h), opt);
+        out[work[r].texel] += shade_sample(s, work[r].tri, work[r].b, arrays.hit(h), opt);
         covered[work[r].texel] = 1;
       }
       for (std::size_t i = i0; i < i1; ++i) {

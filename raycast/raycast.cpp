@@ -33,12 +33,10 @@ void check_device(RTCDevice device) {
 
 }  // namespace
 
-RayArrays::RayArrays(const Ray* rays, std::size_t count) : count_(count), fields_(11 * count), triangle_(count) {
-  for (std::size_t i = 0; i < count; ++i) {
-    const Ray& r = rays[i];
-    const float v[8] = {r.origin.x, r.origin.y, r.origin.z, r.direction.x, r.direction.y, r.direction.z, r.tnear, r.tfar};
-    for (std::size_t k = 0; k < 8; ++k) fields_[k * count + i] = v[k];
-  }
+RayArrays::RayArrays(std::size_t count) : count_(count), fields_(11 * count), triangle_(count, no_hit) {}
+
+RayArrays::RayArrays(const Ray* rays, std::size_t count) : RayArrays(count) {
+  for (std::size_t i = 0; i < count; ++i) set(i, rays[i]);
 }
 
 RayBatch RayArrays::rays(std::size_t first) const {

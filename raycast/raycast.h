@@ -45,12 +45,25 @@ struct HitBatch {
   float *t, *u, *v;
 };
 
-// Rays copied from Ray structs into arrays, with room for their hits: the arrays for
-// Scene::intersect(RayBatch, HitBatch), for callers that start from Ray structs.
+// Rays held as arrays, with room for their hits: the arrays for Scene::intersect(RayBatch,
+// HitBatch). Filled ray by ray, or copied from Ray structs.
 class RayArrays {
  public:
+  explicit RayArrays(std::size_t count);  // `count` rays, all fields 0, no hits
   RayArrays(const Ray* rays, std::size_t count);
   std::size_t size() const { return count_; }
+  // Inline: the bake sets each of its rays through it.
+  void set(std::size_t i, const Ray& r) {
+    const float v[8] = {r.origin.x, r.origin.y, r.origin.z, r.direction.x, r.direction.y, r.direction.z, r.tnear, r.tfar};
+    for (std::size_t k = 0; k < 8; ++k) fields_[k * count_ + i] = v[k];
+  }
+  Ray ray(std::size_t i) const {
+    const auto f = [&](std::size_t k) { return fields_[k * count_ + i]; };
+    return {{f(0), f(1), f(2)}, f(6), {f(3), f(4), f(5)}, f(7)};
+  }
+  Hit hit(std::size_t i) const {  // after Scene::intersect
+    return {triangle_[i], fields_[8 * count_ + i], fields_[9 * count_ + i], fields_[10 * count_ + i]};
+  }
   // The rays and hits from ray `first` on.
   RayBatch rays(std::size_t first = 0) const;
   HitBatch hits(std::size_t first = 0);

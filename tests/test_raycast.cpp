@@ -37,6 +37,12 @@ void compare_on_random_rays(const Mesh& m, unsigned seed, int count) {
     EXPECT_EQ(packet[i].triangle, e.triangle) << "ray " << i;
     EXPECT_EQ(packet[i].t, e.t) << "ray " << i;
     ASSERT_EQ(batch.triangle[i], e.triangle) << "ray " << i;
+    const raycast::Ray back = arrays.ray(i);  // the arrays give back the ray they were given
+    EXPECT_EQ(back.origin, rays[i].origin) << "ray " << i;
+    EXPECT_EQ(back.direction, rays[i].direction) << "ray " << i;
+    EXPECT_EQ(back.tnear, rays[i].tnear) << "ray " << i;
+    EXPECT_EQ(back.tfar, rays[i].tfar) << "ray " << i;
+    EXPECT_EQ(arrays.hit(i).triangle, e.triangle) << "ray " << i;
     if (e.hit()) {
       EXPECT_EQ(batch.t[i], e.t) << "ray " << i;
       EXPECT_EQ(batch.u[i], e.u) << "ray " << i;
