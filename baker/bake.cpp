@@ -522,7 +522,8 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     }
   }
 
-  result.map = Image(W, H, 3, 0.0f);
+  // Unset here: the trace writes the covered texels, the padding stage the others.
+  result.map = Image(W, H, 3, Image::Unset{});
   result.coverage.assign(std::size_t(W) * H, 0);
   if (opt.miss_mask) result.miss_mask = Image(W, H, 1, 0.0f);
   const std::vector<glm::dvec2> offsets = sample_offsets(opt.samples);
@@ -566,27 +567,43 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     std::vector<std::uint8_t> slot_fallback(slot_count);
     const SampleSlots slots{slot_tri.data(),
                             {&slot_b[0], &slot_b[slot_count], &slot_b[2 * slot_count]},
-                            {slot_ray.data(), slot_ray.data() + slot_count, slot_ray.data() + 2 * slot_count},
-                            {slot_ray.data() + 3 * slot_count, slot_ray.data() + 4 * slot_count, slot_ray.data() + 5 * slot_count},
+                            {&slot_ray[0], &slot_ray[slot_count], &slot_ray[2 * slot_count]},
+                            {&slot_ray[3 * slot_count], &slot_ray[4 * slot_count], &slot_ray[5 * slot_count]},
                             slot_fallback.data()};
     const DefaultRays default_ray_setup{default_rays ? low_tris.data() : nullptr, ray_setup.front};
-    // The covered samples, texel by texel (row-major) and within a texel by sample index: triangle,
-    // barycentrics, texel in the tile. This order fixes how each texel's samples are summed.
+    // The covered samples in slot order, which puts each texel's samples in sample order: that
+    // fixes how its values are summed. Rays and hits as arrays, the layout Embree's packets take;
+    // sample r casts rays r * rays_per_sample onwards.
+    raycast::RayArrays rays(slot_count * std::size_t(rays_per_sample));
+    const raycast::HitBatch hits = rays.hits();
     std::vector<std::int32_t> sample_tri(slot_count);
     std::vector<double> sample_b(3 * slot_count);
     double* const sb[3] = {&sample_b[0], &sample_b[slot_count], &sample_b[2 * slot_count]};
     std::vector<std::uint16_t> sample_texel(slot_count);
     std::vector<std::uint8_t> sample_fallback(slot_count, 1);  // per covered sample: its ray is made one at a time
-    // Rays and hits as arrays, the layout Embree's packets take; sample r casts rays
-    // r * rays_per_sample onwards.
-    raycast::RayArrays rays(slot_count * std::size_t(rays_per_sample));
-    const raycast::HitBatch hits = rays.hits();
-    std::vector<double> signed_base(rays.size());  // per ray: distance from P to the ray origin along the ray
-    std::vector<std::uint32_t> chosen(slot_count);      // per covered sample: the ray whose hit counts
-    std::vector<std::int32_t> batch_of(slot_count);     // per covered sample: its batch entry, or -1
-    std::vector<HitSample> batch(slot_count);
-    std::vector<glm::dvec3> batch_value(slot_count);
-    std::vector<std::uint8_t> batch_degenerate(slot_count);
+    const CoveredSamples covered{sample_tri.data(),
+                                {sb[0], sb[1], sb[2]},
+                                sample_texel.data(),
+                                {rays.origin(0), rays.origin(1), rays.origin(2)},
+                                {rays.direction(0), rays.direction(1), rays.direction(2)},
+                                sample_fallback.data()};
+    if (default_rays) {
+      // Every default-policy ray starts at 0 and reaches front + rear (sample_rays' too).
+      std::fill(rays.tfar(), rays.tfar() + rays.size(), ray_setup.front + ray_setup.rear);
+    }
+    std::vector<double> signed_base(rays.size(), double(ray_setup.front));  // per ray: distance from P to its origin along it
+    // The hit that counts, per covered sample: with one ray per sample its own, read in place;
+    // with two (closest), picked into these.
+    std::vector<std::uint32_t> chosen(slot_count), chosen_tri(slot_count);
+    std::vector<float> chosen_u(slot_count), chosen_v(slot_count);
+    const ShadeSamples shade_in{sample_tri.data(),
+                                {sb[0], sb[1], sb[2]},
+                                rays_per_sample == 1 ? hits.triangle : chosen_tri.data(),
+                                rays_per_sample == 1 ? hits.u : chosen_u.data(),
+                                rays_per_sample == 1 ? hits.v : chosen_v.data()};
+    std::vector<double> value(3 * slot_count);
+    double* const value_c[3] = {&value[0], &value[slot_count], &value[2 * slot_count]};
+    std::vector<std::uint8_t> one_at_a_time(slot_count, 1);  // per covered sample: shaded by shade_sample
     std::vector<double> acc(4 * kTexels);  // per texel of the tile: x, y, z sums and covered samples, as arrays
     const TexelSums sums{{&acc[0], &acc[kTexels], &acc[2 * kTexels]}, &acc[3 * kTexels]};
     std::vector<std::uint32_t> miss_count(kTexels);
@@ -612,24 +629,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
                                     (std::size_t(k) * kTile + std::size_t(y0 - ty0)) * kTile + std::size_t(x0 - tx0), kTile);
       }
       // The covered samples, in order, with the rays the coverage made (the default policy).
-      std::size_t sample_count = 0;
-      const float tfar = ray_setup.front + ray_setup.rear;
-      for (std::size_t lt = 0; lt < kTexels; ++lt)
-        for (int k = 0; k < S; ++k) {
-          const std::size_t si = std::size_t(k) * kTexels + lt;
-          if (slot_tri[si] < 0) continue;
-          const std::size_t r = sample_count++;
-          sample_tri[r] = slot_tri[si];
-          for (int c = 0; c < 3; ++c) sb[c][r] = slots.b[c][si];
-          sample_texel[r] = std::uint16_t(lt);
-          if (!default_rays) continue;
-          sample_fallback[r] = slot_fallback[si];
-          rays.set(r, {{slots.org[0][si], slots.org[1][si], slots.org[2][si]},
-                       0.0f,
-                       {slots.dir[0][si], slots.dir[1][si], slots.dir[2][si]},
-                       tfar});
-          signed_base[r] = double(ray_setup.front);
-        }
+      const std::size_t sample_count = compact_samples(slots, slot_count, kTexels, default_rays, covered);
       // The other rays one at a time: other policies, and the special cases of the default one.
       const std::size_t ray_count = sample_count * std::size_t(rays_per_sample);
       for (std::size_t r = 0; r < sample_count; ++r) {
@@ -649,36 +649,34 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
         for (std::size_t r = 0; r < ray_count; ++r) opt.record_rays->push_back(rays.ray(r));
       }
       ts.rays += ray_count;
-      // The hit triangles' corner normals are scattered over the high-poly: ask for them all before
-      // shading needs the first, so the cache misses overlap.
-      for (std::size_t r = 0; r < ray_count; ++r)
-        if (hits.triangle[r] != raycast::no_hit) {
-          const char* line = reinterpret_cast<const char*>(&s.bvh_normals[3 * std::size_t(hits.triangle[r])]);
-          __builtin_prefetch(line);
-          __builtin_prefetch(line + sizeof(glm::vec3) * 3 - 1);
-        }
       // Shade: the high-poly normal at the hit, in the low-poly's tangent frame at P. First, in
       // sample order, which ray's hit counts and the hit statistics; then the common case (tangent
-      // space, per-pixel bitangent) for all hits at once; then each sample's value into its texel.
+      // space, per-pixel bitangent) for all samples at once; then, one at a time, the misses and
+      // the cases the batch leaves out; last, each sample's value into its texel.
       std::fill(acc.begin(), acc.end(), 0.0);
       std::fill(miss_count.begin(), miss_count.end(), 0u);
-      std::size_t batch_count = 0, tile_hits = 0;
-      // In registers for the tile: the batch stores below could alias the thread's counters.
+      std::size_t tile_hits = 0;
+      // In registers for the tile: the stores below could alias the thread's counters.
       double dsum = 0.0, dmin = ts.dmin, dmax = ts.dmax;
       for (std::size_t r = 0; r < sample_count; ++r) {
         double dist = 0.0;
         const std::size_t h = chosen_hit(hits, r * rays_per_sample, signed_base.data(), closest, &dist);
-        chosen[r] = std::uint32_t(h);
-        batch_of[r] = -1;
+        if (rays_per_sample != 1) {
+          chosen[r] = std::uint32_t(h);
+          chosen_tri[r] = hits.triangle[h];
+          chosen_u[r] = hits.u[h];
+          chosen_v[r] = hits.v[h];
+        }
         if (hits.triangle[h] != raycast::no_hit) {
+          // The hit triangles' corner normals are scattered over the high-poly: ask for them all
+          // before shading needs the first, so the cache misses overlap.
+          const char* line = reinterpret_cast<const char*>(&s.bvh_normals[3 * std::size_t(hits.triangle[h])]);
+          __builtin_prefetch(line);
+          __builtin_prefetch(line + sizeof(glm::vec3) * 3 - 1);
           ++tile_hits;
           dmin = std::min(dmin, dist);
           dmax = std::max(dmax, dist);
           dsum += dist;
-          if (batched) {
-            batch_of[r] = std::int32_t(batch_count);
-            batch[batch_count++] = {{sb[0][r], sb[1][r], sb[2][r]}, std::uint32_t(sample_tri[r]), hits.triangle[h], hits.u[h], hits.v[h]};
-          }
         } else {
           ++miss_count[sample_texel[r]];
         }
@@ -689,22 +687,15 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
       ts.dmin = dmin;
       ts.dmax = dmax;
       tile_dsum[tile] = dsum;
-      if (batch_count)
-        encode_hits_per_pixel(low_tris.data(), s.bvh_normals, batch.data(), batch_count,
-                              batch_value.data(), batch_degenerate.data());
+      if (batched && sample_count)
+        encode_hits_per_pixel(low_tris.data(), s.bvh_normals, shade_in, sample_count, value_c, one_at_a_time.data());
       for (std::size_t r = 0; r < sample_count; ++r) {
-        const std::int32_t bi = batch_of[r];
-        glm::dvec3 value;
-        if (bi >= 0 && !batch_degenerate[std::size_t(bi)]) {
-          value = batch_value[std::size_t(bi)];
-        } else {
-          const double b[3] = {sb[0][r], sb[1][r], sb[2][r]};
-          value = shade_sample(s, std::size_t(sample_tri[r]), b, rays.hit(chosen[r]), opt);
-        }
-        const std::size_t lt = sample_texel[r];
-        for (int c = 0; c < 3; ++c) sums.sum[c][lt] += value[c];
-        sums.count[lt] += 1.0;
+        if (!one_at_a_time[r]) continue;
+        const double b[3] = {sb[0][r], sb[1][r], sb[2][r]};
+        const glm::dvec3 v = shade_sample(s, std::size_t(sample_tri[r]), b, rays.hit(rays_per_sample == 1 ? r : chosen[r]), opt);
+        for (int c = 0; c < 3; ++c) value_c[c][r] = v[c];
       }
+      accumulate_samples(value_c, sample_texel.data(), sample_count, sums);
       // Texels: renormalized mean of their covered samples.
       const bool flip_y = opt.space == NormalSpace::tangent && opt.green_down;
       for (int y = 0; y < th; ++y) {

@@ -3,7 +3,11 @@
 #pragma once
 
 #include <cstddef>
+#include <algorithm>
 #include <cstdint>
+#include <memory>
+#include <new>
+#include <utility>
 #include <vector>
 
 #if defined(__linux__)
@@ -12,18 +16,46 @@
 
 namespace nmbake {
 
+// std::allocator, except that a vector's new elements are default-initialized (for float: left
+// as they are) where std::allocator value-initializes them (zeroes them).
+template <typename T>
+struct DefaultInitAllocator : std::allocator<T> {
+  template <typename U>
+  struct rebind {
+    using other = DefaultInitAllocator<U>;
+  };
+  DefaultInitAllocator() = default;
+  template <typename U>
+  DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept {}
+  template <typename U>
+  void construct(U* p) noexcept {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <typename U, typename... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+
 struct Image {
   int width = 0;
   int height = 0;
   int channels = 0;
-  std::vector<float> pixels;  // width * height * channels, row-major from the top row
+  using Pixels = std::vector<float, DefaultInitAllocator<float>>;
+  Pixels pixels;  // width * height * channels, row-major from the top row
 
   Image() = default;
-  Image(int w, int h, int c, float fill = 0.0f) : width(w), height(h), channels(c) {
+  Image(int w, int h, int c, float fill = 0.0f) : Image(w, h, c, Unset{}) {
+    std::fill(pixels.begin(), pixels.end(), fill);
+  }
+  // Pixels left unset, for a caller that writes every one before reading any: a large map is not
+  // written twice (the memory comes from the system zeroed anyway).
+  struct Unset {};
+  Image(int w, int h, int c, Unset) : width(w), height(h), channels(c) {
     const std::size_t n = static_cast<std::size_t>(w) * h * c;
     pixels.reserve(n);
     advise_huge_pages(pixels.data(), n * sizeof(float));
-    pixels.resize(n, fill);
+    pixels.resize(n);
   }
 
   float* at(int x, int y) { return &pixels[(static_cast<std::size_t>(y) * width + x) * channels]; }

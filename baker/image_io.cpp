@@ -40,8 +40,8 @@ std::string one_line(std::string s) {
 // For v = value * scale >= 0, round(v) == trunc(v + 0.5) exactly: v is a float times at most
 // 65535, so v + 0.5 is exact in double wherever it can reach 1. Negative and NaN values clamp to 0
 // either way.
-template <typename T>
-std::vector<T> quantize(const std::vector<float>& values, double scale) {
+template <typename T, typename Floats>
+std::vector<T> quantize(const Floats& values, double scale) {
   std::vector<T> out(values.size());
   for (std::size_t i = 0; i < values.size(); ++i) {
     double v = static_cast<double>(values[i]) * scale + 0.5;

@@ -21,6 +21,7 @@ namespace nmbake::lanes {
 typedef double V __attribute__((vector_size(32)));
 typedef std::int64_t M __attribute__((vector_size(32)));  // comparison results: all ones or zero per lane
 typedef float F __attribute__((vector_size(16)));
+typedef std::int32_t I __attribute__((vector_size(16)));  // also the comparison results of F
 constexpr int kLanes = 4;
 
 struct V3 {
@@ -45,8 +46,14 @@ template <typename Fn>
   for (int k = 0; k < kLanes; ++k) r[k] = std::sqrt(a[k]);
 }
 // Bit k set for each lane k whose mask is set.
+[[gnu::always_inline]] inline unsigned bits(const I& m) {
+  const I t = m & I{1, 2, 4, 8};
+  const I u = t | I{t[2], t[3], 0, 0};
+  return unsigned(u[0] | u[1]);
+}
 [[gnu::always_inline]] inline unsigned bits(const M& m) {
-  return unsigned(m[0] != 0) | unsigned(m[1] != 0) << 1 | unsigned(m[2] != 0) << 2 | unsigned(m[3] != 0) << 3;
+  const I narrow = __builtin_convertvector(m, I);
+  return bits(narrow);
 }
 
 }  // namespace nmbake::lanes

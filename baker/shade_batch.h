@@ -22,19 +22,23 @@ struct LowTriangle {
   glm::dvec4 t[3];
 };
 
-// One hit sample to shade.
-struct HitSample {
-  double b[3];             // barycentrics of the sample on its low-poly triangle
-  std::uint32_t low_tri;   // the low-poly triangle
-  std::uint32_t high_tri;  // the high-poly triangle hit
-  float u, v;              // the hit's barycentrics of corners 1 and 2 (Embree's convention)
+// Samples to shade, as arrays: per sample, the low-poly triangle and barycentrics, and the hit's
+// high-poly triangle (raycast's no_hit, 0xffffffff, for a miss) with its barycentrics u, v of
+// corners 1 and 2 (Embree's convention).
+struct ShadeSamples {
+  const std::int32_t* low_tri;
+  const double* b[3];
+  const std::uint32_t* high_tri;
+  const float* u;
+  const float* v;
 };
 
-// For i < count: value[i] = encode_tangent_normal(interpolate_frame(low[low_tri], b, per_pixel),
-// normalize(interpolated high-poly normal)), and degenerate[i] = 0; or degenerate[i] = 1 (value[i]
-// unspecified) when the interpolated hit normal is shorter than 1e-12 or the frame is singular or
-// the result not finite. high_corner_normals holds 3 normals per high-poly triangle.
-void encode_hits_per_pixel(const LowTriangle* low, const glm::vec3* high_corner_normals, const HitSample* samples,
-                           std::size_t count, glm::dvec3* value, std::uint8_t* degenerate);
+// For i < count: value[c][i] = component c of encode_tangent_normal(interpolate_frame(low[low_tri],
+// b, per_pixel), normalize(interpolated high-poly normal)), and degenerate[i] = 0; or
+// degenerate[i] = 1 (value unspecified) for a miss, or when the interpolated hit normal is shorter
+// than 1e-12, the frame singular or the result not finite. high_corner_normals holds 3 normals per
+// high-poly triangle.
+void encode_hits_per_pixel(const LowTriangle* low, const glm::vec3* high_corner_normals, const ShadeSamples& samples,
+                           std::size_t count, double* const value[3], std::uint8_t* degenerate);
 
 }  // namespace nmbake

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cfloat>
+#include <cmath>
+#include <cstring>
 
 #include "lanes.h"
 
@@ -54,9 +56,31 @@ __attribute__((target_clones("avx2", "default"))) std::size_t cover_rect(const T
     double row_term[3];
     for (int k = 0; k < 3; ++k) row_term[k] = tt.edge_d[k].x * (qy - tt.edge_a[k].y);
     const std::size_t row = first + std::size_t(y - y0) * row_stride;
-    for (int x = x0; x <= x1; x += kLanes) {
+    // The row's texels that can be covered, xa .. xb: each edge's value is linear in x, with one
+    // sign on one side of where it crosses 0 and the other on the other. The bounds have a margin
+    // far above the rounding of that crossing; the test below decides every texel in them.
+    int xa = x0, xb = x1;
+    bool empty = false;
+    for (int k = 0; k < 3 && !empty; ++k) {
+      const double dy = tt.edge_d[k].y;
+      if (dy == 0.0) continue;  // the edge's value does not change along the row
+      const double cross = tt.edge_a[k].x + row_term[k] / dy - ox;
+      if (!(cross >= -DBL_MAX && cross <= DBL_MAX)) continue;  // not finite: no bound
+      const double slack = 1e-6 * (1.0 + (cross < 0.0 ? -cross : cross));
+      if ((tt.edge_side[k] > 0.0) == (dy > 0.0)) {  // covered only up to the crossing
+        const double hi = std::floor(cross + slack);
+        if (hi < double(xa)) empty = true;
+        else if (hi < double(xb)) xb = int(hi);
+      } else {  // covered only from the crossing on
+        const double lo = std::ceil(cross - slack);
+        if (lo > double(xb)) empty = true;
+        else if (lo > double(xa)) xa = int(lo);
+      }
+    }
+    if (empty) continue;
+    for (int x = xa; x <= xb; x += kLanes) {
       const V qx = V{double(x), double(x + 1), double(x + 2), double(x + 3)} + ox;
-      M in = {x <= x1 ? -1 : 0, x + 1 <= x1 ? -1 : 0, x + 2 <= x1 ? -1 : 0, x + 3 <= x1 ? -1 : 0};
+      M in = {x <= xb ? -1 : 0, x + 1 <= xb ? -1 : 0, x + 2 <= xb ? -1 : 0, x + 3 <= xb ? -1 : 0};
       V w[3];
       for (int k = 0; k < 3; ++k) {
         const V e = row_term[k] - tt.edge_d[k].y * (qx - tt.edge_a[k].x);
@@ -78,9 +102,31 @@ __attribute__((target_clones("avx2", "default"))) std::size_t cover_rect(const T
                        __builtin_convertvector(org.z, F)};
       const F df[3] = {__builtin_convertvector(dir.x, F), __builtin_convertvector(dir.y, F),
                        __builtin_convertvector(dir.z, F)};
+      const std::size_t slot0 = row + std::size_t(x - x0);
+      if (m == 0xfu) {
+        // The common case, four lanes at once: all four samples covered, their slots free, none
+        // near enough to an edge to be moved in (inset_from_edges leaves them as they are).
+        I held;
+        std::memcpy(&held, &slots.tri[slot0], sizeof held);
+        const M far_from_edges = (b[0] >= kEdgeInset) & (b[1] >= kEdgeInset) & (b[2] >= kEdgeInset);
+        if (bits(held < 0) == 0xfu && bits(far_from_edges) == 0xfu) {
+          const I tris = {t, t, t, t};
+          std::memcpy(&slots.tri[slot0], &tris, sizeof tris);
+          for (int c = 0; c < 3; ++c) std::memcpy(&slots.b[c][slot0], &b[c], sizeof(V));
+          if (!rays.low) continue;
+          for (int c = 0; c < 3; ++c) {
+            std::memcpy(&slots.org[c][slot0], &of[c], sizeof(F));
+            std::memcpy(&slots.dir[c][slot0], &df[c], sizeof(F));
+          }
+          const std::uint8_t fallback[kLanes] = {std::uint8_t(~good & 1u), std::uint8_t(~good >> 1 & 1u),
+                                                 std::uint8_t(~good >> 2 & 1u), std::uint8_t(~good >> 3 & 1u)};
+          std::memcpy(&slots.ray_fallback[slot0], fallback, sizeof fallback);
+          continue;
+        }
+      }
       for (int k = 0; k < kLanes; ++k) {
         if (!(m >> k & 1u)) continue;
-        const std::size_t slot = row + std::size_t(x + k - x0);
+        const std::size_t slot = slot0 + std::size_t(k);
         if (slots.tri[slot] >= 0) {
           ++taken;
           continue;
@@ -102,6 +148,87 @@ __attribute__((target_clones("avx2", "default"))) std::size_t cover_rect(const T
   return taken;
 }
 
+__attribute__((target_clones("avx2", "default"))) std::size_t compact_samples(const SampleSlots& slots,
+                                                                               std::size_t slot_count, std::size_t texels,
+                                                                               bool rays, const CoveredSamples& out) {
+  std::size_t n = 0;
+  const auto copy_one = [&](std::size_t i) {
+    out.tri[n] = slots.tri[i];
+    for (int c = 0; c < 3; ++c) out.b[c][n] = slots.b[c][i];
+    out.texel[n] = std::uint16_t(i % texels);
+    if (rays) {
+      for (int c = 0; c < 3; ++c) {
+        out.org[c][n] = slots.org[c][i];
+        out.dir[c][n] = slots.dir[c][i];
+      }
+      out.ray_fallback[n] = slots.ray_fallback[i];
+    }
+    ++n;
+  };
+  std::size_t i = 0;
+  if (texels % kLanes == 0) {
+    // Four slots at a time (they are four consecutive texels); one by one where some are empty.
+    for (std::size_t texel = 0; i + kLanes <= slot_count; i += kLanes, texel = texel + kLanes == texels ? 0 : texel + kLanes) {
+      std::int32_t tri[kLanes];
+      std::memcpy(tri, &slots.tri[i], sizeof tri);
+      if ((tri[0] & tri[1] & tri[2] & tri[3]) < 0) continue;  // all empty
+      if ((tri[0] | tri[1] | tri[2] | tri[3]) < 0) {          // some empty
+        for (std::size_t k = 0; k < kLanes; ++k)
+          if (tri[k] >= 0) copy_one(i + k);
+        continue;
+      }
+      std::memcpy(&out.tri[n], tri, sizeof tri);
+      for (int c = 0; c < 3; ++c) std::memcpy(&out.b[c][n], &slots.b[c][i], kLanes * sizeof(double));
+      const std::uint16_t tex[kLanes] = {std::uint16_t(texel), std::uint16_t(texel + 1), std::uint16_t(texel + 2),
+                                         std::uint16_t(texel + 3)};
+      std::memcpy(&out.texel[n], tex, sizeof tex);
+      if (rays) {
+        for (int c = 0; c < 3; ++c) {
+          std::memcpy(&out.org[c][n], &slots.org[c][i], kLanes * sizeof(float));
+          std::memcpy(&out.dir[c][n], &slots.dir[c][i], kLanes * sizeof(float));
+        }
+        std::memcpy(&out.ray_fallback[n], &slots.ray_fallback[i], kLanes);
+      }
+      n += kLanes;
+    }
+  }
+  for (; i < slot_count; ++i)
+    if (slots.tri[i] >= 0) copy_one(i);
+  return n;
+}
+
+__attribute__((target_clones("avx2", "default"))) void accumulate_samples(const double* const value[3],
+                                                                           const std::uint16_t* texel, std::size_t count,
+                                                                           const TexelSums& sums) {
+  const auto add_one = [&](std::size_t i) {
+    const std::size_t t = texel[i];
+    for (int c = 0; c < 3; ++c) sums.sum[c][t] += value[c][i];
+    sums.count[t] += 1.0;
+  };
+  std::size_t i = 0;
+  for (; i + kLanes <= count; i += kLanes) {
+    // Four samples of four consecutive texels (the common case) are four different texels: their
+    // additions are independent, four at a time.
+    const std::size_t t = texel[i];
+    if (!(texel[i + 1] == t + 1 && texel[i + 2] == t + 2 && texel[i + 3] == t + 3)) {
+      for (std::size_t k = 0; k < kLanes; ++k) add_one(i + k);
+      continue;
+    }
+    for (int c = 0; c < 3; ++c) {
+      V sum, add;
+      std::memcpy(&sum, &sums.sum[c][t], sizeof sum);
+      std::memcpy(&add, &value[c][i], sizeof add);
+      sum += add;
+      std::memcpy(&sums.sum[c][t], &sum, sizeof sum);
+    }
+    V n;
+    std::memcpy(&n, &sums.count[t], sizeof n);
+    n += 1.0;
+    std::memcpy(&sums.count[t], &n, sizeof n);
+  }
+  for (; i < count; ++i) add_one(i);
+}
+
 __attribute__((target_clones("avx2", "default"))) void write_texel_row(const TexelSums& sums, std::size_t first,
                                                                         int width, bool flip_y, double snap, float* rgb,
                                                                         std::uint8_t* covered) {
@@ -110,10 +237,18 @@ __attribute__((target_clones("avx2", "default"))) void write_texel_row(const Tex
     const int n = std::min(kLanes, width - x);
     V3 v;
     V count;
-    gather(v.x, [&](int k) { return sums.sum[0][first + std::size_t(x + std::min(k, n - 1))]; });
-    gather(v.y, [&](int k) { return sums.sum[1][first + std::size_t(x + std::min(k, n - 1))]; });
-    gather(v.z, [&](int k) { return sums.sum[2][first + std::size_t(x + std::min(k, n - 1))]; });
-    gather(count, [&](int k) { return sums.count[first + std::size_t(x + std::min(k, n - 1))]; });
+    const std::size_t at = first + std::size_t(x);
+    if (n == kLanes) {
+      std::memcpy(&v.x, &sums.sum[0][at], sizeof(V));
+      std::memcpy(&v.y, &sums.sum[1][at], sizeof(V));
+      std::memcpy(&v.z, &sums.sum[2][at], sizeof(V));
+      std::memcpy(&count, &sums.count[at], sizeof(V));
+    } else {  // a short last block repeats its last texel
+      gather(v.x, [&](int k) { return sums.sum[0][at + std::size_t(std::min(k, n - 1))]; });
+      gather(v.y, [&](int k) { return sums.sum[1][at + std::size_t(std::min(k, n - 1))]; });
+      gather(v.z, [&](int k) { return sums.sum[2][at + std::size_t(std::min(k, n - 1))]; });
+      gather(count, [&](int k) { return sums.count[at + std::size_t(std::min(k, n - 1))]; });
+    }
     const unsigned filled = bits(count > zero);
     if (!filled) continue;
     // glm::length, then v * (1 / length); a zero sum gives (0, 0, 1).

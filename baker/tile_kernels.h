@@ -43,11 +43,34 @@ struct DefaultRays {
 std::size_t cover_rect(const TexelTriangle& tt, std::int32_t t, int x0, int x1, int y0, int y1, double ox, double oy,
                        const DefaultRays& rays, const SampleSlots& slots, std::size_t first, std::size_t row_stride);
 
+// A tile's covered samples, in order, as arrays: triangle, barycentrics, texel of the tile and,
+// with rays, the ray's origin and direction and whether the caller must make the ray itself.
+struct CoveredSamples {
+  std::int32_t* tri;
+  double* b[3];
+  std::uint16_t* texel;
+  float* org[3];
+  float* dir[3];
+  std::uint8_t* ray_fallback;
+};
+
+// Copies each slot i < slot_count that holds a triangle, in increasing i, to the next entry of
+// `out`: triangle, barycentrics, texel i % texels and, with `rays`, the ray and its fallback flag.
+// Returns how many. Slot k * texels + t is sample k of texel t, so each texel's samples come in
+// sample order. texels must be at most 65536.
+std::size_t compact_samples(const SampleSlots& slots, std::size_t slot_count, std::size_t texels, bool rays,
+                            const CoveredSamples& out);
+
 // A tile's texels as arrays: per texel, the sums of its samples' values and how many it has.
 struct TexelSums {
   double* sum[3];
   double* count;
 };
+
+// For each sample i < count, in order: sums.sum[c][texel[i]] += value[c][i] (c = 0, 1, 2) and
+// sums.count[texel[i]] += 1.
+void accumulate_samples(const double* const value[3], const std::uint16_t* texel, std::size_t count,
+                        const TexelSums& sums);
 
 // Texels first .. first + width - 1 of `sums` (one row): each with a positive count is written as
 // v * 0.5 + 0.5 (float) to rgb[3x], rgb[3x + 1], rgb[3x + 2] with covered[x] = 1, where v is its

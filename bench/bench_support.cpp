@@ -261,7 +261,7 @@ const nlohmann::json* find_key(const nlohmann::json& j, const std::string& key) 
   return nullptr;
 }
 
-std::uint64_t pixel_hash(const std::vector<float>& pixels) {
+std::uint64_t pixel_hash(const Image::Pixels& pixels) {
   std::uint64_t h = 1469598103934665603ull;
   for (float v : pixels) {
     std::uint32_t bits;

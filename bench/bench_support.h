@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "image.h"
 #include "mesh.h"
 #include "raycast.h"
 
@@ -72,7 +73,7 @@ const nlohmann::json* find_key(const nlohmann::json& j, const std::string& key);
 
 // FNV-1a over the bits of the pixel values: equal hashes = bit-identical maps (for comparing
 // runs and commits).
-std::uint64_t pixel_hash(const std::vector<float>& pixels);
+std::uint64_t pixel_hash(const Image::Pixels& pixels);
 
 std::string mib(double bytes);
 

@@ -64,6 +64,12 @@ class RayArrays {
   Hit hit(std::size_t i) const {  // after Scene::intersect
     return {triangle_[i], fields_[8 * count_ + i], fields_[9 * count_ + i], fields_[10 * count_ + i]};
   }
+  // The ray fields as writable arrays, for filling many rays in place: origin and direction
+  // components c = 0, 1, 2, tnear and tfar.
+  float* origin(int c) { return fields_.data() + std::size_t(c) * count_; }
+  float* direction(int c) { return fields_.data() + std::size_t(3 + c) * count_; }
+  float* tnear() { return fields_.data() + 6 * count_; }
+  float* tfar() { return fields_.data() + 7 * count_; }
   // The rays and hits from ray `first` on.
   RayBatch rays(std::size_t first = 0) const;
   HitBatch hits(std::size_t first = 0);

@@ -29,6 +29,16 @@ void compare_on_random_rays(const Mesh& m, unsigned seed, int count) {
   raycast::RayArrays arrays(rays.data(), rays.size());
   scene.intersect(arrays.rays(), arrays.hits(), arrays.size());
   const raycast::HitBatch batch = arrays.hits();
+  // Filled field by field in place (as the bake fills its rays), the arrays hold the same rays.
+  raycast::RayArrays filled(rays.size());
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      filled.origin(c)[i] = rays[i].origin[c];
+      filled.direction(c)[i] = rays[i].direction[c];
+    }
+    filled.tnear()[i] = rays[i].tnear;
+    filled.tfar()[i] = rays[i].tfar;
+  }
   int hits = 0;
   for (std::size_t i = 0; i < rays.size(); ++i) {
     const raycast::Hit e = scene.intersect(rays[i]);
@@ -42,6 +52,11 @@ void compare_on_random_rays(const Mesh& m, unsigned seed, int count) {
     EXPECT_EQ(back.direction, rays[i].direction) << "ray " << i;
     EXPECT_EQ(back.tnear, rays[i].tnear) << "ray " << i;
     EXPECT_EQ(back.tfar, rays[i].tfar) << "ray " << i;
+    const raycast::Ray in_place = filled.ray(i);
+    EXPECT_EQ(in_place.origin, rays[i].origin) << "ray " << i;
+    EXPECT_EQ(in_place.direction, rays[i].direction) << "ray " << i;
+    EXPECT_EQ(in_place.tnear, rays[i].tnear) << "ray " << i;
+    EXPECT_EQ(in_place.tfar, rays[i].tfar) << "ray " << i;
     EXPECT_EQ(arrays.hit(i).triangle, e.triangle) << "ray " << i;
     if (e.hit()) {
       EXPECT_EQ(batch.t[i], e.t) << "ray " << i;

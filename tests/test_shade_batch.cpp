@@ -41,33 +41,40 @@ TEST(ShadeBatch, BitIdenticalToOneAtATime) {
   for (int i = 0; i < 3 * 50; ++i) high_normals.push_back(glm::normalize(glm::vec3(uf(rng), uf(rng), 1.0f)));
   for (int c = 0; c < 3; ++c) high_normals[3 * 7 + c] = glm::vec3(0.0f);  // a zero hit normal: flagged
   const std::size_t n = 77;  // not a multiple of the lane count
-  std::vector<HitSample> samples(n);
+  // The first 30 samples share a triangle (the kernel broadcasts it), the rest mix triangles.
+  std::vector<std::int32_t> low_tri(n);
+  std::vector<double> b[3] = {std::vector<double>(n), std::vector<double>(n), std::vector<double>(n)};
+  std::vector<std::uint32_t> high_tri(n);
+  std::vector<float> hu(n), hv(n);
   for (std::size_t i = 0; i < n; ++i) {
-    HitSample& s = samples[i];
-    s.b[0] = u(rng), s.b[1] = (1.0 - s.b[0]) * u(rng), s.b[2] = 1.0 - s.b[0] - s.b[1];
-    s.low_tri = std::uint32_t(i < 30 ? 1 : i % low.size());
-    s.high_tri = std::uint32_t((i * 13) % 50);
-    s.u = float(u(rng)), s.v = float((1.0 - double(s.u)) * u(rng));
+    b[0][i] = u(rng), b[1][i] = (1.0 - b[0][i]) * u(rng), b[2][i] = 1.0 - b[0][i] - b[1][i];
+    low_tri[i] = std::int32_t(i < 30 ? 1 : i % low.size());
+    high_tri[i] = i % 17 == 5 ? 0xffffffffu : std::uint32_t((i * 13) % 50);  // some misses: flagged
+    hu[i] = float(u(rng)), hv[i] = float((1.0 - double(hu[i])) * u(rng));
   }
-  std::vector<glm::dvec3> value(n);
-  std::vector<std::uint8_t> degenerate(n);
-  encode_hits_per_pixel(low.data(), high_normals.data(), samples.data(), n, value.data(), degenerate.data());
-  std::size_t checked = 0;
+  const ShadeSamples samples{low_tri.data(), {b[0].data(), b[1].data(), b[2].data()}, high_tri.data(), hu.data(), hv.data()};
+  std::vector<double> value[3] = {std::vector<double>(n), std::vector<double>(n), std::vector<double>(n)};
+  double* const value_c[3] = {value[0].data(), value[1].data(), value[2].data()};
+  std::vector<std::uint8_t> degenerate(n, 7);
+  encode_hits_per_pixel(low.data(), high_normals.data(), samples, n, value_c, degenerate.data());
+  std::size_t checked = 0, misses = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    const HitSample& s = samples[i];
-    if (s.high_tri == 7) {
-      EXPECT_TRUE(degenerate[i]) << i;
+    if (high_tri[i] == 7 || high_tri[i] == 0xffffffffu) {
+      EXPECT_EQ(degenerate[i], 1) << i;
+      misses += high_tri[i] != 7;
       continue;
     }
-    ASSERT_FALSE(degenerate[i]) << i;
-    const LowTriangle& lt = low[s.low_tri];
-    const PixelFrame frame = interpolate_frame(lt.n, lt.t, s.b);
-    const double w[3] = {1.0 - double(s.u) - double(s.v), double(s.u), double(s.v)};
+    ASSERT_EQ(degenerate[i], 0) << i;
+    const LowTriangle& lt = low[std::size_t(low_tri[i])];
+    const double bi[3] = {b[0][i], b[1][i], b[2][i]};
+    const PixelFrame frame = interpolate_frame(lt.n, lt.t, bi);
+    const double w[3] = {1.0 - double(hu[i]) - double(hv[i]), double(hu[i]), double(hv[i])};
     glm::dvec3 nh(0.0);
-    for (int c = 0; c < 3; ++c) nh += w[c] * glm::dvec3(high_normals[3 * s.high_tri + c]);
+    for (int c = 0; c < 3; ++c) nh += w[c] * glm::dvec3(high_normals[3 * high_tri[i] + c]);
     const glm::dvec3 expect = encode_tangent_normal(frame, nh / glm::length(nh));
-    for (int c = 0; c < 3; ++c) EXPECT_TRUE(same_bits(value[i][c], expect[c])) << "sample " << i << " axis " << c;
+    for (int c = 0; c < 3; ++c) EXPECT_TRUE(same_bits(value[c][i], expect[c])) << "sample " << i << " axis " << c;
     ++checked;
   }
-  EXPECT_GT(checked, 60u);
+  EXPECT_GT(checked, 55u);
+  EXPECT_GT(misses, 3u);
 }

@@ -183,3 +183,60 @@ TEST(TileKernels, WriteTexelRowIsTheTexelFormula) {
       }
     }
 }
+
+// compact_samples keeps the covered slots in slot order with their texels; accumulate_samples then
+// sums each texel's values in that order, as one addition after another would.
+TEST(TileKernels, CompactAndAccumulateKeepSampleOrder) {
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  constexpr std::size_t kTexels = 64;
+  for (int samples = 1; samples <= 5; ++samples) {
+    const std::size_t n = kTexels * std::size_t(samples);
+    Slots slots(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      // Runs of covered slots, gaps, and single ones: both the four-at-a-time and the one-by-one paths.
+      const bool covered = (i / 9) % 3 != 1 && i % 13 != 4;
+      slots.tri[i] = covered ? std::int32_t(i % 7) : -1;
+      for (int c = 0; c < 3; ++c) slots.b[std::size_t(c) * n + i] = u(rng);
+      for (int c = 0; c < 6; ++c) slots.ray[std::size_t(c) * n + i] = float(u(rng));
+      slots.fallback[i] = std::uint8_t(i % 3 == 0);
+    }
+    std::vector<std::int32_t> tri(n);
+    std::vector<double> b(3 * n);
+    std::vector<std::uint16_t> texel(n);
+    std::vector<float> ray(6 * n);
+    std::vector<std::uint8_t> fallback(n);
+    const CoveredSamples out{tri.data(),
+                             {&b[0], &b[n], &b[2 * n]},
+                             texel.data(),
+                             {&ray[0], &ray[n], &ray[2 * n]},
+                             {&ray[3 * n], &ray[4 * n], &ray[5 * n]},
+                             fallback.data()};
+    const std::size_t count = compact_samples(slots.view, n, kTexels, true, out);
+    std::size_t r = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (slots.tri[i] < 0) continue;
+      ASSERT_LT(r, count);
+      EXPECT_EQ(tri[r], slots.tri[i]) << i;
+      EXPECT_EQ(texel[r], i % kTexels) << i;
+      EXPECT_EQ(fallback[r], slots.fallback[i]) << i;
+      for (int c = 0; c < 3; ++c) EXPECT_TRUE(same_bits(b[std::size_t(c) * n + r], slots.b[std::size_t(c) * n + i])) << i;
+      for (int c = 0; c < 6; ++c)
+        EXPECT_TRUE(same_bits(ray[std::size_t(c) * n + r], slots.ray[std::size_t(c) * n + i])) << i;
+      ++r;
+    }
+    EXPECT_EQ(count, r);
+
+    std::vector<double> value(3 * n);
+    for (double& v : value) v = u(rng);
+    const double* const value_c[3] = {&value[0], &value[n], &value[2 * n]};
+    std::vector<double> acc(4 * kTexels, 0.0), expect(4 * kTexels, 0.0);
+    const TexelSums sums{{&acc[0], &acc[kTexels], &acc[2 * kTexels]}, &acc[3 * kTexels]};
+    accumulate_samples(value_c, texel.data(), count, sums);
+    for (std::size_t i = 0; i < count; ++i) {
+      for (int c = 0; c < 3; ++c) expect[std::size_t(c) * kTexels + texel[i]] += value_c[c][i];
+      expect[3 * kTexels + texel[i]] += 1.0;
+    }
+    for (std::size_t i = 0; i < acc.size(); ++i) EXPECT_TRUE(same_bits(acc[i], expect[i])) << samples << " samples, " << i;
+  }
+}
