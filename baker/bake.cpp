@@ -37,6 +37,7 @@ double process_cpu_seconds() {
   return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
+constexpr std::size_t kTilesPerGrab = 4;  // consecutive tiles a trace thread takes at once
 constexpr int kTile = 16;            // texels per tile side
 // Tangent components this close to zero are written as exactly 0: a flat result is then
 // (128,128,255) and not a coin flip between 127 and 128 decided by float noise.
@@ -498,7 +499,11 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   t0 = Clock::now();
   const double cpu0 = process_cpu_seconds();
   const int W = opt.width, H = opt.height;
-  const int tiles_x = (W + kTile - 1) / kTile, tiles_y = (H + kTile - 1) / kTile;
+  // Tiles of 32 x 32 texels up to 4 samples, else 16 x 16: a triangle's rows within a tile are
+  // longer with the larger ones (less set-up per texel), and a tile's samples stay within the
+  // cache with the smaller.
+  const int tile_side = opt.samples <= 4 ? 2 * kTile : kTile;
+  const int tiles_x = (W + tile_side - 1) / tile_side, tiles_y = (H + tile_side - 1) / tile_side;
   const std::size_t tile_count = std::size_t(tiles_x) * tiles_y;
   std::vector<TexelTriangle> texel_tris(low.triangle_count());
   std::vector<std::uint32_t> bin_start(tile_count + 1, 0);
@@ -506,8 +511,8 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     texel_tris[t] = setup_texel_triangle(low.corner_uv(t, 0), low.corner_uv(t, 1), low.corner_uv(t, 2), W, H);
     const TexelTriangle& tt = texel_tris[t];
     if (!tt.valid() || tt.xmax < tt.xmin || tt.ymax < tt.ymin) continue;
-    for (int ty = tt.ymin / kTile; ty <= tt.ymax / kTile; ++ty)
-      for (int tx = tt.xmin / kTile; tx <= tt.xmax / kTile; ++tx) ++bin_start[std::size_t(ty) * tiles_x + tx + 1];
+    for (int ty = tt.ymin / tile_side; ty <= tt.ymax / tile_side; ++ty)
+      for (int tx = tt.xmin / tile_side; tx <= tt.xmax / tile_side; ++tx) ++bin_start[std::size_t(ty) * tiles_x + tx + 1];
   }
   for (std::size_t i = 0; i < tile_count; ++i) bin_start[i + 1] += bin_start[i];
   std::vector<std::uint32_t> bin_tris(bin_start[tile_count]);
@@ -516,8 +521,8 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     for (std::size_t t = 0; t < low.triangle_count(); ++t) {
       const TexelTriangle& tt = texel_tris[t];
       if (!tt.valid() || tt.xmax < tt.xmin || tt.ymax < tt.ymin) continue;
-      for (int ty = tt.ymin / kTile; ty <= tt.ymax / kTile; ++ty)
-        for (int tx = tt.xmin / kTile; tx <= tt.xmax / kTile; ++tx)
+      for (int ty = tt.ymin / tile_side; ty <= tt.ymax / tile_side; ++ty)
+        for (int tx = tt.xmin / tile_side; tx <= tt.xmax / tile_side; ++tx)
           bin_tris[fill[std::size_t(ty) * tiles_x + tx]++] = std::uint32_t(t);
     }
   }
@@ -556,10 +561,10 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
 
   auto worker = [&](int id) {
     ThreadStats& ts = tstats[id];
-    // Sample slots of a tile: sample k of tile texel (x, y) is slot (k * kTile + y) * kTile + x, so
-    // a texel row is contiguous for the coverage kernel.
-    constexpr std::size_t kTexels = std::size_t(kTile) * kTile;
-    const std::size_t slot_count = kTexels * std::size_t(S);
+    // Sample slots of a tile: sample k of tile texel (x, y) is slot (k * tile_side + y) * tile_side
+    // + x, so a texel row is contiguous for the coverage kernel.
+    const std::size_t tile_texels = std::size_t(tile_side) * tile_side;
+    const std::size_t slot_count = tile_texels * std::size_t(S);
     const bool default_rays = !ray_setup.cage && !ray_setup.closest;
     std::vector<std::int32_t> slot_tri(slot_count);
     std::vector<double> slot_b(3 * slot_count);
@@ -604,12 +609,19 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     std::vector<double> value(3 * slot_count);
     double* const value_c[3] = {&value[0], &value[slot_count], &value[2 * slot_count]};
     std::vector<std::uint8_t> one_at_a_time(slot_count, 1);  // per covered sample: shaded by shade_sample
-    std::vector<double> acc(4 * kTexels);  // per texel of the tile: x, y, z sums and covered samples, as arrays
-    const TexelSums sums{{&acc[0], &acc[kTexels], &acc[2 * kTexels]}, &acc[3 * kTexels]};
-    std::vector<std::uint32_t> miss_count(kTexels);
-    for (std::size_t tile; !cancel.load(std::memory_order_relaxed) && (tile = next_tile.fetch_add(1)) < tile_count;) {
-      const int tx0 = int(tile % tiles_x) * kTile, ty0 = int(tile / tiles_x) * kTile;
-      const int tw = std::min(kTile, W - tx0), th = std::min(kTile, H - ty0);
+    std::vector<double> acc(4 * tile_texels);  // per texel of the tile: x, y, z sums and covered samples, as arrays
+    const TexelSums sums{{&acc[0], &acc[tile_texels], &acc[2 * tile_texels]}, &acc[3 * tile_texels]};
+    std::vector<std::uint32_t> miss_count(tile_texels);
+    for (std::size_t tile = 0, grab_end = 0; !cancel.load(std::memory_order_relaxed); ++tile) {
+      if (tile == grab_end) {
+        // A few consecutive tiles at a time: they lie near each other on the model, and a thread
+        // that casts their rays one after another finds more of the BVH in its own caches.
+        tile = next_tile.fetch_add(kTilesPerGrab);
+        if (tile >= tile_count) break;
+        grab_end = std::min(tile + kTilesPerGrab, tile_count);
+      }
+      const int tx0 = int(tile % tiles_x) * tile_side, ty0 = int(tile / tiles_x) * tile_side;
+      const int tw = std::min(tile_side, W - tx0), th = std::min(tile_side, H - ty0);
       const std::uint32_t b0 = bin_start[tile], b1 = bin_start[tile + 1];
       if (b0 == b1) {
         ++tiles_done;
@@ -626,10 +638,10 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
         if (x1 < x0 || y1 < y0) continue;
         for (int k = 0; k < S; ++k)
           ts.overlaps += cover_rect(tt, std::int32_t(t), x0, x1, y0, y1, offsets[k].x, offsets[k].y, default_ray_setup, slots,
-                                    (std::size_t(k) * kTile + std::size_t(y0 - ty0)) * kTile + std::size_t(x0 - tx0), kTile);
+                                    (std::size_t(k) * tile_side + std::size_t(y0 - ty0)) * tile_side + std::size_t(x0 - tx0), tile_side);
       }
       // The covered samples, in order, with the rays the coverage made (the default policy).
-      const std::size_t sample_count = compact_samples(slots, slot_count, kTexels, default_rays, covered);
+      const std::size_t sample_count = compact_samples(slots, slot_count, tile_texels, default_rays, covered);
       // The other rays one at a time: other policies, and the special cases of the default one.
       const std::size_t ray_count = sample_count * std::size_t(rays_per_sample);
       for (std::size_t r = 0; r < sample_count; ++r) {
@@ -699,7 +711,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
       // Texels: renormalized mean of their covered samples.
       const bool flip_y = opt.space == NormalSpace::tangent && opt.green_down;
       for (int y = 0; y < th; ++y) {
-        const std::size_t first = std::size_t(y) * kTile, gi = std::size_t(ty0 + y) * W + std::size_t(tx0);
+        const std::size_t first = std::size_t(y) * tile_side, gi = std::size_t(ty0 + y) * W + std::size_t(tx0);
         write_texel_row(sums, first, tw, flip_y, kSnap, result.map.at(tx0, ty0 + y), &result.coverage[gi]);
         if (opt.miss_mask)
           for (int x = 0; x < tw; ++x)

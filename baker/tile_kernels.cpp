@@ -50,6 +50,8 @@ __attribute__((target_clones("avx2", "default"))) std::size_t cover_rect(const T
                                                                           std::size_t first, std::size_t row_stride) {
   std::size_t taken = 0;
   const V zero = {0.0, 0.0, 0.0, 0.0};
+  double inv_dy[3];  // for the rows' bounds, which need not be exact
+  for (int k = 0; k < 3; ++k) inv_dy[k] = tt.edge_d[k].y != 0.0 ? 1.0 / tt.edge_d[k].y : 0.0;
   for (int y = y0; y <= y1; ++y) {
     const double qy = y + oy;
     // Edge k's value at q is d.x * (q.y - a.y) - d.y * (q.x - a.x); the first product is the row's.
@@ -58,15 +60,17 @@ __attribute__((target_clones("avx2", "default"))) std::size_t cover_rect(const T
     const std::size_t row = first + std::size_t(y - y0) * row_stride;
     // The row's texels that can be covered, xa .. xb: each edge's value is linear in x, with one
     // sign on one side of where it crosses 0 and the other on the other. The bounds have a margin
-    // far above the rounding of that crossing; the test below decides every texel in them.
+    // far above the rounding of that crossing (relative to the terms it sums) and of the edge
+    // values near it; the test below decides every texel in them.
     int xa = x0, xb = x1;
     bool empty = false;
     for (int k = 0; k < 3 && !empty; ++k) {
       const double dy = tt.edge_d[k].y;
       if (dy == 0.0) continue;  // the edge's value does not change along the row
-      const double cross = tt.edge_a[k].x + row_term[k] / dy - ox;
+      const double along = row_term[k] * inv_dy[k];
+      const double cross = tt.edge_a[k].x + along - ox;
       if (!(cross >= -DBL_MAX && cross <= DBL_MAX)) continue;  // not finite: no bound
-      const double slack = 1e-6 * (1.0 + (cross < 0.0 ? -cross : cross));
+      const double slack = 1e-6 * (1.0 + std::fabs(tt.edge_a[k].x) + std::fabs(along) + std::fabs(ox));
       if ((tt.edge_side[k] > 0.0) == (dy > 0.0)) {  // covered only up to the crossing
         const double hi = std::floor(cross + slack);
         if (hi < double(xa)) empty = true;
