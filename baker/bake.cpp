@@ -846,9 +846,12 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
       double b[3];
     };
     std::vector<Sample> work;
-    std::vector<raycast::Ray> rays;
-    std::vector<double> signed_base;
     constexpr std::size_t kChunk = 64;
+    // Sized for a chunk's most samples (each texel has at most one per offset); each chunk fills
+    // the first work.size() * rays_per_sample rays.
+    raycast::RayArrays arrays(kChunk * offsets.size() * std::size_t(rays_per_sample));
+    const raycast::HitBatch hits = arrays.hits();
+    std::vector<double> signed_base(arrays.size());
     for (std::size_t i0; (i0 = next.fetch_add(kChunk)) < texels.size();) {
       const std::size_t i1 = std::min(texels.size(), i0 + kChunk);
       work.clear();
@@ -863,13 +866,13 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
             break;
           }
       }
-      rays.resize(work.size() * rays_per_sample);
-      signed_base.resize(rays.size());
-      for (std::size_t r = 0; r < work.size(); ++r)
-        sample_rays(s, work[r].tri, work[r].b, ray_setup, &rays[r * rays_per_sample], &signed_base[r * rays_per_sample]);
-      raycast::RayArrays arrays(rays.data(), rays.size());
-      const raycast::HitBatch hits = arrays.hits();
-      if (!rays.empty()) scene.intersect(arrays.rays(), hits, rays.size());
+      for (std::size_t r = 0; r < work.size(); ++r) {
+        raycast::Ray one[2];
+        const int n = sample_rays(s, work[r].tri, work[r].b, ray_setup, one, &signed_base[r * rays_per_sample]);
+        for (int j = 0; j < n; ++j) arrays.set(r * rays_per_sample + std::size_t(j), one[j]);
+      }
+      const std::size_t ray_count = work.size() * std::size_t(rays_per_sample);
+      if (ray_count) scene.intersect(arrays.rays(), hits, ray_count);
       for (std::size_t r = 0; r < work.size(); ++r) {
         double dist = 0.0;
         const std::size_t h = chosen_hit(hits, r * rays_per_sample, signed_base.data(), ray_setup.closest, &dist);

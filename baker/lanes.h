@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
 // GCC 12 reports vectors built by gather() as "maybe uninitialized" in the AVX2 clones; every lane
 // is written before use (all four are assigned at once). Off for the kernel files that include this.
@@ -54,6 +55,13 @@ template <typename Fn>
 [[gnu::always_inline]] inline unsigned bits(const M& m) {
   const I narrow = __builtin_convertvector(m, I);
   return bits(narrow);
+}
+
+// to[k] = bit k of `bits` (0 or 1), for the four lanes: per-lane flags stored at once.
+[[gnu::always_inline]] inline void store_flags(std::uint8_t* to, unsigned bits) {
+  const std::uint8_t flags[kLanes] = {std::uint8_t(bits & 1u), std::uint8_t(bits >> 1 & 1u), std::uint8_t(bits >> 2 & 1u),
+                                      std::uint8_t(bits >> 3 & 1u)};
+  std::memcpy(to, flags, sizeof flags);
 }
 
 }  // namespace nmbake::lanes

@@ -6,14 +6,13 @@
 #include <cstring>
 
 #include "lanes.h"
+#include "raycast.h"
 
 namespace nmbake {
 
 using namespace lanes;
 
 namespace {
-
-constexpr std::uint32_t kMiss = 0xffffffffu;  // raycast::no_hit
 
 // Four samples from `i` on (a short last block repeats its last sample). `same_triangle`: all four
 // on one low-poly triangle, whose data is then loaded once and broadcast instead of gathered.
@@ -32,8 +31,8 @@ template <bool same_triangle>
   for (int k = 0; k < kLanes; ++k) {
     lp[k] = &low[in.low_tri[same_triangle ? i : at[k]]];
     const std::uint32_t ht = in.high_tri[at[k]];
-    miss |= unsigned(ht == kMiss) << k;
-    hp[k] = &high_corner_normals[3 * std::size_t(ht == kMiss ? 0 : ht)];  // a miss reads any triangle, and is flagged
+    miss |= unsigned(ht == raycast::no_hit) << k;
+    hp[k] = &high_corner_normals[3 * std::size_t(ht == raycast::no_hit ? 0 : ht)];  // a miss reads any triangle, and is flagged
   }
   V b[3], tw[3];
   V3 n[3], t[3], hn[3];
@@ -123,9 +122,7 @@ template <bool same_triangle>
     std::memcpy(&value[0][i], &r.x, sizeof(V));
     std::memcpy(&value[1][i], &r.y, sizeof(V));
     std::memcpy(&value[2][i], &r.z, sizeof(V));
-    const std::uint8_t flags[kLanes] = {std::uint8_t(bad & 1u), std::uint8_t(bad >> 1 & 1u), std::uint8_t(bad >> 2 & 1u),
-                                        std::uint8_t(bad >> 3 & 1u)};
-    std::memcpy(&degenerate[i], flags, sizeof flags);
+    store_flags(&degenerate[i], bad);
   } else {
     for (std::size_t k = 0; i + k < count; ++k) {
       value[0][i + k] = r.x[k];

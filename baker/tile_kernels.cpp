@@ -122,9 +122,7 @@ __attribute__((target_clones("avx2", "default"))) std::size_t cover_rect(const T
             std::memcpy(&slots.org[c][slot0], &of[c], sizeof(F));
             std::memcpy(&slots.dir[c][slot0], &df[c], sizeof(F));
           }
-          const std::uint8_t fallback[kLanes] = {std::uint8_t(~good & 1u), std::uint8_t(~good >> 1 & 1u),
-                                                 std::uint8_t(~good >> 2 & 1u), std::uint8_t(~good >> 3 & 1u)};
-          std::memcpy(&slots.ray_fallback[slot0], fallback, sizeof fallback);
+          store_flags(&slots.ray_fallback[slot0], ~good);
           continue;
         }
       }
