@@ -158,7 +158,7 @@ TEST(TileKernels, WriteTexelRowIsTheTexelFormula) {
       const TexelSums sums{{&acc[0], &acc[16], &acc[32]}, &acc[48]};
       for (int x = 0; x < 16; ++x) {
         for (int c = 0; c < 3; ++c) sums.sum[c][x] = u(rng);
-        sums.count[x] = double(x % 5);  // some texels without samples
+        sums.count[x] = x < 8 ? double(1 + x % 3) : double(x % 5);  // two blocks all with samples, then some without
         if (x % 7 == 3) sums.sum[0][x] = sums.sum[1][x] = sums.sum[2][x] = 0.0;       // zero sum
         if (x % 6 == 2) sums.sum[1][x] = 1e-9 * sums.sum[0][x];                       // snaps to 0
         if (x % 8 == 5) sums.sum[2][x] = -0.0;                                         // a negative zero
