@@ -274,12 +274,12 @@ __attribute__((target_clones("avx2", "default"))) void write_texel_row(const Tex
     if (filled == 0xfu && n == kLanes) {
       // Four texels, all with samples (most blocks): interleaved to r g b per texel in registers,
       // stored as three vectors.
-      const F rg_lo = __builtin_shuffle(out[0], out[1], I{0, 4, 1, 5});     // r0 g0 r1 g1
-      const F rg_mid = __builtin_shuffle(out[0], out[1], I{5, 2, 6, 2});    // g1 r2 g2 -
-      const F rg_hi = __builtin_shuffle(out[0], out[1], I{3, 7, 3, 7});     // r3 g3 - -
-      const F rgb4[3] = {__builtin_shuffle(rg_lo, out[2], I{0, 1, 4, 2}),   // r0 g0 b0 r1
-                         __builtin_shuffle(rg_mid, out[2], I{0, 5, 1, 2}),  // g1 b1 r2 g2
-                         __builtin_shuffle(out[2], rg_hi, I{2, 4, 5, 3})};  // b2 r3 g3 b3
+      const F rg_lo = __builtin_shufflevector(out[0], out[1], 0, 4, 1, 5);     // r0 g0 r1 g1
+      const F rg_mid = __builtin_shufflevector(out[0], out[1], 5, 2, 6, 2);    // g1 r2 g2 -
+      const F rg_hi = __builtin_shufflevector(out[0], out[1], 3, 7, 3, 7);     // r3 g3 - -
+      const F rgb4[3] = {__builtin_shufflevector(rg_lo, out[2], 0, 1, 4, 2),   // r0 g0 b0 r1
+                         __builtin_shufflevector(rg_mid, out[2], 0, 5, 1, 2),  // g1 b1 r2 g2
+                         __builtin_shufflevector(out[2], rg_hi, 2, 4, 5, 3)};  // b2 r3 g3 b3
       std::memcpy(rgb + 3 * std::size_t(x), rgb4, sizeof rgb4);
       store_flags(covered + x, 0xfu);
       continue;
