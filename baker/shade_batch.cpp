@@ -89,10 +89,9 @@ template <bool same_triangle>
     h.y += hw[c] * hn[c].y;
     h.z += hw[c] * hn[c].z;
   }
-  V hh, hlen;
+  // The encoding normalizes its result, so h goes in at its own length.
+  V hh;
   dot(hh, h, h);
-  vsqrt(hlen, hh);
-  h = {h.x / hlen, h.y / hlen, h.z / hlen};
   // encode_tangent_normal.
   V3 bxn, nxt, txb;
   cross(bxn, fb, fn);
@@ -108,14 +107,21 @@ template <bool same_triangle>
   dot(x.x, h, bxn);
   dot(x.y, h, nxt);
   dot(x.z, h, txb);
-  x = {x.x / det, x.y / det, x.z / det};
   V xx, len;
   dot(xx, x, x);
   vsqrt(len, xx);
-  const V3 r{x.x / len, x.y / len, x.z / len};
+  const V inv = 1.0 / len;
+  // inv, negated where det is not positive (encode_tangent_normal's x * -inv): its sign bit flipped.
+  const M sign_bit = {INT64_MIN, INT64_MIN, INT64_MIN, INT64_MIN};
+  M inv_bits;
+  std::memcpy(&inv_bits, &inv, sizeof inv);
+  inv_bits ^= ~(det > zero) & sign_bit;
+  V s;
+  std::memcpy(&s, &inv_bits, sizeof s);
+  const V3 r{x.x * s, x.y * s, x.z * s};
   // Degenerate: a miss, a short hit normal, a singular frame, a result not finite (NaN fails each
   // comparison, and an infinite det or len is above DBL_MAX).
-  const M good = (hlen > 1e-12) & (det * det > 1e-24 * scale2) & (det >= -DBL_MAX) & (det <= DBL_MAX) &
+  const M good = (hh > 1e-24) & (det * det > 1e-24 * scale2) & (det >= -DBL_MAX) & (det <= DBL_MAX) &
                  (len > 0.0) & (len <= DBL_MAX);
   const unsigned bad = (~bits(good) | miss) & 0xfu;
   if (full) {

@@ -66,22 +66,23 @@ inline PixelFrame interpolate_frame(const Vec3 normal[3], const Vec4 tangent[3],
   return f;
 }
 
-// Tangent-space unit vector whose decoding in `frame` is the world direction `world`: the exact
-// inverse of normalize(t.x*T + t.y*B + t.z*N), renormalized. Falls back to (0,0,1) when the frame
-// is singular. Inline: the bake calls it per sample.
+// Tangent-space unit vector whose decoding in `frame` is the direction of `world` (any positive
+// length): the exact inverse of normalize(t.x*T + t.y*B + t.z*N), renormalized. Falls back to
+// (0,0,1) when the frame is singular. Inline: the bake calls it per sample.
 inline glm::dvec3 encode_tangent_normal(const PixelFrame& f, const glm::dvec3& world) {
   // Solve [T B N] x = world by Cramer's rule; x is defined up to a positive scale because the
-  // renderer normalizes, so the determinant's magnitude does not matter, only its sign and zero.
+  // renderer normalizes, so the determinant's magnitude does not matter, only its sign and zero:
+  // the adjugate times world, normalized, negated when det < 0 (one division, not six).
   const glm::dvec3 bxn = glm::cross(f.b, f.n), nxt = glm::cross(f.n, f.t), txb = glm::cross(f.t, f.b);
   const double det = glm::dot(f.t, bxn);
   // Singular when |det| <= 1e-12 |T||B||N|, compared squared to spare three square roots.
   const double scale2 = glm::dot(f.t, f.t) * glm::dot(f.b, f.b) * glm::dot(f.n, f.n);
   if (!(det * det > 1e-24 * scale2) || !std::isfinite(det)) return {0.0, 0.0, 1.0};
-  glm::dvec3 x(glm::dot(world, bxn), glm::dot(world, nxt), glm::dot(world, txb));
-  x /= det;
-  const double len = glm::length(x);
+  const glm::dvec3 x(glm::dot(world, bxn), glm::dot(world, nxt), glm::dot(world, txb));
+  const double len = std::sqrt(glm::dot(x, x));
   if (!(len > 0.0) || !std::isfinite(len)) return {0.0, 0.0, 1.0};
-  return x / len;
+  const double inv = 1.0 / len;
+  return det > 0.0 ? x * inv : x * -inv;
 }
 
 // World direction of a tangent-space vector (the renderer's decoding).

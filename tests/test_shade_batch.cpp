@@ -1,5 +1,5 @@
 // encode_hits_per_pixel (four samples per vector instruction) gives exactly the bits of its
-// one-at-a-time definition, interpolate_frame + the normalized hit normal + encode_tangent_normal,
+// one-at-a-time definition, interpolate_frame + the interpolated hit normal + encode_tangent_normal,
 // and flags the degenerate hit normals it leaves to the bake's one-at-a-time path.
 #include <cstring>
 #include <random>
@@ -39,7 +39,11 @@ TEST(ShadeBatch, BitIdenticalToOneAtATime) {
   for (int i = 0; i < 6; ++i) low.push_back(random_low_triangle(rng));
   std::vector<glm::vec3> high_normals;
   for (int i = 0; i < 3 * 50; ++i) high_normals.push_back(glm::normalize(glm::vec3(uf(rng), uf(rng), 1.0f)));
-  for (int c = 0; c < 3; ++c) high_normals[3 * 7 + c] = glm::vec3(0.0f);  // a zero hit normal: flagged
+  for (int c = 0; c < 3; ++c) {
+    high_normals[3 * 7 + c] = glm::vec3(0.0f);      // a zero hit normal: flagged
+    high_normals[3 * 9 + c] *= 1e-13f;              // squared length below 1e-24: flagged
+    high_normals[3 * 11 + c] *= 1e-10f;             // short but above it: encoded at its own length
+  }
   const std::size_t n = 77;  // not a multiple of the lane count
   // The first 30 samples share a triangle (the kernel broadcasts it), the rest mix triangles.
   std::vector<std::int32_t> low_tri(n);
@@ -57,11 +61,12 @@ TEST(ShadeBatch, BitIdenticalToOneAtATime) {
   double* const value_c[3] = {value[0].data(), value[1].data(), value[2].data()};
   std::vector<std::uint8_t> degenerate(n, 7);
   encode_hits_per_pixel(low.data(), high_normals.data(), samples, n, value_c, degenerate.data());
-  std::size_t checked = 0, misses = 0;
+  std::size_t checked = 0, misses = 0, short_normals = 0, scaled = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    if (high_tri[i] == 7 || high_tri[i] == 0xffffffffu) {
+    if (high_tri[i] == 7 || high_tri[i] == 9 || high_tri[i] == 0xffffffffu) {
       EXPECT_EQ(degenerate[i], 1) << i;
-      misses += high_tri[i] != 7;
+      misses += high_tri[i] == 0xffffffffu;
+      short_normals += high_tri[i] == 9;
       continue;
     }
     ASSERT_EQ(degenerate[i], 0) << i;
@@ -71,10 +76,13 @@ TEST(ShadeBatch, BitIdenticalToOneAtATime) {
     const double w[3] = {1.0 - double(hu[i]) - double(hv[i]), double(hu[i]), double(hv[i])};
     glm::dvec3 nh(0.0);
     for (int c = 0; c < 3; ++c) nh += w[c] * glm::dvec3(high_normals[3 * high_tri[i] + c]);
-    const glm::dvec3 expect = encode_tangent_normal(frame, nh / glm::length(nh));
+    const glm::dvec3 expect = encode_tangent_normal(frame, nh);
     for (int c = 0; c < 3; ++c) EXPECT_TRUE(same_bits(value[c][i], expect[c])) << "sample " << i << " axis " << c;
     ++checked;
+    scaled += high_tri[i] == 11;
   }
   EXPECT_GT(checked, 55u);
+  EXPECT_GT(short_normals, 0u);
+  EXPECT_GT(scaled, 0u);
   EXPECT_GT(misses, 3u);
 }

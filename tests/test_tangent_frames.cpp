@@ -118,9 +118,11 @@ TEST(TangentFrames, EncodeIsTheExactInverseOfDecode) {
     PixelFrame fr{{1.0 + 0.3 * u(rng), 0.3 * u(rng), 0.2 * u(rng)},
                   {0.25 * u(rng), 0.8 + 0.3 * u(rng), 0.2 * u(rng)},
                   {0.2 * u(rng), 0.2 * u(rng), 1.1 + 0.2 * u(rng)}};
+    if (i % 2) fr.b = -fr.b;  // a mirrored frame: det < 0
     glm::dvec3 t(u(rng), u(rng), 0.2 + std::abs(u(rng)));
     t = glm::normalize(t);
-    const glm::dvec3 world = decode_tangent_normal(fr, t);
+    // The world direction at any length (the encoding normalizes): from 1e-9 to 1e3.
+    const glm::dvec3 world = decode_tangent_normal(fr, t) * std::pow(10.0, -3.0 + 6.0 * u(rng));
     const glm::dvec3 back = encode_tangent_normal(fr, world);
     EXPECT_LT(glm::length(back - t), 1e-12) << "sample " << i;
   }
