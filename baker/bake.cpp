@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <exception>
 #include <fstream>
 #include <limits>
 #include <mutex>
@@ -354,6 +355,28 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   st.low_triangles = low.triangle_count();
   st.high_triangles = high.triangle_count();
 
+  // The output buffers, allocated by a helper while prepare runs on one core: the system zeroes
+  // each fresh page at its first touch (about 1 GB/s on a 2-core VM, 40 ms for a 2048^2 map), work
+  // that would otherwise fall between the trace's rays. Joined before the trace.
+  std::exception_ptr output_error;
+  std::thread output_alloc([&] {
+    try {
+      const std::size_t texels = std::size_t(opt.width) * std::size_t(opt.height);
+      result.map = Image(opt.width, opt.height, 3, Image::Unset{});  // the trace writes the covered texels, padding the rest
+      result.map.fault_in();
+      result.coverage.assign(texels, 0);
+      if (opt.miss_mask) result.miss_mask = Image(opt.width, opt.height, 1, 0.0f);
+    } catch (...) {
+      output_error = std::current_exception();
+    }
+  });
+  struct JoinOnExit {
+    std::thread& t;
+    ~JoinOnExit() {
+      if (t.joinable()) t.join();
+    }
+  } join_output_alloc{output_alloc};
+
   // Prepare: tangent frames, re-centred coordinates, ray normals, high-poly normals.
   auto t0 = Clock::now();
   Prepared s = prepare(low, high, cage, st);
@@ -531,10 +554,8 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     }
   }
 
-  // Unset here: the trace writes the covered texels, the padding stage the others.
-  result.map = Image(W, H, 3, Image::Unset{});
-  result.coverage.assign(std::size_t(W) * H, 0);
-  if (opt.miss_mask) result.miss_mask = Image(W, H, 1, 0.0f);
+  output_alloc.join();
+  if (output_error) std::rethrow_exception(output_error);
   const std::vector<glm::dvec2> offsets = sample_offsets(opt.samples);
   const int S = int(offsets.size());
   const bool closest = opt.policy == RayPolicy::closest && !cage;
