@@ -591,19 +591,11 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     const std::size_t tile_texels = std::size_t(tile_side) * tile_side;
     const std::size_t slot_count = tile_texels * std::size_t(S);
     const bool default_rays = !ray_setup.cage && !ray_setup.closest;
-    std::vector<std::int32_t> slot_tri(slot_count);
-    std::vector<double> slot_b(3 * slot_count);
-    std::vector<float> slot_ray(6 * slot_count);
-    std::vector<std::uint8_t> slot_fallback(slot_count);
-    const SampleSlots slots{slot_tri.data(),
-                            {&slot_b[0], &slot_b[slot_count], &slot_b[2 * slot_count]},
-                            {&slot_ray[0], &slot_ray[slot_count], &slot_ray[2 * slot_count]},
-                            {&slot_ray[3 * slot_count], &slot_ray[4 * slot_count], &slot_ray[5 * slot_count]},
-                            slot_fallback.data()};
-    const DefaultRays default_ray_setup{default_rays ? low_tris.data() : nullptr, ray_setup.front};
     // The covered samples in slot order, which puts each texel's samples in sample order: that
     // fixes how its values are summed. Rays and hits as arrays, the layout Embree's packets take;
-    // sample r casts rays r * rays_per_sample onwards.
+    // sample r casts rays r * rays_per_sample onwards. The coverage fills slots in these same
+    // arrays (with the default policy's one ray per sample, slot i's ray is ray i), and the
+    // compaction closes the gaps in place: a fully covered stretch of slots stays where it is.
     raycast::RayArrays rays(slot_count * std::size_t(rays_per_sample));
     const raycast::HitBatch hits = rays.hits();
     std::vector<std::int32_t> sample_tri(slot_count);
@@ -617,6 +609,12 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
                                 {rays.origin(0), rays.origin(1), rays.origin(2)},
                                 {rays.direction(0), rays.direction(1), rays.direction(2)},
                                 sample_fallback.data()};
+    const SampleSlots slots{covered.tri,
+                            {sb[0], sb[1], sb[2]},
+                            {covered.org[0], covered.org[1], covered.org[2]},
+                            {covered.dir[0], covered.dir[1], covered.dir[2]},
+                            covered.ray_fallback};
+    const DefaultRays default_ray_setup{default_rays ? low_tris.data() : nullptr, ray_setup.front};
     if (default_rays) {
       // Every default-policy ray starts at 0 and reaches front + rear (sample_rays' too).
       std::fill(rays.tfar(), rays.tfar() + rays.size(), ray_setup.front + ray_setup.rear);
@@ -653,7 +651,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
         continue;  // no triangle touches this tile: it costs nothing
       }
       const auto tile_start = Clock::now();
-      std::fill(slot_tri.begin(), slot_tri.end(), -1);
+      std::fill(sample_tri.begin(), sample_tri.end(), -1);
       // Rasterize: the lowest triangle index wins a sample covered twice (overlapping islands).
       for (std::uint32_t bi = b0; bi < b1; ++bi) {
         const std::uint32_t t = bin_tris[bi];

@@ -4,6 +4,7 @@
 #include <cfloat>
 #include <cmath>
 #include <cstring>
+#include <type_traits>
 
 #include "lanes.h"
 
@@ -154,6 +155,7 @@ __attribute__((target_clones("avx2", "default"))) std::size_t compact_samples(co
                                                                                std::size_t slot_count, std::size_t texels,
                                                                                bool rays, const CoveredSamples& out) {
   std::size_t n = 0;
+  // Entry i to entry n <= i, one value at a time (in place, n may equal i).
   const auto copy_one = [&](std::size_t i) {
     out.tri[n] = slots.tri[i];
     for (int c = 0; c < 3; ++c) out.b[c][n] = slots.b[c][i];
@@ -167,6 +169,13 @@ __attribute__((target_clones("avx2", "default"))) std::size_t compact_samples(co
     }
     ++n;
   };
+  // Four entries from i to n < i: each array's four values are read before any is written (they
+  // may overlap when done in place).
+  const auto move_four = [&](auto* to, const auto* from) {
+    std::remove_const_t<std::remove_reference_t<decltype(*from)>> v[kLanes];
+    std::memcpy(v, from, sizeof v);
+    std::memcpy(to, v, sizeof v);
+  };
   std::size_t i = 0;
   if (texels % kLanes == 0) {
     // Four slots at a time (they are four consecutive texels); one by one where some are empty.
@@ -179,17 +188,19 @@ __attribute__((target_clones("avx2", "default"))) std::size_t compact_samples(co
           if (tri[k] >= 0) copy_one(i + k);
         continue;
       }
-      std::memcpy(&out.tri[n], tri, sizeof tri);
-      for (int c = 0; c < 3; ++c) std::memcpy(&out.b[c][n], &slots.b[c][i], kLanes * sizeof(double));
       const std::uint16_t tex[kLanes] = {std::uint16_t(texel), std::uint16_t(texel + 1), std::uint16_t(texel + 2),
                                          std::uint16_t(texel + 3)};
       std::memcpy(&out.texel[n], tex, sizeof tex);
-      if (rays) {
-        for (int c = 0; c < 3; ++c) {
-          std::memcpy(&out.org[c][n], &slots.org[c][i], kLanes * sizeof(float));
-          std::memcpy(&out.dir[c][n], &slots.dir[c][i], kLanes * sizeof(float));
+      if (out.tri + n != slots.tri + i) {  // in place and no gap yet: already where they belong
+        std::memcpy(&out.tri[n], tri, sizeof tri);
+        for (int c = 0; c < 3; ++c) move_four(&out.b[c][n], &slots.b[c][i]);
+        if (rays) {
+          for (int c = 0; c < 3; ++c) {
+            move_four(&out.org[c][n], &slots.org[c][i]);
+            move_four(&out.dir[c][n], &slots.dir[c][i]);
+          }
+          move_four(&out.ray_fallback[n], &slots.ray_fallback[i]);
         }
-        std::memcpy(&out.ray_fallback[n], &slots.ray_fallback[i], kLanes);
       }
       n += kLanes;
     }

@@ -57,7 +57,8 @@ struct CoveredSamples {
 // Copies each slot i < slot_count that holds a triangle, in increasing i, to the next entry of
 // `out`: triangle, barycentrics, texel i % texels and, with `rays`, the ray and its fallback flag.
 // Returns how many. Slot k * texels + t is sample k of texel t, so each texel's samples come in
-// sample order. texels must be at most 65536.
+// sample order. texels must be at most 65536. `out` may be the slots' own arrays (except texel):
+// the compaction then works in place.
 std::size_t compact_samples(const SampleSlots& slots, std::size_t slot_count, std::size_t texels, bool rays,
                             const CoveredSamples& out);
 

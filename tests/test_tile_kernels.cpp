@@ -227,6 +227,31 @@ TEST(TileKernels, CompactAndAccumulateKeepSampleOrder) {
     }
     EXPECT_EQ(count, r);
 
+    // In place (the bake's use): the same entries as the copy, in the slots' own arrays. The
+    // pattern starts with a fully covered block (left where it is), then single gaps, where the
+    // four-at-a-time moves overlap their source.
+    Slots same = slots;
+    same.view = {same.tri.data(),
+                 {&same.b[0], &same.b[n], &same.b[2 * n]},
+                 {&same.ray[0], &same.ray[n], &same.ray[2 * n]},
+                 {&same.ray[3 * n], &same.ray[4 * n], &same.ray[5 * n]},
+                 same.fallback.data()};
+    std::vector<std::uint16_t> same_texel(n, 0xffff);
+    const CoveredSamples in_place{same.view.tri,
+                                  {same.view.b[0], same.view.b[1], same.view.b[2]},
+                                  same_texel.data(),
+                                  {same.view.org[0], same.view.org[1], same.view.org[2]},
+                                  {same.view.dir[0], same.view.dir[1], same.view.dir[2]},
+                                  same.view.ray_fallback};
+    ASSERT_EQ(compact_samples(same.view, n, kTexels, true, in_place), count);
+    for (std::size_t k = 0; k < count; ++k) {
+      EXPECT_EQ(same.tri[k], tri[k]) << k;
+      EXPECT_EQ(same_texel[k], texel[k]) << k;
+      EXPECT_EQ(same.fallback[k], fallback[k]) << k;
+      for (int c = 0; c < 3; ++c) EXPECT_TRUE(same_bits(same.b[std::size_t(c) * n + k], b[std::size_t(c) * n + k])) << k;
+      for (int c = 0; c < 6; ++c) EXPECT_TRUE(same_bits(same.ray[std::size_t(c) * n + k], ray[std::size_t(c) * n + k])) << k;
+    }
+
     std::vector<double> value(3 * n);
     for (double& v : value) v = u(rng);
     const double* const value_c[3] = {&value[0], &value[n], &value[2 * n]};
