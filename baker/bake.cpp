@@ -355,9 +355,13 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   st.low_triangles = low.triangle_count();
   st.high_triangles = high.triangle_count();
 
+  // Prepare: tangent frames, re-centred coordinates, ray normals, high-poly normals.
+  auto t0 = Clock::now();
   // The output buffers, allocated by a helper while prepare runs on one core: the system zeroes
-  // each fresh page at its first touch (about 1 GB/s on a 2-core VM, 40 ms for a 2048^2 map), work
-  // that would otherwise fall between the trace's rays. Joined before the trace.
+  // each fresh page at its first touch (18-40 ms for a 2048^2 map on our 2-core VM), work
+  // that would otherwise fall between the trace's rays. Joined before the trace. Starting a thread
+  // waits while another thread of the process is loading a shared library (glibc's loader lock; the
+  // CLI loads its image module in the background, up to 0.2 s): in prepare's time, where it shows.
   std::exception_ptr output_error;
   std::thread output_alloc([&] {
     try {
@@ -377,8 +381,6 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     }
   } join_output_alloc{output_alloc};
 
-  // Prepare: tangent frames, re-centred coordinates, ray normals, high-poly normals.
-  auto t0 = Clock::now();
   Prepared s = prepare(low, high, cage, st);
   for (std::size_t t = 0; t < low.triangle_count(); ++t)
     for (int c = 0; c < 3; ++c) {
