@@ -270,8 +270,8 @@ glm::dvec3 shade_sample(const Prepared& s, std::size_t tri, const double b[3], c
   for (int c = 0; c < 3; ++c) nh += w[c] * glm::dvec3(s.bvh_normals[3 * ht + c]);
   const double len2 = glm::dot(nh, nh);
   // The encoding normalizes, so in tangent space the hit normal goes in at its own length, unless
-  // that is too short to trust (encode_hits_per_pixel's case, with the same test).
-  if (opt.space == NormalSpace::tangent && len2 > 1e-24) return encode_tangent_normal(frame, nh);
+  // that is too short to trust (encode_hits_per_pixel's test).
+  if (opt.space == NormalSpace::tangent && len2 > kShortHitNormal2) return encode_tangent_normal(frame, nh);
   double len = std::sqrt(len2);
   if (!(len > 1e-12)) {
     const glm::dvec3 q0(s.high_pos[s.bvh_index[3 * ht]]), q1(s.high_pos[s.bvh_index[3 * ht + 1]]),

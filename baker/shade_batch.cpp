@@ -121,7 +121,7 @@ template <bool same_triangle>
   const V3 r{x.x * s, x.y * s, x.z * s};
   // Degenerate: a miss, a short hit normal, a singular frame, a result not finite (NaN fails each
   // comparison, and an infinite det or len is above DBL_MAX).
-  const M good = (hh > 1e-24) & (det * det > 1e-24 * scale2) & (det >= -DBL_MAX) & (det <= DBL_MAX) &
+  const M good = (hh > kShortHitNormal2) & (det * det > 1e-24 * scale2) & (det >= -DBL_MAX) & (det <= DBL_MAX) &
                  (len > 0.0) & (len <= DBL_MAX);
   const unsigned bad = (~bits(good) | miss) & 0xfu;
   if (full) {

@@ -33,10 +33,14 @@ struct ShadeSamples {
   const float* v;
 };
 
+// A hit normal (interpolated, before normalizing) whose squared length is at most this is too
+// short to encode as it is: the one-at-a-time path takes its fallbacks.
+constexpr double kShortHitNormal2 = 1e-24;
+
 // For i < count: value[c][i] = component c of encode_tangent_normal(interpolate_frame(low[low_tri],
 // b, per_pixel), interpolated high-poly normal), and degenerate[i] = 0; or degenerate[i] = 1
 // (value unspecified) for a miss, or when the interpolated hit normal's squared length is at most
-// 1e-24, the frame singular or the result not finite. high_corner_normals holds 3 normals per
+// kShortHitNormal2, the frame singular or the result not finite. high_corner_normals holds 3 normals per
 // high-poly triangle.
 void encode_hits_per_pixel(const LowTriangle* low, const glm::vec3* high_corner_normals, const ShadeSamples& samples,
                            std::size_t count, double* const value[3], std::uint8_t* degenerate);

@@ -4,7 +4,6 @@
 #include <cfloat>
 #include <cmath>
 #include <cstring>
-#include <type_traits>
 
 #include "lanes.h"
 
@@ -169,13 +168,6 @@ __attribute__((target_clones("avx2", "default"))) std::size_t compact_samples(co
     }
     ++n;
   };
-  // Four entries from i to n < i: each array's four values are read before any is written (they
-  // may overlap when done in place).
-  const auto move_four = [&](auto* to, const auto* from) {
-    std::remove_const_t<std::remove_reference_t<decltype(*from)>> v[kLanes];
-    std::memcpy(v, from, sizeof v);
-    std::memcpy(to, v, sizeof v);
-  };
   std::size_t i = 0;
   if (texels % kLanes == 0) {
     // Four slots at a time (they are four consecutive texels); one by one where some are empty.
@@ -191,15 +183,17 @@ __attribute__((target_clones("avx2", "default"))) std::size_t compact_samples(co
       const std::uint16_t tex[kLanes] = {std::uint16_t(texel), std::uint16_t(texel + 1), std::uint16_t(texel + 2),
                                          std::uint16_t(texel + 3)};
       std::memcpy(&out.texel[n], tex, sizeof tex);
-      if (out.tri + n != slots.tri + i) {  // in place and no gap yet: already where they belong
+      // Moved unless in place with no gap yet (then already where they belong); memmove, as in
+      // place the four entries from i can overlap the four from n.
+      if (out.tri + n != slots.tri + i) {
         std::memcpy(&out.tri[n], tri, sizeof tri);
-        for (int c = 0; c < 3; ++c) move_four(&out.b[c][n], &slots.b[c][i]);
+        for (int c = 0; c < 3; ++c) std::memmove(&out.b[c][n], &slots.b[c][i], kLanes * sizeof(double));
         if (rays) {
           for (int c = 0; c < 3; ++c) {
-            move_four(&out.org[c][n], &slots.org[c][i]);
-            move_four(&out.dir[c][n], &slots.dir[c][i]);
+            std::memmove(&out.org[c][n], &slots.org[c][i], kLanes * sizeof(float));
+            std::memmove(&out.dir[c][n], &slots.dir[c][i], kLanes * sizeof(float));
           }
-          move_four(&out.ray_fallback[n], &slots.ray_fallback[i]);
+          std::memmove(&out.ray_fallback[n], &slots.ray_fallback[i], kLanes);
         }
       }
       n += kLanes;

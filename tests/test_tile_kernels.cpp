@@ -19,7 +19,12 @@ bool same_bits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 // A rectangle of slots with the arrays SampleSlots points into.
 struct Slots {
-  explicit Slots(std::size_t n) : tri(n, -1), b(3 * n), ray(6 * n), fallback(n, 9) {
+  explicit Slots(std::size_t n) : tri(n, -1), b(3 * n), ray(6 * n), fallback(n, 9) { point_view(); }
+  // A copy's view points at the copy's own arrays.
+  Slots(const Slots& o) : tri(o.tri), b(o.b), ray(o.ray), fallback(o.fallback) { point_view(); }
+  Slots& operator=(const Slots&) = delete;
+  void point_view() {
+    const std::size_t n = tri.size();
     view = {tri.data(), {&b[0], &b[n], &b[2 * n]}, {&ray[0], &ray[n], &ray[2 * n]}, {&ray[3 * n], &ray[4 * n], &ray[5 * n]},
             fallback.data()};
   }
@@ -231,11 +236,6 @@ TEST(TileKernels, CompactAndAccumulateKeepSampleOrder) {
     // pattern starts with a fully covered block (left where it is), then single gaps, where the
     // four-at-a-time moves overlap their source.
     Slots same = slots;
-    same.view = {same.tri.data(),
-                 {&same.b[0], &same.b[n], &same.b[2 * n]},
-                 {&same.ray[0], &same.ray[n], &same.ray[2 * n]},
-                 {&same.ray[3 * n], &same.ray[4 * n], &same.ray[5 * n]},
-                 same.fallback.data()};
     std::vector<std::uint16_t> same_texel(n, 0xffff);
     const CoveredSamples in_place{same.view.tri,
                                   {same.view.b[0], same.view.b[1], same.view.b[2]},
