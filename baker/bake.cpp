@@ -55,8 +55,13 @@ struct Prepared {
   // They point into the mesh and high_corner_normals, or, after culling, into the kept_ copies.
   const std::uint32_t* bvh_index = nullptr;
   const glm::vec3* bvh_normals = nullptr;
+  const std::int8_t* bvh_facing = nullptr;
   std::vector<std::uint32_t> kept_index;
   std::vector<glm::vec3> kept_normals;
+  std::vector<std::int8_t> kept_facing;
+  // Per high-poly triangle: the side its normals point to, +1 that of cross(p1 - p0, p2 - p0)
+  // (raycast::HitRule::facing).
+  std::vector<std::int8_t> high_facing;
   TangentFrames frames;
   std::vector<LowTriangle> low_tris;
   std::vector<glm::dvec3> cage_corners;  // 3 per low-poly triangle, with a cage
@@ -121,6 +126,20 @@ double quantile(std::vector<float>& v, double q) {
   return v[k];
 }
 
+// Per triangle, +1 when its corner normals (3 per triangle) point to the side of
+// cross(p1 - p0, p2 - p0), -1 when to the other; +1 where that cannot be told (no area, normals
+// that cancel).
+std::vector<std::int8_t> triangle_facing(const std::vector<glm::vec3>& pos, const std::vector<std::uint32_t>& index,
+                                         const std::vector<glm::vec3>& corner_normals) {
+  std::vector<std::int8_t> out(index.size() / 3, 1);
+  for (std::size_t t = 0; t < out.size(); ++t) {
+    const glm::dvec3 p0(pos[index[3 * t]]), p1(pos[index[3 * t + 1]]), p2(pos[index[3 * t + 2]]);
+    const glm::dvec3 n = glm::dvec3(corner_normals[3 * t]) + glm::dvec3(corner_normals[3 * t + 1]) + glm::dvec3(corner_normals[3 * t + 2]);
+    if (glm::dot(glm::cross(p1 - p0, p2 - p0), n) < 0.0) out[t] = -1;
+  }
+  return out;
+}
+
 template <typename Fn>
 void run_parallel(int threads, Fn&& worker) {
   std::vector<std::thread> pool;
@@ -165,6 +184,7 @@ Prepared prepare(const Mesh& low, const Mesh& high, const Mesh* cage, BakeStats&
     s.high_corner_normals = compute_high_corner_normals(high, &st.high_faces_reoriented);
     st.high_normals_computed = true;
   }
+  s.high_facing = triangle_facing(s.high_pos, high.position_index, s.high_corner_normals);
   s.low_tris.resize(low.triangle_count());
   for (std::size_t t = 0; t < low.triangle_count(); ++t)
     for (int c = 0; c < 3; ++c) {
@@ -180,7 +200,19 @@ Prepared prepare(const Mesh& low, const Mesh& high, const Mesh* cage, BakeStats&
   }
   s.bvh_index = high.position_index.data();
   s.bvh_normals = s.high_corner_normals.data();
+  s.bvh_facing = s.high_facing.data();
   return s;
+}
+
+// The high-poly found inverted (BakeStats::HighFacing): fronts are taken the other way round, and
+// normals nmbake computed itself are turned outwards with them (a file's normals are kept: the map
+// then is what it was without the rule). Applies to the BVH's copies too.
+void turn_inverted_high(Prepared& s, bool normals_computed) {
+  for (auto* v : {&s.high_facing, &s.kept_facing})
+    for (std::int8_t& f : *v) f = std::int8_t(-f);
+  if (normals_computed)
+    for (auto* v : {&s.high_corner_normals, &s.kept_normals})
+      for (glm::vec3& n : *v) n = -n;
 }
 
 glm::dvec3 low_point(const LowTriangle& lt, const double b[3]) { return b[0] * lt.p[0] + b[1] * lt.p[1] + b[2] * lt.p[2]; }
@@ -244,7 +276,11 @@ inline std::size_t chosen_hit(const raycast::HitBatch& hits, std::size_t first, 
   if (closest) {
     const std::size_t out = first, in = first + 1;
     const bool out_hit = hits.triangle[out] != raycast::no_hit, in_hit = hits.triangle[in] != raycast::no_hit;
-    if (out_hit && (!in_hit || hits.t[out] <= hits.t[in])) {
+    // A hit whose normal points away (taken only for want of another on its ray) yields to one
+    // on the other ray that does not.
+    const auto away = [&](std::size_t i) { return hits.flags && (hits.flags[i] & raycast::hit_normal_disagrees); };
+    const bool prefer_out = out_hit && in_hit && away(out) != away(in) ? !away(out) : hits.t[out] <= hits.t[in];
+    if (out_hit && (!in_hit || prefer_out)) {
       *dist = hits.t[out];
       return out;
     }
@@ -414,18 +450,24 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     // The trace reads per-triangle arrays in BVH order, so a hit's triangle index needs no mapping.
     s.bvh_index = high.position_index.data();
     s.bvh_normals = s.high_corner_normals.data();
+    s.bvh_facing = s.high_facing.data();
     if (!kept.empty()) {
       std::vector<std::uint32_t> index(3 * kept.size());
       std::vector<glm::vec3> normals(3 * kept.size());
-      for (std::size_t i = 0; i < kept.size(); ++i)
+      std::vector<std::int8_t> facing(kept.size());
+      for (std::size_t i = 0; i < kept.size(); ++i) {
         for (int c = 0; c < 3; ++c) {
           index[3 * i + c] = high.position_index[3 * std::size_t(kept[i]) + c];
           normals[3 * i + c] = s.high_corner_normals[3 * std::size_t(kept[i]) + c];
         }
+        facing[i] = s.high_facing[kept[i]];
+      }
       s.kept_index = std::move(index);
       s.kept_normals = std::move(normals);
+      s.kept_facing = std::move(facing);
       s.bvh_index = s.kept_index.data();
       s.bvh_normals = s.kept_normals.data();
+      s.bvh_facing = s.kept_facing.data();
     }
     const std::size_t tris = kept.empty() ? high.triangle_count() : kept.size();
     st.bvh_quality = bvh_quality_for(opt, tris);
@@ -457,13 +499,14 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   st.seconds_bvh = seconds_since(t0);
 
   // Ray distances: given, or measured by probing along the ray normals from points on the low-poly.
+  // The same probes tell whether the high-poly's faces point the way its normals say (for the hit
+  // rule), so they are cast whenever either is needed.
   t0 = Clock::now();
   st.front = opt.front;
   st.rear = opt.rear;
-  if (auto_distances) {
-    st.auto_distances = true;
+  if (auto_distances || !opt.keep_backfaces) {
     const std::size_t tris = low.triangle_count();
-    const std::size_t stride = std::max<std::size_t>(1, tris / 50000);
+    const std::size_t stride = std::max<std::size_t>(1, tris / (auto_distances ? 50000 : 5000));
     static const double probe_bary[4][3] = {{1 / 3.0, 1 / 3.0, 1 / 3.0}, {4 / 6.0, 1 / 6.0, 1 / 6.0},
                                             {1 / 6.0, 4 / 6.0, 1 / 6.0}, {1 / 6.0, 1 / 6.0, 4 / 6.0}};
     std::vector<raycast::Ray> rays;
@@ -483,24 +526,49 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
       }
     });
     std::vector<float> outside, inside;
+    std::size_t nearest_back = 0;
     for (std::size_t i = 0; i < pairs; ++i) {
       const raycast::Hit& o = hits[2 * i];
       const raycast::Hit& in = hits[2 * i + 1];
-      if (o.hit() && (!in.hit() || o.t <= in.t))
+      const raycast::Hit* nearest = nullptr;
+      if (o.hit() && (!in.hit() || o.t <= in.t)) {
         outside.push_back(o.t);
-      else if (in.hit())
+        nearest = &o;
+      } else if (in.hit()) {
         inside.push_back(in.t);
+        nearest = &in;
+      }
+      if (nearest) {
+        // A back face: its front (by its normals) faces away from the low-poly's outside, which is
+        // +direction for the outward probe and -direction for the inward one.
+        const std::uint32_t* v = s.bvh_index + 3 * std::size_t(nearest->triangle);
+        const glm::vec3 ng = glm::cross(s.high_pos[v[1]] - s.high_pos[v[0]], s.high_pos[v[2]] - s.high_pos[v[0]]);
+        const glm::vec3 out = nearest == &o ? rays[2 * i].direction : -rays[2 * i + 1].direction;
+        nearest_back += float(s.bvh_facing[nearest->triangle]) * glm::dot(ng, out) < 0.0f;
+      }
     }
-    // Cover all but the farthest 0.1% of probes, with a 25% margin and a floor for coincident meshes.
-    const double floor_dist = 1e-4 * s.diagonal;
-    const double front = 1.25 * quantile(outside, 0.999) + floor_dist;
-    const double rear = 1.25 * quantile(inside, 0.999) + floor_dist;
-    if (opt.front < 0.0f) st.front = float(front);
-    if (opt.rear < 0.0f) st.rear = float(rear);
-    std::size_t beyond = 0;
-    for (float d : outside) beyond += d > st.front;
-    for (float d : inside) beyond += d > st.rear;
-    st.auto_probe_beyond = pairs ? double(beyond) / double(pairs) : 0.0;
+    const std::size_t probes_hit = outside.size() + inside.size();
+    st.backface_probe_share = probes_hit ? double(nearest_back) / double(probes_hit) : 0.0;
+    if (auto_distances) {
+      st.auto_distances = true;
+      // Cover all but the farthest 0.1% of probes, with a 25% margin and a floor for coincident meshes.
+      const double floor_dist = 1e-4 * s.diagonal;
+      const double front = 1.25 * quantile(outside, 0.999) + floor_dist;
+      const double rear = 1.25 * quantile(inside, 0.999) + floor_dist;
+      if (opt.front < 0.0f) st.front = float(front);
+      if (opt.rear < 0.0f) st.rear = float(rear);
+      std::size_t beyond = 0;
+      for (float d : outside) beyond += d > st.front;
+      for (float d : inside) beyond += d > st.rear;
+      st.auto_probe_beyond = pairs ? double(beyond) / double(pairs) : 0.0;
+    }
+  }
+  if (!opt.keep_backfaces) {
+    st.high_facing = st.backface_probe_share > kInvertedShare ? BakeStats::HighFacing::inverted
+                     : st.backface_probe_share > kMixedShare  ? BakeStats::HighFacing::mixed
+                                                              : BakeStats::HighFacing::sound;
+    st.backfaces_skipped = st.high_facing != BakeStats::HighFacing::mixed;
+    if (st.high_facing == BakeStats::HighFacing::inverted) turn_inverted_high(s, st.high_normals_computed);
   }
   if (cage) {
     if (st.front < 0.0f) st.front = 0.0f;
@@ -565,7 +633,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
 
   // One cache line each: the counters change per sample, and shared lines would serialize threads.
   struct alignas(64) ThreadStats {
-    std::uint64_t rays = 0, hits = 0, misses = 0, covered = 0, overlaps = 0;
+    std::uint64_t rays = 0, hits = 0, misses = 0, covered = 0, overlaps = 0, backface_skips = 0, facing_away = 0;
     Clock::duration intersect{0}, tiles{0};
     double dmin = std::numeric_limits<double>::infinity(), dmax = -std::numeric_limits<double>::infinity();
   };
@@ -586,6 +654,12 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   ray_setup.closest = closest;
   ray_setup.diagonal = s.diagonal;
 
+  // The hit rule (raycast::HitRule), over the BVH's triangles as finally built.
+  raycast::HitRule rule;
+  rule.facing = s.bvh_facing;
+  rule.corner_normals = s.bvh_normals;
+  const raycast::HitRule* const hit_rule = st.backfaces_skipped ? &rule : nullptr;
+
   auto worker = [&](int id) {
     ThreadStats& ts = tstats[id];
     // Sample slots of a tile: sample k of tile texel (x, y) is slot (k * tile_side + y) * tile_side
@@ -600,6 +674,11 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     // compaction closes the gaps in place: a fully covered stretch of slots stays where it is.
     raycast::RayArrays rays(slot_count * std::size_t(rays_per_sample));
     const raycast::HitBatch hits = rays.hits();
+    // With two rays per sample (closest), the first leaves the low-poly outwards.
+    std::vector<std::uint8_t> outward(rays_per_sample == 2 ? rays.size() : 0);
+    for (std::size_t i = 0; i < outward.size(); i += 2) outward[i] = 1;
+    raycast::RayBatch ray_batch = rays.rays();
+    ray_batch.outward = outward.empty() ? nullptr : outward.data();
     std::vector<std::int32_t> sample_tri(slot_count);
     std::vector<double> sample_b(3 * slot_count);
     double* const sb[3] = {&sample_b[0], &sample_b[slot_count], &sample_b[2 * slot_count]};
@@ -678,8 +757,10 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
       }
       if (ray_count) {
         const auto cast_start = Clock::now();
-        scene->intersect(rays.rays(), hits, ray_count);
+        scene->intersect(ray_batch, hits, ray_count, hit_rule);
         ts.intersect += Clock::now() - cast_start;
+        if (hit_rule)
+          for (std::size_t r = 0; r < ray_count; ++r) ts.backface_skips += (hits.flags[r] & raycast::hit_passed_backface) != 0;
       }
       if (opt.record_rays) {
         std::lock_guard<std::mutex> lock(record_mutex);
@@ -705,6 +786,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
           chosen_v[r] = hits.v[h];
         }
         if (hits.triangle[h] != raycast::no_hit) {
+          if (hit_rule) ts.facing_away += (hits.flags[h] & raycast::hit_normal_disagrees) != 0;
           // The hit triangles' corner normals are scattered over the high-poly: ask for them all
           // before shading needs the first, so the cache misses overlap.
           const char* line = reinterpret_cast<const char*>(&s.bvh_normals[3 * std::size_t(hits.triangle[h])]);
@@ -781,6 +863,8 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     total.misses += ts.misses;
     total.covered += ts.covered;
     total.overlaps += ts.overlaps;
+    total.backface_skips += ts.backface_skips;
+    total.facing_away += ts.facing_away;
     st.thread_seconds_intersect += std::chrono::duration<double>(ts.intersect).count();
     st.thread_seconds_tiles += std::chrono::duration<double>(ts.tiles).count();
     total.dmin = std::min(total.dmin, ts.dmin);
@@ -791,6 +875,8 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   st.misses = total.misses;
   st.samples_covered = total.covered;
   st.overlapping_samples = total.overlaps;
+  st.backface_skips = total.backface_skips;
+  st.hits_facing_away = total.facing_away;
   if (total.hits) {
     st.hit_distance_min = total.dmin;
     st.hit_distance_max = total.dmax;
@@ -827,11 +913,16 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
   const int threads = opt.threads > 0 ? opt.threads : std::max(1, int(std::thread::hardware_concurrency()));
   const int W = opt.width, H = opt.height;
   BakeStats scratch;
-  const Prepared s = prepare(low, high, cage, scratch);
+  Prepared s = prepare(low, high, cage, scratch);
+  if (st.high_facing == BakeStats::HighFacing::inverted) turn_inverted_high(s, scratch.high_normals_computed);
   // Few rays: a quick BVH build pays off more than a fast one to trace. All triangles: culling
   // leaves the hits unchanged.
   raycast::Scene scene(&s.high_pos[0].x, s.high_pos.size(), high.position_index.data(), high.triangle_count(),
                        raycast::BuildQuality::low, opt.threads);
+  raycast::HitRule rule;
+  rule.facing = s.high_facing.data();
+  rule.corner_normals = s.high_corner_normals.data();
+  const raycast::HitRule* const hit_rule = st.backfaces_skipped ? &rule : nullptr;
   RaySetup ray_setup;
   ray_setup.front = st.front;
   ray_setup.rear = st.rear;
@@ -876,6 +967,10 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
     // the first work.size() * rays_per_sample rays.
     raycast::RayArrays arrays(kChunk * offsets.size() * std::size_t(rays_per_sample));
     const raycast::HitBatch hits = arrays.hits();
+    std::vector<std::uint8_t> outward(rays_per_sample == 2 ? arrays.size() : 0);
+    for (std::size_t i = 0; i < outward.size(); i += 2) outward[i] = 1;
+    raycast::RayBatch ray_batch = arrays.rays();
+    ray_batch.outward = outward.empty() ? nullptr : outward.data();
     std::vector<double> signed_base(arrays.size());
     for (std::size_t i0; (i0 = next.fetch_add(kChunk)) < texels.size();) {
       const std::size_t i1 = std::min(texels.size(), i0 + kChunk);
@@ -897,7 +992,7 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
         for (int j = 0; j < n; ++j) arrays.set(r * rays_per_sample + std::size_t(j), one[j]);
       }
       const std::size_t ray_count = work.size() * std::size_t(rays_per_sample);
-      if (ray_count) scene.intersect(arrays.rays(), hits, ray_count);
+      if (ray_count) scene.intersect(ray_batch, hits, ray_count, hit_rule);
       for (std::size_t r = 0; r < work.size(); ++r) {
         double dist = 0.0;
         const std::size_t h = chosen_hit(hits, r * rays_per_sample, signed_base.data(), ray_setup.closest, &dist);

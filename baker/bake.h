@@ -32,6 +32,10 @@ enum class NormalSpace { tangent, object };
 constexpr int kMaxMapSide = 65536;  // texels per side; larger maps are refused (ResourceError)
 constexpr int kMaxSamples = 1024;   // sample points per texel
 constexpr double kCoordinateSpacingWarn = 1e-3;  // BakeStats::coordinate_spacing above this: warn
+// BakeStats::backface_probe_share above which the high-poly is taken as inverted, and above which
+// (up to the first) as partly inverted, when back faces are kept.
+constexpr double kInvertedShare = 0.5;
+constexpr double kMixedShare = 0.2;
 
 struct BakeOptions {
   int width = 2048;   // map width in texels
@@ -49,6 +53,11 @@ struct BakeOptions {
   // Leave high-poly triangles out of the BVH when they lie farther from the low-poly (and cage)
   // than any ray reaches (cull.h). The map is the same either way; off only for comparison.
   bool cull_far = true;
+  // Take the first hit along the ray whatever it faces (earlier nmbake's rule). By default a hit on
+  // a back face (the inside of some part of the high-poly, judged against the side the low-poly's
+  // normal points to) is passed over for the next one, and a hit whose normal points away from the
+  // low-poly's outside is taken only when the ray finds no other (raycast::HitRule).
+  bool keep_backfaces = false;
   // Bytes the bake's buffers may take (estimate_bake_bytes); 0 = what the machine has
   // (memory_budget_bytes: MemAvailable, cgroup limit, ulimit -v). Larger bakes are refused.
   std::uint64_t memory_limit = 0;
@@ -89,6 +98,18 @@ struct BakeStats {
   // from inverted high-poly normals or winding. 0 for object-space maps.
   std::size_t texels_facing_away = 0;
   bool high_normals_computed = false;
+  // The hit rule (BakeOptions::keep_backfaces): whether it was applied, and why not.
+  bool backfaces_skipped = false;
+  // Probes from the low-poly both ways along its normals: of those that hit, the share whose
+  // nearest hit is a back face. Near 0 on a sound high-poly; near 1 when its winding and normals
+  // are inverted (then the faces' fronts are taken the other way round, and computed normals are
+  // turned outwards); in between, when only some parts are inverted, back faces are kept.
+  double backface_probe_share = 0.0;
+  enum class HighFacing { sound, inverted, mixed } high_facing = HighFacing::sound;
+  // Rays whose first hit was a back face, passed over for the next hit.
+  std::uint64_t backface_skips = 0;
+  // Samples whose hit has a normal pointing away from the low-poly's outside (no other hit was found).
+  std::uint64_t hits_facing_away = 0;
   // Seconds per stage.
   double seconds_prepare = 0, seconds_bvh = 0, seconds_distances = 0, seconds_trace = 0, seconds_padding = 0;
   double cpu_seconds_trace = 0;  // process CPU time of the trace stage (all threads)

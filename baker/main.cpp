@@ -51,6 +51,7 @@ struct Args {
   int threads = 0;
   bool quiet = false;
   bool no_cull = false;
+  bool keep_backfaces = false;
   bool estimate_error = false;
 };
 
@@ -138,6 +139,9 @@ int run(int argc, char** argv) {
   app.add_option("--threads", a.threads, "Worker threads (default: all cores)");
   app.add_flag("--no-cull", a.no_cull,
                "Keep high-poly triangles out of every ray's reach in the BVH (default: left out; same map)");
+  app.add_flag("--keep-backfaces", a.keep_backfaces,
+               "Take the first hit whatever it faces (default: hits on back faces, the insides of other parts, are passed "
+               "over and counted as backface_skips in the report)");
   app.add_flag("--quiet", a.quiet, "No progress bar and no summary line");
   app.add_flag("--estimate-error", a.estimate_error,
                "Re-bake 4096 random covered texels (fixed seed) with 64 samples (4x --samples if more) and report the "
@@ -180,6 +184,7 @@ int run(int argc, char** argv) {
   o.threads = a.threads;
   o.miss_mask = !a.miss_mask.empty();
   o.cull_far = !a.no_cull;
+  o.keep_backfaces = a.keep_backfaces;
   const int bits = a.bits ? a.bits : default_bits_for(a.output);
   check_output_path(a.output, "the map");
   if (!a.miss_mask.empty()) check_output_path(a.miss_mask, "the miss mask");

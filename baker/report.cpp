@@ -43,6 +43,7 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
       {"padding", o.padding},
       {"threads", r.threads_used},
       {"cull", o.cull_far},
+      {"keep_backfaces", o.keep_backfaces},
   };
   auto mesh_json = [](const MeshLoadInfo& info, std::size_t triangles) {
     return json{{"format", info.format},
@@ -86,6 +87,13 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
       {"uv_outside_entirely_triangles", s.uv_outside_entirely_triangles},
       {"high_faces_reoriented", s.high_faces_reoriented},
       {"texels_facing_away", s.texels_facing_away},
+      {"backfaces_skipped", s.backfaces_skipped},
+      {"backface_skips", s.backface_skips},
+      {"backface_probe_share", s.backface_probe_share},
+      {"high_facing", s.high_facing == BakeStats::HighFacing::inverted ? "inverted"
+                      : s.high_facing == BakeStats::HighFacing::mixed  ? "mixed"
+                                                                       : "sound"},
+      {"hits_facing_away", s.hits_facing_away},
       {"coordinate_spacing", s.coordinate_spacing},
       {"largest_coordinate", s.largest_coordinate},
   };

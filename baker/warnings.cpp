@@ -37,6 +37,16 @@ std::vector<std::string> bake_warnings(const BakeStats& s, const MeshTopology& t
   if (s.texels_covered && double(s.texels_facing_away) > kFacingAwayShareWarn * double(s.texels_covered))
     out.push_back(format("warning: %.1f%% of covered texels point into the low-poly: are the normals or the winding of %s inverted?",
                          100.0 * double(s.texels_facing_away) / double(s.texels_covered), high.c_str()));
+  if (s.high_facing == BakeStats::HighFacing::inverted)
+    out.push_back(format("warning: %s: its faces look inverted (%.0f%% of the surfaces nearest the low-poly face into it): their fronts "
+                         "were taken the other way round%s",
+                         high.c_str(), 100.0 * s.backface_probe_share,
+                         s.high_normals_computed ? " and the computed normals turned outwards"
+                                                 : "; the file's normals are kept, so the map points into the surface"));
+  else if (s.high_facing == BakeStats::HighFacing::mixed)
+    out.push_back(format("warning: %s: some of its parts look inverted (%.0f%% of the surfaces nearest the low-poly face into it): "
+                         "back faces are kept for this bake, as with --keep-backfaces",
+                         high.c_str(), 100.0 * s.backface_probe_share));
   if (s.coordinate_spacing > kCoordinateSpacingWarn)
     out.push_back(format("warning: coordinates reach %.3g, far from the origin for a scene this size: float precision there is "
                          "%.2g of the scene diagonal (above %.0e the map degrades measurably); move the meshes near the origin",

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -31,9 +32,91 @@ void check_device(RTCDevice device) {
                                         std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
 }
 
+// The context a call under a HitRule hands Embree: its filter finds the rule and the per-ray
+// state of the packet being traced here. A ray's id is its lane in the packet.
+struct RuleContext {
+  RTCIntersectContext context;  // first: the filter receives a pointer to it
+  const HitRule* rule = nullptr;
+  std::uint8_t outward[8] = {};
+  float backface_t[8];               // nearest back face passed over
+  float fallback_t[8];               // nearest front-face hit whose normal disagrees
+  std::uint32_t fallback_prim[8];
+  float fallback_u[8], fallback_v[8];
+
+  explicit RuleContext(const HitRule* r) : rule(r) {
+    rtcInitIntersectContext(&context);
+    context.filter = r ? &filter : nullptr;
+  }
+  void reset_lanes() {
+    for (int k = 0; k < 8; ++k) {
+      backface_t[k] = fallback_t[k] = std::numeric_limits<float>::infinity();
+      fallback_prim[k] = no_hit;
+    }
+  }
+
+  // Called by Embree for every hit it finds within the ray's current range, in no particular
+  // order, possibly more than once for one triangle (spatial splits); the hit's distance is in
+  // the ray's tfar. A rejected hit (valid = 0) leaves the range as it was.
+  static void filter(const RTCFilterFunctionNArguments* args) {
+    RuleContext& rc = *reinterpret_cast<RuleContext*>(args->context);
+    const HitRule& rule = *rc.rule;
+    const unsigned n = args->N;
+    for (unsigned i = 0; i < n; ++i) {
+      if (args->valid[i] != -1) continue;
+      const unsigned lane = RTCRayN_id(args->ray, n, i) & 7u;
+      const std::uint32_t prim = RTCHitN_primID(args->hit, n, i);
+      // The low-poly's outside: -direction for inward rays, +direction for outward ones.
+      const float side = rc.outward[lane] ? 1.0f : -1.0f;
+      const glm::vec3 out(side * RTCRayN_dir_x(args->ray, n, i), side * RTCRayN_dir_y(args->ray, n, i),
+                          side * RTCRayN_dir_z(args->ray, n, i));
+      const glm::vec3 ng(RTCHitN_Ng_x(args->hit, n, i), RTCHitN_Ng_y(args->hit, n, i), RTCHitN_Ng_z(args->hit, n, i));
+      const float t = RTCRayN_tfar(args->ray, n, i);
+      float front = glm::dot(ng, out);
+      if (rule.facing) front *= float(rule.facing[prim]);
+      if (front < 0.0f && rule.skip_backfaces) {
+        rc.backface_t[lane] = std::min(rc.backface_t[lane], t);
+        args->valid[i] = 0;
+        continue;
+      }
+      if (rule.corner_normals) {
+        const float u = RTCHitN_u(args->hit, n, i), v = RTCHitN_v(args->hit, n, i);
+        const glm::vec3* c = rule.corner_normals + 3 * std::size_t(prim);
+        const glm::vec3 nh = (1.0f - u - v) * c[0] + u * c[1] + v * c[2];
+        if (!(glm::dot(nh, out) > 0.0f)) {
+          // Nearest first; equal distances by triangle index, whatever order Embree found them in.
+          if (t < rc.fallback_t[lane] || (t == rc.fallback_t[lane] && prim < rc.fallback_prim[lane])) {
+            rc.fallback_t[lane] = t;
+            rc.fallback_prim[lane] = prim;
+            rc.fallback_u[lane] = u;
+            rc.fallback_v[lane] = v;
+          }
+          args->valid[i] = 0;
+        }
+      }
+    }
+  }
+
+  // Lane k's result after the call, from Embree's hit (prim, t, u, v; prim no_hit for none):
+  // Embree's hit, else the fallback; its flags.
+  std::uint8_t finish(int k, std::uint32_t& prim, float& t, float& u, float& v) const {
+    std::uint8_t flags = 0;
+    if (prim == no_hit && fallback_prim[k] != no_hit) {
+      prim = fallback_prim[k];
+      t = fallback_t[k];
+      u = fallback_u[k];
+      v = fallback_v[k];
+      flags |= hit_normal_disagrees;
+    }
+    if (backface_t[k] < (prim == no_hit ? std::numeric_limits<float>::infinity() : t) ||
+        (prim == no_hit && backface_t[k] != std::numeric_limits<float>::infinity()))
+      flags |= hit_passed_backface;
+    return flags;
+  }
+};
+
 }  // namespace
 
-RayArrays::RayArrays(std::size_t count) : count_(count), fields_(11 * count), triangle_(count, no_hit) {}
+RayArrays::RayArrays(std::size_t count) : count_(count), fields_(11 * count), triangle_(count, no_hit), flags_(count, 0) {}
 
 RayArrays::RayArrays(const Ray* rays, std::size_t count) : RayArrays(count) {
   for (std::size_t i = 0; i < count; ++i) set(i, rays[i]);
@@ -48,7 +131,7 @@ RayBatch RayArrays::rays(std::size_t first) const {
 HitBatch RayArrays::hits(std::size_t first) {
   float* f = fields_.data() + first;
   const std::size_t n = count_;
-  return {triangle_.data() + first, f + 8 * n, f + 9 * n, f + 10 * n};
+  return {triangle_.data() + first, f + 8 * n, f + 9 * n, f + 10 * n, flags_.data() + first};
 }
 
 struct Scene::Impl {
@@ -72,8 +155,9 @@ Scene::Scene(const float* positions, std::size_t vertex_count, const std::uint32
   impl_->triangles = triangle_count;
 
   impl_->scene = rtcNewScene(impl_->device);
-  // Robust: coincident and touching triangles must not lose hits to fast approximations.
-  rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
+  // Robust: coincident and touching triangles must not lose hits to fast approximations. Context
+  // filters: the calls under a HitRule pass theirs (the others pass none and pay nothing for it).
+  rtcSetSceneFlags(impl_->scene, RTCSceneFlags(RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION));
   rtcSetSceneBuildQuality(impl_->scene, to_embree(quality));
 
   RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -125,6 +209,36 @@ Hit Scene::intersect(const Ray& ray) const {
   return h;
 }
 
+Hit Scene::intersect(const Ray& ray, const HitRule& rule, bool outward, std::uint8_t* flags) const {
+  RuleContext rc(&rule);
+  rc.reset_lanes();
+  rc.outward[0] = outward;
+  RTCRayHit rh;
+  rh.ray.org_x = ray.origin.x;
+  rh.ray.org_y = ray.origin.y;
+  rh.ray.org_z = ray.origin.z;
+  rh.ray.tnear = ray.tnear;
+  rh.ray.dir_x = ray.direction.x;
+  rh.ray.dir_y = ray.direction.y;
+  rh.ray.dir_z = ray.direction.z;
+  rh.ray.time = 0.0f;
+  rh.ray.tfar = ray.tfar;
+  rh.ray.mask = 0xffffffffu;
+  rh.ray.id = 0;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(impl_->scene, &rc.context, &rh);
+  Hit h;
+  std::uint32_t prim = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID ? rh.hit.primID : no_hit;
+  float t = rh.ray.tfar, u = rh.hit.u, v = rh.hit.v;
+  const std::uint8_t f = rc.finish(0, prim, t, u, v);
+  if (flags) *flags = f;
+  if (prim != no_hit) h = {prim, t, u, v};
+  return h;
+}
+
 void Scene::intersect(const Ray* rays, Hit* hits, std::size_t count) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
@@ -166,9 +280,8 @@ void Scene::intersect(const Ray* rays, Hit* hits, std::size_t count) const {
   }
 }
 
-void Scene::intersect(const RayBatch& rays, const HitBatch& hits, std::size_t count) const {
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
+void Scene::intersect(const RayBatch& rays, const HitBatch& hits, std::size_t count, const HitRule* rule) const {
+  RuleContext rc(rule);
   alignas(32) RTCRayHit8 rh;
   alignas(32) int valid[8];
   // Fields no ray sets, once.
@@ -201,9 +314,19 @@ void Scene::intersect(const RayBatch& rays, const HitBatch& hits, std::size_t co
       rh.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
       rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
     }
-    rtcIntersect8(valid, impl_->scene, &context, &rh);
+    if (rule) {
+      rc.reset_lanes();
+      for (std::size_t k = 0; k < 8; ++k) rc.outward[k] = rays.outward ? rays.outward[base + std::min(k, n - 1)] : 0;
+    }
+    rtcIntersect8(valid, impl_->scene, &rc.context, &rh);
     for (std::size_t k = 0; k < 8; ++k)
       rh.hit.primID[k] = rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID ? rh.hit.primID[k] : no_hit;
+    if (rule) {
+      for (std::size_t k = 0; k < n; ++k) {
+        const std::uint8_t f = rc.finish(int(k), rh.hit.primID[k], rh.ray.tfar[k], rh.hit.u[k], rh.hit.v[k]);
+        if (hits.flags) hits.flags[base + k] = f;
+      }
+    }
     if (n == 8) {
       std::memcpy(hits.triangle + base, rh.hit.primID, 8 * sizeof(std::uint32_t));
       std::memcpy(hits.t + base, rh.ray.tfar, 8 * sizeof(float));

@@ -38,11 +38,40 @@ struct RayBatch {
   const float *org_x, *org_y, *org_z;
   const float *dir_x, *dir_y, *dir_z;  // need not be unit; t is in units of |direction|
   const float *tnear, *tfar;
+  // For a HitRule: per ray, 1 when the ray leaves the low-poly outwards (the low-poly's outside
+  // lies along +direction), 0 when it travels inwards (outside along -direction, the usual ray
+  // from a cage). Null: every ray travels inwards.
+  const std::uint8_t* outward = nullptr;
 };
 // Their hits, the same way: triangle[i] is no_hit for a miss (t, u, v then unspecified).
 struct HitBatch {
   std::uint32_t* triangle;
   float *t, *u, *v;
+  // With a HitRule, when not null: per ray, the HitFlags of its hit.
+  std::uint8_t* flags = nullptr;
+};
+
+// Which hits a ray takes (Scene::intersect with a rule). Without a rule the first hit along the
+// ray counts, whatever it is.
+//
+// A triangle's front is the side its vertex normals point to (facing[t] = +1: the side of
+// cross(p1 - p0, p2 - p0), -1: the other), so a triangle wound against its neighbours is judged by
+// its normals. A hit is on a back face when that front faces away from the low-poly's outside
+// (RayBatch::outward): on a closed high-poly that is the inside of some part, never the surface
+// the ray looks for. With skip_backfaces such hits are passed over and the ray takes the next one.
+// With corner_normals, a front-face hit whose interpolated normal points away from the low-poly's
+// outside (dot <= 0: it would bake as a texel facing into the surface, as grazing hits on the
+// side of another part do) is taken only when the ray finds no other: then the first of those.
+struct HitRule {
+  const std::int8_t* facing = nullptr;  // per triangle, +1 or -1; null: +1 for all
+  bool skip_backfaces = true;
+  const glm::vec3* corner_normals = nullptr;  // 3 per triangle (any length), or null: no normal test
+};
+
+// HitBatch::flags bits.
+enum HitFlags : std::uint8_t {
+  hit_passed_backface = 1,   // the first surface along the ray was a back face, passed over
+  hit_normal_disagrees = 2,  // the hit taken is one whose normal points away (no other was found)
 };
 
 // Rays held as arrays, with room for their hits: the arrays for Scene::intersect(RayBatch,
@@ -73,11 +102,13 @@ class RayArrays {
   // The rays and hits from ray `first` on.
   RayBatch rays(std::size_t first = 0) const;
   HitBatch hits(std::size_t first = 0);
+  std::uint8_t flags(std::size_t i) const { return flags_[i]; }  // HitFlags of ray i after a call under a rule
 
  private:
   std::size_t count_;
   std::vector<float> fields_;  // 8 ray fields, then the hits' t, u, v: count_ each
   std::vector<std::uint32_t> triangle_;
+  std::vector<std::uint8_t> flags_;
 };
 
 enum class BuildQuality { low, medium, high };
@@ -96,8 +127,11 @@ class Scene {
   Hit intersect(const Ray& ray) const;
   // `count` independent rays, traced as 8-wide packets (rays need not be coherent). Thread-safe.
   void intersect(const Ray* rays, Hit* hits, std::size_t count) const;
-  // The same for rays and hits held as arrays. Thread-safe.
-  void intersect(const RayBatch& rays, const HitBatch& hits, std::size_t count) const;
+  // The same for rays and hits held as arrays, optionally under a HitRule (whose arrays are
+  // indexed by the triangles given at construction). Thread-safe.
+  void intersect(const RayBatch& rays, const HitBatch& hits, std::size_t count, const HitRule* rule = nullptr) const;
+  // Single rays under a rule (`outward` as in RayBatch); `flags` receives the HitFlags when not null.
+  Hit intersect(const Ray& ray, const HitRule& rule, bool outward = false, std::uint8_t* flags = nullptr) const;
 
   std::size_t triangle_count() const;
 

@@ -106,3 +106,169 @@ TEST(Raycast, RespectsTnearAndTfar) {
   r.tnear = 1.0005f;
   EXPECT_FALSE(scene.intersect(r).hit());
 }
+
+// ---- Hit rules (back faces, normals that point away) ----
+namespace {
+
+// Two unit quads at z = 0 and z = 1 over [-1,1]^2; `flip_top` winds the upper one clockwise seen
+// from +z (its geometric normal points down).
+Mesh two_planes(bool flip_top) {
+  Mesh m;
+  for (float z : {0.0f, 1.0f})
+    for (glm::vec2 xy : {glm::vec2(-1, -1), glm::vec2(1, -1), glm::vec2(1, 1), glm::vec2(-1, 1)}) m.positions.push_back({xy, z});
+  m.position_index = {0, 1, 2, 0, 2, 3};
+  if (flip_top)
+    m.position_index.insert(m.position_index.end(), {4, 6, 5, 4, 7, 6});
+  else
+    m.position_index.insert(m.position_index.end(), {4, 5, 6, 4, 6, 7});
+  return m;
+}
+
+struct RuleCase {
+  raycast::Hit hit;
+  std::uint8_t flags = 0;
+};
+
+// The same ray traced alone and in a packet (in lane 3 of 5, the others aimed elsewhere) must agree.
+RuleCase trace(const raycast::Scene& scene, const raycast::Ray& ray, const raycast::HitRule& rule, bool outward) {
+  RuleCase one;
+  one.hit = scene.intersect(ray, rule, outward, &one.flags);
+  std::vector<raycast::Ray> rays(5, raycast::Ray{{5.0f, 5.0f, 5.0f}, 0.0f, {0, 0, 1}, 1.0f});
+  rays[3] = ray;
+  raycast::RayArrays arrays(rays.data(), rays.size());
+  std::vector<std::uint8_t> out(rays.size(), 0);
+  out[3] = outward;
+  raycast::RayBatch batch = arrays.rays();
+  batch.outward = out.data();
+  scene.intersect(batch, arrays.hits(), arrays.size(), &rule);
+  EXPECT_EQ(arrays.hit(3).triangle, one.hit.triangle);
+  if (one.hit.hit()) {
+    EXPECT_EQ(arrays.hit(3).t, one.hit.t);
+  }
+  EXPECT_EQ(arrays.flags(3), one.flags);
+  for (std::size_t i : {0u, 1u, 2u, 4u}) EXPECT_FALSE(arrays.hit(i).hit()) << "lane " << i;
+  return one;
+}
+
+}  // namespace
+
+TEST(RaycastRule, BackFaceIsPassedOverAndCounted) {
+  for (bool flip_top : {false, true}) {
+    const Mesh m = two_planes(flip_top);
+    raycast::Scene scene(&m.positions[0].x, m.positions.size(), m.position_index.data(), m.triangle_count());
+    const raycast::Ray down{{0.3f, 0.2f, 2.0f}, 0.0f, {0, 0, -1}, 10.0f};  // inward: the outside is +z
+    raycast::HitRule rule;
+    const RuleCase r = trace(scene, down, rule, false);
+    ASSERT_TRUE(r.hit.hit());
+    if (flip_top) {
+      // The top faces down, away from the outside: passed over, the bottom plane is taken.
+      EXPECT_NEAR(r.hit.t, 2.0f, 1e-6f);
+      EXPECT_GE(r.hit.triangle, 0u);
+      EXPECT_LT(r.hit.triangle, 2u);
+      EXPECT_EQ(r.flags, raycast::hit_passed_backface);
+    } else {
+      EXPECT_NEAR(r.hit.t, 1.0f, 1e-6f);
+      EXPECT_EQ(r.flags, 0);
+    }
+    // Without skipping, the first hit whatever it faces, and no flag.
+    rule.skip_backfaces = false;
+    const RuleCase keep = trace(scene, down, rule, false);
+    EXPECT_NEAR(keep.hit.t, 1.0f, 1e-6f);
+    EXPECT_EQ(keep.flags, 0);
+    // Facing from the normals: turning the top's facing around makes it a front face again.
+    std::vector<std::int8_t> facing = {1, 1, std::int8_t(flip_top ? -1 : 1), std::int8_t(flip_top ? -1 : 1)};
+    raycast::HitRule by_normals;
+    by_normals.facing = facing.data();
+    EXPECT_NEAR(trace(scene, down, by_normals, false).hit.t, 1.0f, 1e-6f);
+  }
+}
+
+TEST(RaycastRule, OutwardRaysJudgeFacesByTheOutside) {
+  const Mesh m = two_planes(false);
+  raycast::Scene scene(&m.positions[0].x, m.positions.size(), m.position_index.data(), m.triangle_count());
+  raycast::HitRule rule;
+  // From between the planes upwards, leaving the low-poly outwards: the top plane faces the
+  // outside (+z): a front face, taken.
+  const raycast::Ray up{{0.3f, 0.2f, 0.5f}, 0.0f, {0, 0, 1}, 10.0f};
+  RuleCase r = trace(scene, up, rule, true);
+  EXPECT_NEAR(r.hit.t, 0.5f, 1e-6f);
+  EXPECT_EQ(r.flags, 0);
+  // The same ray taken as an inward one (outside along -z): the top plane is a back face, and
+  // nothing lies beyond it.
+  r = trace(scene, up, rule, false);
+  EXPECT_FALSE(r.hit.hit());
+  EXPECT_EQ(r.flags, raycast::hit_passed_backface);
+}
+
+TEST(RaycastRule, NormalPointingAwayIsTakenOnlyWithoutAnother) {
+  const Mesh m = two_planes(false);
+  raycast::Scene scene(&m.positions[0].x, m.positions.size(), m.position_index.data(), m.triangle_count());
+  const raycast::Ray down{{0.3f, 0.2f, 2.0f}, 0.0f, {0, 0, -1}, 10.0f};
+  // The top plane's normals point down (away from the outside), the bottom's up.
+  std::vector<glm::vec3> normals(12, glm::vec3(0, 0, 1));
+  for (int c = 6; c < 12; ++c) normals[c] = {0.2f, 0.0f, -1.0f};
+  raycast::HitRule rule;
+  rule.corner_normals = normals.data();
+  RuleCase r = trace(scene, down, rule, false);
+  EXPECT_NEAR(r.hit.t, 2.0f, 1e-6f);
+  EXPECT_EQ(r.flags, 0);
+  // With both pointing away, the nearer of them, flagged.
+  for (int c = 0; c < 6; ++c) normals[c] = {0.0f, 0.0f, -1.0f};
+  r = trace(scene, down, rule, false);
+  ASSERT_TRUE(r.hit.hit());
+  EXPECT_NEAR(r.hit.t, 1.0f, 1e-6f);
+  EXPECT_GE(r.hit.triangle, 2u);
+  EXPECT_EQ(r.flags, raycast::hit_normal_disagrees);
+}
+
+TEST(RaycastRule, MatchesBruteForceOnClosedTorus) {
+  // Random rays through a closed torus: under the rule the hit is the nearest front face (the
+  // outside taken as -direction), found by testing every triangle.
+  const Mesh m = test::make_torus(40, 20);
+  const float* pos = &m.positions[0].x;
+  raycast::Scene scene(pos, m.positions.size(), m.position_index.data(), m.triangle_count());
+  raycast::HitRule rule;
+  std::mt19937 rng(12113);
+  std::uniform_real_distribution<float> box(-1.6f, 1.6f), dir(-1.0f, 1.0f);
+  int checked = 0, passed = 0;
+  for (int i = 0; i < 3001; ++i) {
+    glm::vec3 d(dir(rng), dir(rng), dir(rng));
+    if (glm::length(d) < 1e-2f) continue;
+    d = glm::normalize(d);
+    const raycast::Ray ray{{box(rng), box(rng), box(rng)}, 0.0f, d, 4.0f};
+    double best = 1e30;
+    bool first_is_back = false;
+    double first = 1e30;
+    for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+      const glm::dvec3 p0(m.corner_position(t, 0)), p1(m.corner_position(t, 1)), p2(m.corner_position(t, 2));
+      const glm::dvec3 e1 = p1 - p0, e2 = p2 - p0, o(ray.origin), dd(ray.direction);
+      const glm::dvec3 pv = glm::cross(dd, e2);
+      const double det = glm::dot(e1, pv);
+      if (det == 0.0) continue;
+      const glm::dvec3 tv = o - p0;
+      const double u = glm::dot(tv, pv) / det;
+      const glm::dvec3 qv = glm::cross(tv, e1);
+      const double v = glm::dot(dd, qv) / det;
+      const double tt = glm::dot(e2, qv) / det;
+      if (u < 0 || v < 0 || u + v > 1 || tt < 0 || tt > ray.tfar) continue;
+      const bool back = glm::dot(glm::cross(e1, e2), -dd) < 0.0;
+      if (tt < first) first = tt, first_is_back = back;
+      if (!back) best = std::min(best, tt);
+    }
+    std::uint8_t flags = 0;
+    const raycast::Hit h = scene.intersect(ray, rule, false, &flags);
+    if (best > 1e29) {
+      EXPECT_FALSE(h.hit()) << "ray " << i;
+    } else {
+      ASSERT_TRUE(h.hit()) << "ray " << i;
+      EXPECT_NEAR(h.t, best, 1e-4) << "ray " << i;
+      ++checked;
+    }
+    if (first < 1e29 && std::abs(first - best) > 1e-3) {
+      EXPECT_EQ(flags & raycast::hit_passed_backface, first_is_back ? raycast::hit_passed_backface : 0) << "ray " << i;
+      passed += first_is_back;
+    }
+  }
+  EXPECT_GT(checked, 300) << "too few hits for the comparison to mean anything";
+  EXPECT_GT(passed, 100) << "too few rays met a back face first";
+}

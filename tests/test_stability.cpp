@@ -650,18 +650,28 @@ TEST(Stability, HighPolyTopologyIsInspected) {
 }
 
 TEST(Stability, NonManifoldFinsGiveTheFirstHit) {
+  // 0 < x < 0.2: the slanted fin lies above the plane; elsewhere the plane (+Z). The fin's normal
+  // points down, into the low-poly: by default the plane beneath it is taken (a hit whose normal
+  // points away is taken only for want of another); with back faces kept, the first hit, the fin.
   const Mesh low = load_low("flat_grid_low.obj");
-  const BakeResult r = bake_normal_map(low, load("nonmanifold_high.obj"), nullptr, options(64, 0.6f));
-  EXPECT_EQ(r.stats.misses, 0u);
-  EXPECT_TRUE(all_finite(r.map));
   const glm::dvec3 fin = glm::normalize(glm::dvec3(0.9, 0, -0.6));
-  std::size_t wrong = 0;
-  test::for_each_decoded_texel(low, r.map, [&](int, int, const glm::dvec3& w, const glm::dvec3& p, std::size_t) {
-    // 0 < x < 0.2: the slanted fin lies above the plane; elsewhere the plane (+Z).
-    const glm::dvec3 expect = (p.x > 0.0 && p.x < 0.2) ? fin : glm::dvec3(0, 0, 1);
-    wrong += angle_deg(w, expect) > 1e-3;
-  });
-  EXPECT_EQ(wrong, 0u);
+  for (bool keep : {false, true}) {
+    BakeOptions o = options(64, 0.6f);
+    o.keep_backfaces = keep;
+    const BakeResult r = bake_normal_map(low, load("nonmanifold_high.obj"), nullptr, o);
+    EXPECT_EQ(r.stats.misses, 0u);
+    EXPECT_TRUE(all_finite(r.map));
+    std::size_t wrong = 0, on_fin = 0;
+    test::for_each_decoded_texel(low, r.map, [&](int, int, const glm::dvec3& w, const glm::dvec3& p, std::size_t) {
+      const bool under_fin = p.x > 0.0 && p.x < 0.2;
+      on_fin += under_fin;
+      const glm::dvec3 expect = under_fin && keep ? fin : glm::dvec3(0, 0, 1);
+      wrong += angle_deg(w, expect) > 1e-3;
+    });
+    EXPECT_GT(on_fin, 100u);
+    EXPECT_EQ(wrong, 0u) << "keep_backfaces " << keep;
+    EXPECT_EQ(r.stats.hits_facing_away, 0u);
+  }
 }
 
 TEST(Stability, IsolatedVerticesChangeNothing) {
@@ -691,15 +701,36 @@ TEST(Stability, InconsistentWindingDoesNotFlipComputedNormals) {
 }
 
 TEST(Stability, InvertedNormalsAreBakedAsGivenAndReported) {
+  // A file's inverted normals are baked as given (the faces' fronts follow them, so the hit rule
+  // changes nothing); normals computed from an inverted winding are turned outwards. Both are
+  // reported as an inverted high-poly.
   const Mesh low = load_low("flat_grid_low.obj");
-  for (const char* name : {"inverted_normals_high.obj", "inverted_winding_high.obj"}) {
-    const BakeResult r = bake_normal_map(low, load(name), nullptr, options(64, 0.1f));
-    measured(std::string(name) + ".texels_facing_away", double(r.stats.texels_facing_away));
-    EXPECT_EQ(r.stats.texels_facing_away, r.stats.texels_covered) << name;
+  for (bool keep : {false, true}) {
+    BakeOptions o = options(64, 0.1f);
+    o.keep_backfaces = keep;
+    const BakeResult r = bake_normal_map(low, load("inverted_normals_high.obj"), nullptr, o);
+    measured(std::string("inverted_normals.texels_facing_away.keep") + (keep ? "1" : "0"), double(r.stats.texels_facing_away));
+    EXPECT_EQ(r.stats.texels_facing_away, r.stats.texels_covered);
+    EXPECT_EQ(r.stats.high_facing, keep ? BakeStats::HighFacing::sound : BakeStats::HighFacing::inverted);
     EXPECT_TRUE(all_finite(r.map));
+    const BakeResult w = bake_normal_map(low, load("inverted_winding_high.obj"), nullptr, o);
+    EXPECT_TRUE(all_finite(w.map));
+    if (keep) {
+      EXPECT_EQ(w.stats.texels_facing_away, w.stats.texels_covered);
+    } else {
+      EXPECT_EQ(w.stats.high_facing, BakeStats::HighFacing::inverted);
+      EXPECT_GT(w.stats.backface_probe_share, 0.99);
+      EXPECT_EQ(w.stats.texels_facing_away, 0u);
+      // The same map as the correctly wound field's.
+      const BakeResult ref = bake_normal_map(low, load("bumps_nonormals_high.obj"), nullptr, o);
+      double mean = 0.0;
+      EXPECT_LT(max_texel_angle(w, ref, &mean), 1e-3);
+      EXPECT_EQ(ref.stats.high_facing, BakeStats::HighFacing::sound);
+    }
   }
   const BakeResult ok = bake_normal_map(low, load("bumps_high.obj"), nullptr, options(64, 0.1f));
   EXPECT_EQ(ok.stats.texels_facing_away, 0u);
+  EXPECT_EQ(ok.stats.backface_probe_share, 0.0);
 }
 
 TEST(Stability, TopologyAndInversionAreReportedByTheCli) {
@@ -720,7 +751,24 @@ TEST(Stability, TopologyAndInversionAreReportedByTheCli) {
   r = run_nmbake(low + " " + data("inverted_normals_high.obj") + " -o out.png --size 32 --report r.json");
   ASSERT_EQ(r.code, 0);
   EXPECT_EQ(r.report["texels_facing_away"], 32 * 32);
+  EXPECT_EQ(r.report["high_facing"], "inverted");
   EXPECT_TRUE(contains(r.err, "warning: 100.0% of covered texels point into the low-poly")) << r.err;
+  EXPECT_TRUE(contains(r.err, "inverted_normals_high.obj: its faces look inverted (100% of the surfaces nearest the low-poly face "
+                              "into it): their fronts were taken the other way round; the file's normals are kept"))
+      << r.err;
+  r = run_nmbake(low + " " + data("inverted_winding_high.obj") + " -o out.png --size 32 --report r.json");
+  ASSERT_EQ(r.code, 0);
+  EXPECT_EQ(r.report["texels_facing_away"], 0);
+  EXPECT_EQ(r.report["high_facing"], "inverted");
+  EXPECT_TRUE(contains(r.err, "inverted_winding_high.obj: its faces look inverted (100% of the surfaces nearest the low-poly face "
+                              "into it): their fronts were taken the other way round and the computed normals turned outwards"))
+      << r.err;
+  // --keep-backfaces: the first hit, as it lies.
+  r = run_nmbake(low + " " + data("inverted_winding_high.obj") + " -o out.png --size 32 --report r.json --keep-backfaces");
+  ASSERT_EQ(r.code, 0);
+  EXPECT_EQ(r.report["texels_facing_away"], 32 * 32);
+  EXPECT_EQ(r.report["options"]["keep_backfaces"], true);
+  EXPECT_EQ(r.report["backfaces_skipped"], false);
 }
 
 // ---------------------------------------------------------------------------------------------
