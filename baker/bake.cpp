@@ -15,6 +15,7 @@
 #include <sstream>
 #include <thread>
 
+#include "auto_cage.h"
 #include "cull.h"
 #include "memory_budget.h"
 #include "mesh_topology.h"
@@ -43,6 +44,12 @@ constexpr int kTile = 16;            // texels per tile side
 // Tangent components this close to zero are written as exactly 0: a flat result is then
 // (128,128,255) and not a coin flip between 127 and 128 decided by float noise.
 constexpr double kSnap = 1e-6;
+// How much the automatic cage's distances may change per unit length along the low-poly: rays
+// from it then tilt at most atan(0.25) = 14 degrees from the surface normal.
+constexpr double kCageSlope = 0.25;
+// How far the distance probes look, as a share of the scene diagonal: farther is another part of
+// the model. (A bulge of 15% of the diagonal, the hard-asset bench's tallest, is within it.)
+constexpr double kProbeReach = 0.2;
 
 // The scene in re-centred float coordinates, flat arrays for the hot loop.
 struct Prepared {
@@ -65,6 +72,8 @@ struct Prepared {
   TangentFrames frames;
   std::vector<LowTriangle> low_tris;
   std::vector<glm::dvec3> cage_corners;  // 3 per low-poly triangle, with a cage
+  std::vector<double> corner_rear;        // 3 per low-poly triangle: per-vertex rear distances; empty: the global one
+  std::vector<double> corner_search;      // 3 per low-poly triangle: how far out rays search (LocalDistances::search)
 };
 
 // Over the positions faces use: a vertex no face uses (a stray point far away) must not move the
@@ -148,6 +157,54 @@ void run_parallel(int threads, Fn&& worker) {
   for (auto& t : pool) t.join();
 }
 
+// The cage's corners, re-centred, 3 per low-poly triangle (its topology is the low-poly's).
+void attach_cage(Prepared& s, const Mesh& cage) {
+  s.cage_pos = recentre(cage.positions, s.centre);
+  s.cage_corners.resize(cage.position_index.size());
+  for (std::size_t c = 0; c < s.cage_corners.size(); ++c) s.cage_corners[c] = glm::dvec3(s.cage_pos[cage.position_index[c]]);
+}
+
+// A cage must enclose the low-poly: one whose vertices mostly lie inside it (moved against the ray
+// normals) is refused.
+void check_cage_encloses(const Prepared& s, const Mesh& cage) {
+  std::vector<std::uint8_t> used(s.low_pos.size(), 0);
+  for (std::uint32_t i : cage.position_index) used[i] = 1;
+  std::size_t inside = 0, outside = 0;
+  const double tiny = 1e-6 * s.diagonal;
+  for (std::size_t i = 0; i < used.size(); ++i) {
+    if (!used[i]) continue;
+    const double off = glm::dot(glm::dvec3(s.cage_pos[i]) - glm::dvec3(s.low_pos[i]), glm::dvec3(s.ray_normal[i]));
+    inside += off < -tiny;
+    outside += off > tiny;
+  }
+  if (inside > outside)
+    throw InputError(cage.source + ": the cage lies inside the low-poly (" + std::to_string(inside) + " of " +
+                     std::to_string(inside + outside) + " moved vertices are moved inwards along the normals); a cage must enclose it");
+}
+
+// A summary of per-vertex distances.
+void summarize(const std::vector<float>& v, BakeStats::Range& out) {
+  if (v.empty()) return;
+  double sum = 0.0;
+  out.min = out.max = v[0];
+  for (float x : v) {
+    out.min = std::min(out.min, double(x));
+    out.max = std::max(out.max, double(x));
+    sum += x;
+  }
+  out.mean = sum / double(v.size());
+}
+
+// Per-vertex rear and search distances (LocalDistances) as 3 per low-poly triangle.
+void attach_rear(Prepared& s, const Mesh& low, const std::vector<float>& vertex_rear, const std::vector<float>& vertex_search) {
+  s.corner_rear.resize(low.position_index.size());
+  s.corner_search.resize(low.position_index.size());
+  for (std::size_t c = 0; c < s.corner_rear.size(); ++c) {
+    s.corner_rear[c] = double(vertex_rear[low.position_index[c]]);
+    s.corner_search[c] = double(vertex_search[low.position_index[c]]);
+  }
+}
+
 // Everything the rays and the shading read, from the meshes: tangent frames, re-centred
 // coordinates, ray normals, high-poly corner normals, the low-poly triangles in double. Fills the
 // stats it learns on the way (degenerate counts, centre, coordinate precision, computed normals).
@@ -161,7 +218,8 @@ Prepared prepare(const Mesh& low, const Mesh& high, const Mesh* cage, BakeStats&
     glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
     grow_box(lo, hi, low.positions, low.position_index);
     grow_box(lo, hi, high.positions, high.position_index);
-    if (cage) grow_box(lo, hi, cage->positions, cage->position_index);
+    // Not the cage's: an automatic cage is made after this, and the same cage read from a file
+    // must give the same centre, so the same rays to the bit.
     s.centre = 0.5 * (lo + hi);
     st.centre = s.centre;
     s.diagonal = glm::length(hi - lo);
@@ -174,7 +232,6 @@ Prepared prepare(const Mesh& low, const Mesh& high, const Mesh* cage, BakeStats&
   }
   s.low_pos = recentre(low.positions, s.centre);
   s.high_pos = recentre(high.positions, s.centre);
-  if (cage) s.cage_pos = recentre(cage->positions, s.centre);
   s.ray_normal = position_averaged_normals(low, s.frames);
   if (high.has_normals()) {
     s.high_corner_normals.resize(high.normal_index.size());
@@ -194,10 +251,7 @@ Prepared prepare(const Mesh& low, const Mesh& high, const Mesh* cage, BakeStats&
       s.low_tris[t].n[c] = glm::dvec3(s.frames.normal[3 * t + c]);
       s.low_tris[t].t[c] = glm::dvec4(s.frames.tangent[3 * t + c]);
     }
-  if (cage) {
-    s.cage_corners.resize(3 * low.triangle_count());
-    for (std::size_t c = 0; c < s.cage_corners.size(); ++c) s.cage_corners[c] = glm::dvec3(s.cage_pos[cage->position_index[c]]);
-  }
+  if (cage) attach_cage(s, *cage);
   s.bvh_index = high.position_index.data();
   s.bvh_normals = s.high_corner_normals.data();
   s.bvh_facing = s.high_facing.data();
@@ -235,15 +289,20 @@ struct RaySetup {
 };
 
 // The rays of the sample at barycentrics b of low-poly triangle `tri` (two for the closest-hit
-// policy, else one) and, per ray, the distance from P to its origin along it. Returns the count.
+// policy, else one) and, per ray, the distance from P to its origin along it and the part of the
+// ray where hits are looked for first (raycast::RayBatch::prefer_lo/hi). Returns the count.
 inline int sample_rays(const Prepared& s, std::size_t tri, const double b[3], const RaySetup& r, raycast::Ray* rays,
-                       double* signed_base) {
+                       double* signed_base, float* prefer_lo, float* prefer_hi) {
+  prefer_lo[0] = prefer_lo[1] = 0.0f;
+  prefer_hi[0] = prefer_hi[1] = std::numeric_limits<float>::infinity();
   const LowTriangle& lt = s.low_tris[tri];
   const glm::dvec3 p = low_point(lt, b);
   const glm::dvec3 n = low_ray_normal(lt, b);
   if (r.cage) {
     glm::dvec3 pc(0.0);
     for (int c = 0; c < 3; ++c) pc += b[c] * s.cage_corners[3 * tri + c];
+    double rear = r.rear;
+    if (!s.corner_rear.empty()) rear = b[0] * s.corner_rear[3 * tri] + b[1] * s.corner_rear[3 * tri + 1] + b[2] * s.corner_rear[3 * tri + 2];
     glm::dvec3 d = p - pc;
     double len = glm::length(d);
     // A cage point on the low-poly gives no direction: use the ray normal from P.
@@ -254,8 +313,21 @@ inline int sample_rays(const Prepared& s, std::size_t tri, const double b[3], co
     } else {
       d /= len;
     }
-    signed_base[0] = len;
-    rays[0] = {glm::vec3(pc), 0.0f, glm::vec3(d), float(len + r.rear)};
+    // Where a neighbouring part limits the cage, rays search on beyond it, as far out as the
+    // high-poly was found there, for a hit to take only when none lies within the cage.
+    double search = len;
+    if (!s.corner_search.empty())
+      search = std::max(len, b[0] * s.corner_search[3 * tri] + b[1] * s.corner_search[3 * tri + 1] + b[2] * s.corner_search[3 * tri + 2]);
+    if (r.closest) {  // from P out to the cage point, and in to the rear distance
+      signed_base[0] = signed_base[1] = 0.0;
+      rays[0] = {glm::vec3(p), 0.0f, glm::vec3(-d), float(search)};
+      rays[1] = {glm::vec3(p), 0.0f, glm::vec3(d), float(rear)};
+      if (search > len) prefer_hi[0] = float(len);
+      return 2;
+    }
+    signed_base[0] = search;
+    rays[0] = {glm::vec3(p - search * d), 0.0f, glm::vec3(d), float(search + rear)};
+    if (search > len) prefer_lo[0] = float(search - len);
     return 1;
   }
   if (r.closest) {
@@ -418,6 +490,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   } join_output_alloc{output_alloc};
 
   Prepared s = prepare(low, high, cage, st);
+  if (cage) check_cage_encloses(s, *cage);
   for (std::size_t t = 0; t < low.triangle_count(); ++t)
     for (int c = 0; c < 3; ++c) {
       const glm::vec2 uv = low.corner_uv(t, c);
@@ -437,12 +510,20 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   // stays within `margin` of its low-poly triangle's box (grown over the cage triangle): front
   // and rear when given, else the distance probe's reach, and after the probe the distances it
   // chose (the BVH is rebuilt then only if that leaves out a fifth of it or more).
-  const bool auto_distances = !cage && (opt.front < 0.0f || opt.rear < 0.0f);
-  const double reach = 0.1 * s.diagonal;  // the probe's: farther than this is another part of the model
+  // How far rays reach: from a cage read from a file (its rear measured per vertex unless given);
+  // one fixed distance for the whole scene where --front or --rear is given (the other measured for
+  // the whole scene); else from the automatic cage, front and rear measured per vertex (auto_cage.h).
+  const bool auto_cage = !cage && opt.front < 0.0f && opt.rear < 0.0f;
+  const bool auto_distances = !cage && !auto_cage && (opt.front < 0.0f || opt.rear < 0.0f);
+  const bool local_rear = auto_cage || (cage && opt.rear < 0.0f);
+  const bool probing = auto_distances || local_rear;
+  const double reach = kProbeReach * s.diagonal;  // the probe's: farther than this is another part of the model
+  const double floor_dist = 1e-4 * s.diagonal;  // the least distance measured (coincident meshes)
+  const bool any_cage = cage || auto_cage;
   std::vector<Box> regions;
   auto ray_margin = [&](double front, double rear) {
     // Rays are cast in float: a little slack keeps the test conservative.
-    return 1.01 * (cage ? rear : std::max(front, rear)) + 1e-6 * s.diagonal;
+    return 1.01 * (any_cage ? rear : std::max(front, rear)) + 1e-6 * s.diagonal;
   };
   std::vector<std::uint32_t> kept;  // triangles in the BVH, increasing; empty with all of them in
   std::optional<raycast::Scene> scene;
@@ -475,23 +556,26 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     scene.emplace(&s.high_pos[0].x, s.high_pos.size(), s.bvh_index, tris, st.bvh_quality, opt.threads);
     st.high_triangles_culled = kept.empty() ? 0 : high.triangle_count() - kept.size();
   };
-  t0 = Clock::now();
-  if (opt.cull_far) {
+  // Each low-poly triangle's box, grown over its cage triangle when there is one.
+  auto make_regions = [&] {
     regions.resize(low.triangle_count());
     for (std::size_t t = 0; t < low.triangle_count(); ++t) {
       Box b{low_tris[t].p[0], low_tris[t].p[0]};
       for (int c = 0; c < 3; ++c) {
         b.lo = glm::min(b.lo, low_tris[t].p[c]);
         b.hi = glm::max(b.hi, low_tris[t].p[c]);
-        if (cage) {
-          const glm::dvec3 q(s.cage_pos[cage->position_index[3 * t + c]]);
-          b.lo = glm::min(b.lo, q);
-          b.hi = glm::max(b.hi, q);
+        if (!s.cage_corners.empty()) {
+          b.lo = glm::min(b.lo, s.cage_corners[3 * t + c]);
+          b.hi = glm::max(b.hi, s.cage_corners[3 * t + c]);
         }
       }
       regions[t] = b;
     }
-    const double margin = auto_distances ? reach * 1.01 + 1e-6 * s.diagonal : ray_margin(opt.front, opt.rear);
+  };
+  t0 = Clock::now();
+  if (opt.cull_far) {
+    make_regions();
+    const double margin = probing ? reach * 1.01 + 1e-6 * s.diagonal : ray_margin(opt.front, opt.rear);
     kept = triangles_near(regions, margin, s.high_pos, high.position_index);
     if (kept.size() == high.triangle_count()) kept.clear();
   }
@@ -504,9 +588,10 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   t0 = Clock::now();
   st.front = opt.front;
   st.rear = opt.rear;
-  if (auto_distances || !opt.keep_backfaces) {
+  double global_front = 0.0, global_rear = 0.0;  // measured for the whole scene
+  if (probing || !opt.keep_backfaces) {
     const std::size_t tris = low.triangle_count();
-    const std::size_t stride = std::max<std::size_t>(1, tris / (auto_distances ? 50000 : 5000));
+    const std::size_t stride = std::max<std::size_t>(1, tris / (probing ? 50000 : 5000));
     static const double probe_bary[4][3] = {{1 / 3.0, 1 / 3.0, 1 / 3.0}, {4 / 6.0, 1 / 6.0, 1 / 6.0},
                                             {1 / 6.0, 4 / 6.0, 1 / 6.0}, {1 / 6.0, 1 / 6.0, 4 / 6.0}};
     std::vector<raycast::Ray> rays;
@@ -525,36 +610,50 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
         scene->intersect(&rays[2 * i], &hits[2 * i], 2 * n);
       }
     });
-    std::vector<float> outside, inside;
-    std::size_t nearest_back = 0;
-    for (std::size_t i = 0; i < pairs; ++i) {
-      const raycast::Hit& o = hits[2 * i];
-      const raycast::Hit& in = hits[2 * i + 1];
-      const raycast::Hit* nearest = nullptr;
-      if (o.hit() && (!in.hit() || o.t <= in.t)) {
-        outside.push_back(o.t);
-        nearest = &o;
-      } else if (in.hit()) {
-        inside.push_back(in.t);
-        nearest = &in;
-      }
-      if (nearest) {
-        // A back face: its front (by its normals) faces away from the low-poly's outside, which is
-        // +direction for the outward probe and -direction for the inward one.
-        const std::uint32_t* v = s.bvh_index + 3 * std::size_t(nearest->triangle);
-        const glm::vec3 ng = glm::cross(s.high_pos[v[1]] - s.high_pos[v[0]], s.high_pos[v[2]] - s.high_pos[v[0]]);
-        const glm::vec3 out = nearest == &o ? rays[2 * i].direction : -rays[2 * i + 1].direction;
-        nearest_back += float(s.bvh_facing[nearest->triangle]) * glm::dot(ng, out) < 0.0f;
-      }
+    std::size_t nearest_back = 0, probes_hit = 0;
+    // A back face: its front (by its normals) faces away from the low-poly's outside, +direction
+    // of the outward probe (the first of a pair).
+    std::vector<std::uint8_t> is_back(rays.size(), 0);
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      if (!hits[i].hit()) continue;
+      const std::uint32_t* v = s.bvh_index + 3 * std::size_t(hits[i].triangle);
+      const glm::vec3 ng = glm::cross(s.high_pos[v[1]] - s.high_pos[v[0]], s.high_pos[v[2]] - s.high_pos[v[0]]);
+      is_back[i] = float(s.bvh_facing[hits[i].triangle]) * glm::dot(ng, rays[i & ~std::size_t(1)].direction) < 0.0f;
     }
-    const std::size_t probes_hit = outside.size() + inside.size();
+    for (std::size_t i = 0; i < pairs; ++i) {  // how the faces point: by the nearest hit either way
+      const raycast::Hit &o = hits[2 * i], &in = hits[2 * i + 1];
+      if (!o.hit() && !in.hit()) continue;
+      ++probes_hit;
+      nearest_back += o.hit() && (!in.hit() || o.t <= in.t) ? is_back[2 * i] : is_back[2 * i + 1];
+    }
     st.backface_probe_share = probes_hit ? double(nearest_back) / double(probes_hit) : 0.0;
-    if (auto_distances) {
+    if (!opt.keep_backfaces) {
+      st.high_facing = st.backface_probe_share > kInvertedShare ? BakeStats::HighFacing::inverted
+                       : st.backface_probe_share > kMixedShare  ? BakeStats::HighFacing::mixed
+                                                                : BakeStats::HighFacing::sound;
+      st.backfaces_skipped = st.high_facing != BakeStats::HighFacing::mixed;
+    }
+    // How far the high-poly lies: by the nearest hit either way that the rays may take (with back
+    // faces skipped, not a back face as the faces were found to point: that is another part's inside).
+    const std::uint8_t back_is = st.high_facing == BakeStats::HighFacing::inverted ? 0 : 1;
+    std::vector<float> outside, inside;
+    for (std::size_t i = 0; i < pairs; ++i) {
+      const raycast::Hit &o = hits[2 * i], &in = hits[2 * i + 1];
+      const bool o_ok = o.hit() && !(st.backfaces_skipped && is_back[2 * i] == back_is);
+      const bool in_ok = in.hit() && !(st.backfaces_skipped && is_back[2 * i + 1] == back_is);
+      if (o_ok && (!in_ok || o.t <= in.t))
+        outside.push_back(o.t);
+      else if (in_ok)
+        inside.push_back(in.t);
+    }
+    if (probing) {
       st.auto_distances = true;
       // Cover all but the farthest 0.1% of probes, with a 25% margin and a floor for coincident meshes.
-      const double floor_dist = 1e-4 * s.diagonal;
-      const double front = 1.25 * quantile(outside, 0.999) + floor_dist;
-      const double rear = 1.25 * quantile(inside, 0.999) + floor_dist;
+      global_front = 1.25 * quantile(outside, 0.999) + floor_dist;
+      global_rear = 1.25 * quantile(inside, 0.999) + floor_dist;
+    }
+    if (auto_distances) {
+      const double front = global_front, rear = global_rear;
       if (opt.front < 0.0f) st.front = float(front);
       if (opt.rear < 0.0f) st.rear = float(rear);
       std::size_t beyond = 0;
@@ -563,19 +662,39 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
       st.auto_probe_beyond = pairs ? double(beyond) / double(pairs) : 0.0;
     }
   }
-  if (!opt.keep_backfaces) {
-    st.high_facing = st.backface_probe_share > kInvertedShare ? BakeStats::HighFacing::inverted
-                     : st.backface_probe_share > kMixedShare  ? BakeStats::HighFacing::mixed
-                                                              : BakeStats::HighFacing::sound;
-    st.backfaces_skipped = st.high_facing != BakeStats::HighFacing::mixed;
-    if (st.high_facing == BakeStats::HighFacing::inverted) turn_inverted_high(s, st.high_normals_computed);
+  if (st.high_facing == BakeStats::HighFacing::inverted) turn_inverted_high(s, st.high_normals_computed);
+  if (local_rear) {
+    // Per-vertex distances (after the facing decision: the probes judge faces by it).
+    const LocalDistances ld = measure_local_distances({&s.low_pos, &low.position_index, &s.ray_normal},
+                                                      {&*scene, s.high_pos.data(), s.bvh_index, s.bvh_facing}, reach, floor_dist,
+                                                      global_front, global_rear, kCageSlope, threads);
+    st.auto_distances = true;
+    st.cage_front_limited = auto_cage ? ld.front_limited : 0;
+    st.cage_rear_limited = ld.rear_limited;
+    result.vertex_rear = ld.rear;
+    result.vertex_search = ld.search;
+    attach_rear(s, low, ld.rear, ld.search);
+    if (auto_cage) {
+      // The cage: every vertex moved along its ray normal by its front distance, in the meshes'
+      // own coordinates (float, as a cage file holds them), then re-centred like a file's.
+      result.cage_positions.resize(low.positions.size());
+      for (std::size_t i = 0; i < low.positions.size(); ++i)
+        result.cage_positions[i] = glm::vec3(glm::dvec3(low.positions[i]) + double(ld.front[i]) * glm::dvec3(s.ray_normal[i]));
+      Mesh auto_mesh;
+      auto_mesh.positions = result.cage_positions;
+      auto_mesh.position_index = low.position_index;
+      attach_cage(s, auto_mesh);
+    }
+    summarize(auto_cage ? ld.front : std::vector<float>(), st.vertex_front);
+    summarize(ld.rear, st.vertex_rear);
+    if (auto_cage) st.front = float(st.vertex_front.max);
+    st.rear = float(st.vertex_rear.max);
   }
-  if (cage) {
-    if (st.front < 0.0f) st.front = 0.0f;
-    if (st.rear < 0.0f) st.rear = float(1e-4 * s.diagonal);
-  }
+  st.cage = cage ? BakeStats::CageSource::file : auto_cage ? BakeStats::CageSource::automatic : BakeStats::CageSource::none;
+  if (cage && st.front < 0.0f) st.front = 0.0f;
   st.seconds_distances = seconds_since(t0);
-  if (opt.cull_far && auto_distances) {
+  if (opt.cull_far && probing) {
+    make_regions();
     t0 = Clock::now();
     std::vector<std::uint32_t> all;
     if (kept.empty()) {
@@ -628,7 +747,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   if (output_error) std::rethrow_exception(output_error);
   const std::vector<glm::dvec2> offsets = sample_offsets(opt.samples);
   const int S = int(offsets.size());
-  const bool closest = opt.policy == RayPolicy::closest && !cage;
+  const bool closest = opt.policy == RayPolicy::closest;
   const int rays_per_sample = closest ? 2 : 1;
 
   // One cache line each: the counters change per sample, and shared lines would serialize threads.
@@ -650,7 +769,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   RaySetup ray_setup;
   ray_setup.front = st.front;
   ray_setup.rear = st.rear;
-  ray_setup.cage = cage != nullptr;
+  ray_setup.cage = any_cage;
   ray_setup.closest = closest;
   ray_setup.diagonal = s.diagonal;
 
@@ -679,6 +798,11 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     for (std::size_t i = 0; i < outward.size(); i += 2) outward[i] = 1;
     raycast::RayBatch ray_batch = rays.rays();
     ray_batch.outward = outward.empty() ? nullptr : outward.data();
+    std::vector<float> prefer_lo(any_cage ? rays.size() : 0), prefer_hi(any_cage ? rays.size() : 0);
+    if (any_cage) {
+      ray_batch.prefer_lo = prefer_lo.data();
+      ray_batch.prefer_hi = prefer_hi.data();
+    }
     std::vector<std::int32_t> sample_tri(slot_count);
     std::vector<double> sample_b(3 * slot_count);
     double* const sb[3] = {&sample_b[0], &sample_b[slot_count], &sample_b[2 * slot_count]};
@@ -752,8 +876,13 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
         if (!sample_fallback[r]) continue;
         raycast::Ray one[2];
         const double b[3] = {sb[0][r], sb[1][r], sb[2][r]};
-        const int n = sample_rays(s, std::size_t(sample_tri[r]), b, ray_setup, one, &signed_base[r * rays_per_sample]);
-        for (int j = 0; j < n; ++j) rays.set(r * rays_per_sample + std::size_t(j), one[j]);
+        float lo[2], hi[2];
+        const int n = sample_rays(s, std::size_t(sample_tri[r]), b, ray_setup, one, &signed_base[r * rays_per_sample], lo, hi);
+        for (int j = 0; j < n; ++j) {
+          const std::size_t i = r * rays_per_sample + std::size_t(j);
+          rays.set(i, one[j]);
+          if (any_cage) prefer_lo[i] = lo[j], prefer_hi[i] = hi[j];
+        }
       }
       if (ray_count) {
         const auto cast_start = Clock::now();
@@ -907,13 +1036,21 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
 // The bake's own preparation, rays and shading (prepare, sample_rays, chosen_hit, shade_sample)
 // for a list of texels; tests/test_error_estimate.cpp checks both agree texel for texel.
 std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt,
-                                          const BakeStats& st, const std::vector<std::uint32_t>& texels, int samples) {
+                                          const BakeResult& baked, const std::vector<std::uint32_t>& texels, int samples) {
+  const BakeStats& st = baked.stats;
   std::vector<glm::dvec3> out(texels.size(), glm::dvec3(0.0));
   if (texels.empty() || low.triangle_count() == 0 || high.triangle_count() == 0 || !low.has_uvs()) return out;
   const int threads = opt.threads > 0 ? opt.threads : std::max(1, int(std::thread::hardware_concurrency()));
   const int W = opt.width, H = opt.height;
   BakeStats scratch;
+  Mesh auto_mesh;  // the bake's automatic cage
+  if (!cage && !baked.cage_positions.empty()) {
+    auto_mesh.positions = baked.cage_positions;
+    auto_mesh.position_index = low.position_index;
+    cage = &auto_mesh;
+  }
   Prepared s = prepare(low, high, cage, scratch);
+  if (!baked.vertex_rear.empty()) attach_rear(s, low, baked.vertex_rear, baked.vertex_search);
   if (st.high_facing == BakeStats::HighFacing::inverted) turn_inverted_high(s, scratch.high_normals_computed);
   // Few rays: a quick BVH build pays off more than a fast one to trace. All triangles: culling
   // leaves the hits unchanged.
@@ -927,7 +1064,7 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
   ray_setup.front = st.front;
   ray_setup.rear = st.rear;
   ray_setup.cage = cage != nullptr;
-  ray_setup.closest = opt.policy == RayPolicy::closest && !cage;
+  ray_setup.closest = opt.policy == RayPolicy::closest;
   ray_setup.diagonal = s.diagonal;
   const int rays_per_sample = ray_setup.closest ? 2 : 1;
 
@@ -971,6 +1108,9 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
     for (std::size_t i = 0; i < outward.size(); i += 2) outward[i] = 1;
     raycast::RayBatch ray_batch = arrays.rays();
     ray_batch.outward = outward.empty() ? nullptr : outward.data();
+    std::vector<float> prefer_lo(arrays.size()), prefer_hi(arrays.size());
+    ray_batch.prefer_lo = prefer_lo.data();
+    ray_batch.prefer_hi = prefer_hi.data();
     std::vector<double> signed_base(arrays.size());
     for (std::size_t i0; (i0 = next.fetch_add(kChunk)) < texels.size();) {
       const std::size_t i1 = std::min(texels.size(), i0 + kChunk);
@@ -988,8 +1128,14 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
       }
       for (std::size_t r = 0; r < work.size(); ++r) {
         raycast::Ray one[2];
-        const int n = sample_rays(s, work[r].tri, work[r].b, ray_setup, one, &signed_base[r * rays_per_sample]);
-        for (int j = 0; j < n; ++j) arrays.set(r * rays_per_sample + std::size_t(j), one[j]);
+        float lo[2], hi[2];
+        const int n = sample_rays(s, work[r].tri, work[r].b, ray_setup, one, &signed_base[r * rays_per_sample], lo, hi);
+        for (int j = 0; j < n; ++j) {
+          const std::size_t i = r * rays_per_sample + std::size_t(j);
+          arrays.set(i, one[j]);
+          prefer_lo[i] = lo[j];
+          prefer_hi[i] = hi[j];
+        }
       }
       const std::size_t ray_count = work.size() * std::size_t(rays_per_sample);
       if (ray_count) scene.intersect(ray_batch, hits, ray_count, hit_rule);

@@ -108,6 +108,17 @@ struct BakeStats {
   enum class HighFacing { sound, inverted, mixed } high_facing = HighFacing::sound;
   // Rays whose first hit was a back face, passed over for the next hit.
   std::uint64_t backface_skips = 0;
+  // Where rays start: a cage from a file, the automatic cage (no --cage, --front or --rear), or
+  // none (one fixed distance for the scene).
+  enum class CageSource { none, automatic, file } cage = CageSource::none;
+  // Per low-poly vertex (file vertex) distances, scene units: front with the automatic cage, rear
+  // with it and with a file's cage when --rear is not given (else all 0).
+  struct Range {
+    double min = 0.0, mean = 0.0, max = 0.0;
+  } vertex_front, vertex_rear;
+  // Welded vertices whose measured front or rear need was cut by the limit (half the distance to
+  // the next part of the low-poly along the normal).
+  std::size_t cage_front_limited = 0, cage_rear_limited = 0;
   // Samples whose hit has a normal pointing away from the low-poly's outside (no other hit was found).
   std::uint64_t hits_facing_away = 0;
   // Seconds per stage.
@@ -124,6 +135,15 @@ struct BakeResult {
   Image miss_mask;                    // 1 channel, share of missed samples (only with options.miss_mask)
   std::vector<std::uint8_t> coverage;  // per texel: 1 = covered by the UV layout
   BakeStats stats;
+  // The automatic cage (BakeStats::CageSource::automatic): per low-poly position, object space as
+  // the low-poly's (a cage file with the low-poly's topology holds these); else empty.
+  std::vector<glm::vec3> cage_positions;
+  // Per low-poly position, the rear distance measured (with the automatic cage or a file's cage
+  // without --rear); else empty.
+  std::vector<float> vertex_rear;
+  // Per low-poly position, how far out rays search beyond a cage that a neighbouring part limits
+  // (LocalDistances::search); empty where vertex_rear is.
+  std::vector<float> vertex_search;
 };
 
 struct Cancelled : Error {
@@ -149,12 +169,12 @@ std::vector<glm::dvec2> sample_offsets(int samples);
 
 // ---- Re-baking chosen texels (for the error estimate, error_estimate.h) ----
 // The unit values bake_normal_map gives texels `texels` (indices y * width + x) with `samples`
-// sample points each (sample_offsets), using the ray distances and centre of a finished bake
-// (`stats`) and otherwise the same rays, shading and averaging as the bake (tangent space with
+// sample points each (sample_offsets), using the ray distances, cage and centre of a finished bake
+// (`baked`) and otherwise the same rays, shading and averaging as the bake (tangent space with
 // --green down applied, or object space), as n in [-1,1]^3 (not encoded, not snapped to 0).
 // A texel none of whose samples falls in the UV layout gets (0,0,0). Builds its own BVH.
 std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& options,
-                                          const BakeStats& stats, const std::vector<std::uint32_t>& texels, int samples);
+                                          const BakeResult& baked, const std::vector<std::uint32_t>& texels, int samples);
 // ---- end of re-baking chosen texels ----
 
 }  // namespace nmbake

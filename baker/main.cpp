@@ -2,6 +2,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -41,7 +42,7 @@ const char* kExitCodes =
     "  130 interrupted (no output written)\n";
 
 struct Args {
-  std::string low, high, output, cage, miss_mask, report;
+  std::string low, high, output, cage, miss_mask, report, save_cage;
   std::string size = "2048";
   int samples = 1;
   double front = -1.0, rear = -1.0;
@@ -78,6 +79,15 @@ std::string human(double v) {
   else if (v >= 1e3) std::snprintf(buf, sizeof buf, "%.1fk", v / 1e3);
   else std::snprintf(buf, sizeof buf, "%.0f", v);
   return buf;
+}
+
+// Whether two paths name one file: by identity where both exist (links, "./"), else by their
+// normalized absolute names.
+bool same_file(const std::string& a, const std::string& b) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec);
+  return fs::weakly_canonical(a, ec) == fs::weakly_canonical(b, ec);
 }
 
 // Fails early, before a long bake, when the output cannot be created where asked.
@@ -127,6 +137,9 @@ int run(int argc, char** argv) {
   app.add_option("--front", a.front, "Ray start distance outside the low-poly, scene units (default: measured)");
   app.add_option("--rear", a.rear, "Ray reach inside the low-poly, scene units (default: measured)");
   app.add_option("--cage", a.cage, "Cage mesh with the low-poly's topology: rays go from cage to low-poly");
+  app.add_option("--save-cage", a.save_cage,
+                 "Write the automatic cage (made when --cage, --front and --rear are absent) as OBJ with the low-poly's "
+                 "topology and UVs; baking with --cage that file gives the same map");
   app.add_option("--policy", a.policy, "cage-first (default) or closest")->check(CLI::IsMember({"cage-first", "closest"}));
   app.add_option("--space", a.space, "tangent (default) or object")->check(CLI::IsMember({"tangent", "object"}));
   app.add_option("--green", a.green, "up = OpenGL/Blender/glTF (default), down = DirectX/Unreal")->check(CLI::IsMember({"up", "down"}));
@@ -186,6 +199,17 @@ int run(int argc, char** argv) {
   o.cull_far = !a.no_cull;
   o.keep_backfaces = a.keep_backfaces;
   const int bits = a.bits ? a.bits : default_bits_for(a.output);
+  if (!a.save_cage.empty()) {
+    if (!a.cage.empty() || a.front != -1.0 || a.rear != -1.0)
+      throw UsageError("--save-cage writes the automatic cage, which is made only without --cage, --front and --rear");
+    std::string ext = std::filesystem::path(a.save_cage).extension().string();
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (ext != ".obj") throw UsageError("--save-cage " + a.save_cage + ": the cage is written as OBJ (.obj)");
+    for (const std::string* in : {&a.low, &a.high, &a.output, &a.report, &a.miss_mask})
+      if (!in->empty() && same_file(*in, a.save_cage))
+        throw UsageError("--save-cage " + a.save_cage + " is the same file as " + *in + "; nothing written");
+    check_output_path(a.save_cage, "the cage");
+  }
   check_output_path(a.output, "the map");
   if (!a.miss_mask.empty()) check_output_path(a.miss_mask, "the miss mask");
   if (!a.report.empty()) check_output_path(a.report, "the report");
@@ -221,7 +245,16 @@ int run(int argc, char** argv) {
   // Topology checks are only reported: they run beside the image write, which uses one core
   // (about 0.3-0.6 s CPU per 400k triangles; beside the bake they took time from its threads).
   auto topology = std::async(std::launch::async, [&high] { return inspect_topology(high); });
-  if (s.auto_distances && !a.quiet)
+  if (s.cage == BakeStats::CageSource::automatic && !a.quiet)
+    std::fprintf(stderr,
+                 "nmbake: automatic cage: front %.3g-%.3g (mean %.3g), rear %.3g-%.3g (mean %.3g) per vertex; limited by a neighbouring "
+                 "part at %zu and %zu vertices\n",
+                 s.vertex_front.min, s.vertex_front.max, s.vertex_front.mean, s.vertex_rear.min, s.vertex_rear.max, s.vertex_rear.mean,
+                 s.cage_front_limited, s.cage_rear_limited);
+  else if (s.cage == BakeStats::CageSource::file && s.auto_distances && !a.quiet)
+    std::fprintf(stderr, "nmbake: rear distances measured per vertex: %.3g-%.3g (mean %.3g)\n", s.vertex_rear.min, s.vertex_rear.max,
+                 s.vertex_rear.mean);
+  else if (s.auto_distances && !a.quiet)
     std::fprintf(stderr, "nmbake: ray distances measured: --front %.6g --rear %.6g (%.2f%% of probes lie beyond)\n", s.front, s.rear,
                  100.0 * s.auto_probe_beyond);
   if (g_interrupted) throw Cancelled();
@@ -258,6 +291,14 @@ int run(int argc, char** argv) {
     WriteOptions mo;
     mo.bits = default_bits_for(a.miss_mask);
     write_image(a.miss_mask, r.miss_mask, mo);
+  }
+  if (!a.save_cage.empty()) {
+    Mesh cage_mesh;
+    cage_mesh.positions = r.cage_positions;
+    cage_mesh.uvs = low.uvs;
+    cage_mesh.position_index = low.position_index;
+    cage_mesh.uv_index = low.uv_index;
+    write_text_atomically(a.save_cage, obj_text(cage_mesh, "nmbake " NMBAKE_VERSION " automatic cage of " + a.low + " for " + a.high));
   }
   run.seconds_write = std::chrono::duration<double>(Clock::now() - t0).count();
   run.high_topology = topology.get();

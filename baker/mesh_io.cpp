@@ -10,6 +10,7 @@
 #include <cctype>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <new>
 #include <string>
@@ -219,6 +220,31 @@ Mesh load_mesh(const std::string& path, const LoadOptions& options, MeshLoadInfo
   } catch (const std::length_error&) {
     throw ResourceError(path + ": out of memory while loading");
   }
+}
+
+std::string obj_text(const Mesh& mesh, const std::string& comment) {
+  std::string out = "# " + comment + "\n";
+  char line[160];
+  for (const glm::vec3& p : mesh.positions) {
+    std::snprintf(line, sizeof line, "v %.9g %.9g %.9g\n", double(p.x), double(p.y), double(p.z));
+    out += line;
+  }
+  for (const glm::vec2& t : mesh.uvs) {
+    std::snprintf(line, sizeof line, "vt %.9g %.9g\n", double(t.x), double(t.y));
+    out += line;
+  }
+  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+    out += "f";
+    for (int c = 0; c < 3; ++c) {
+      if (mesh.has_uvs())
+        std::snprintf(line, sizeof line, " %u/%u", mesh.position_index[3 * t + c] + 1, mesh.uv_index[3 * t + c] + 1);
+      else
+        std::snprintf(line, sizeof line, " %u", mesh.position_index[3 * t + c] + 1);
+      out += line;
+    }
+    out += "\n";
+  }
+  return out;
 }
 
 }  // namespace nmbake

@@ -26,4 +26,9 @@ Mesh load_mesh(const std::string& path, const LoadOptions& options = {}, MeshLoa
 Mesh load_mesh_from_memory(const std::string& name, std::string_view bytes, const LoadOptions& options = {},
                            MeshLoadInfo* info = nullptr);
 
+// The mesh as OBJ text: positions (each float exactly, %.9g), UVs when it has them, and its
+// triangles (v/vt), in the mesh's own vertex order, so reading it back gives the same arrays.
+// `comment` becomes the first line (after "# ").
+std::string obj_text(const Mesh& mesh, const std::string& comment);
+
 }  // namespace nmbake

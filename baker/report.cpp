@@ -94,6 +94,14 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
                       : s.high_facing == BakeStats::HighFacing::mixed  ? "mixed"
                                                                        : "sound"},
       {"hits_facing_away", s.hits_facing_away},
+      {"cage",
+       {{"source", s.cage == BakeStats::CageSource::automatic ? "automatic"
+                   : s.cage == BakeStats::CageSource::file    ? "file"
+                                                              : "none"},
+        {"front", {{"min", s.vertex_front.min}, {"mean", s.vertex_front.mean}, {"max", s.vertex_front.max}}},
+        {"rear", {{"min", s.vertex_rear.min}, {"mean", s.vertex_rear.mean}, {"max", s.vertex_rear.max}}},
+        {"front_limited_vertices", s.cage_front_limited},
+        {"rear_limited_vertices", s.cage_rear_limited}}},
       {"coordinate_spacing", s.coordinate_spacing},
       {"largest_coordinate", s.largest_coordinate},
   };

@@ -38,20 +38,32 @@ struct RuleContext {
   RTCIntersectContext context;  // first: the filter receives a pointer to it
   const HitRule* rule = nullptr;
   std::uint8_t outward[8] = {};
+  float prefer_lo[8], prefer_hi[8];  // the preferred part of each ray
   float backface_t[8];               // nearest back face passed over
-  float fallback_t[8];               // nearest front-face hit whose normal disagrees
-  std::uint32_t fallback_prim[8];
-  float fallback_u[8], fallback_v[8];
+  // Hits kept for want of a better one: [0] the front-face hit outside the preferred part nearest
+  // to it (key: that distance), [1] the first hit whose normal disagrees (key: t).
+  struct Kept {
+    float key, t, u, v;
+    std::uint32_t prim;
+  } kept[2][8];
 
   explicit RuleContext(const HitRule* r) : rule(r) {
     rtcInitIntersectContext(&context);
     context.filter = r ? &filter : nullptr;
   }
   void reset_lanes() {
+    constexpr float inf = std::numeric_limits<float>::infinity();
     for (int k = 0; k < 8; ++k) {
-      backface_t[k] = fallback_t[k] = std::numeric_limits<float>::infinity();
-      fallback_prim[k] = no_hit;
+      backface_t[k] = inf;
+      prefer_lo[k] = 0.0f;
+      prefer_hi[k] = inf;
+      for (auto& kk : kept) kk[k] = {inf, 0.0f, 0.0f, 0.0f, no_hit};
     }
+  }
+  // Keeps the hit when its key is smaller (equal keys: the lower triangle index, whatever order
+  // Embree found them in).
+  static void keep(Kept& k, float key, float t, float u, float v, std::uint32_t prim) {
+    if (key < k.key || (key == k.key && prim < k.prim)) k = {key, t, u, v, prim};
   }
 
   // Called by Embree for every hit it finds within the ray's current range, in no particular
@@ -78,20 +90,19 @@ struct RuleContext {
         args->valid[i] = 0;
         continue;
       }
+      const float u = RTCHitN_u(args->hit, n, i), v = RTCHitN_v(args->hit, n, i);
       if (rule.corner_normals) {
-        const float u = RTCHitN_u(args->hit, n, i), v = RTCHitN_v(args->hit, n, i);
         const glm::vec3* c = rule.corner_normals + 3 * std::size_t(prim);
         const glm::vec3 nh = (1.0f - u - v) * c[0] + u * c[1] + v * c[2];
         if (!(glm::dot(nh, out) > 0.0f)) {
-          // Nearest first; equal distances by triangle index, whatever order Embree found them in.
-          if (t < rc.fallback_t[lane] || (t == rc.fallback_t[lane] && prim < rc.fallback_prim[lane])) {
-            rc.fallback_t[lane] = t;
-            rc.fallback_prim[lane] = prim;
-            rc.fallback_u[lane] = u;
-            rc.fallback_v[lane] = v;
-          }
+          keep(rc.kept[1][lane], t, t, u, v, prim);
           args->valid[i] = 0;
+          continue;
         }
+      }
+      if (t < rc.prefer_lo[lane] || t > rc.prefer_hi[lane]) {
+        keep(rc.kept[0][lane], t < rc.prefer_lo[lane] ? rc.prefer_lo[lane] - t : t - rc.prefer_hi[lane], t, u, v, prim);
+        args->valid[i] = 0;
       }
     }
   }
@@ -100,13 +111,14 @@ struct RuleContext {
   // Embree's hit, else the fallback; its flags.
   std::uint8_t finish(int k, std::uint32_t& prim, float& t, float& u, float& v) const {
     std::uint8_t flags = 0;
-    if (prim == no_hit && fallback_prim[k] != no_hit) {
-      prim = fallback_prim[k];
-      t = fallback_t[k];
-      u = fallback_u[k];
-      v = fallback_v[k];
-      flags |= hit_normal_disagrees;
-    }
+    for (int j = 0; j < 2 && prim == no_hit; ++j)
+      if (kept[j][k].prim != no_hit) {
+        prim = kept[j][k].prim;
+        t = kept[j][k].t;
+        u = kept[j][k].u;
+        v = kept[j][k].v;
+        flags |= j == 0 ? hit_outside_preferred : hit_normal_disagrees;
+      }
     if (backface_t[k] < (prim == no_hit ? std::numeric_limits<float>::infinity() : t) ||
         (prim == no_hit && backface_t[k] != std::numeric_limits<float>::infinity()))
       flags |= hit_passed_backface;
@@ -209,10 +221,12 @@ Hit Scene::intersect(const Ray& ray) const {
   return h;
 }
 
-Hit Scene::intersect(const Ray& ray, const HitRule& rule, bool outward, std::uint8_t* flags) const {
+Hit Scene::intersect(const Ray& ray, const HitRule& rule, bool outward, std::uint8_t* flags, float prefer_lo, float prefer_hi) const {
   RuleContext rc(&rule);
   rc.reset_lanes();
   rc.outward[0] = outward;
+  rc.prefer_lo[0] = prefer_lo;
+  rc.prefer_hi[0] = prefer_hi;
   RTCRayHit rh;
   rh.ray.org_x = ray.origin.x;
   rh.ray.org_y = ray.origin.y;
@@ -316,7 +330,12 @@ void Scene::intersect(const RayBatch& rays, const HitBatch& hits, std::size_t co
     }
     if (rule) {
       rc.reset_lanes();
-      for (std::size_t k = 0; k < 8; ++k) rc.outward[k] = rays.outward ? rays.outward[base + std::min(k, n - 1)] : 0;
+      for (std::size_t k = 0; k < 8; ++k) {
+        const std::size_t i = base + std::min(k, n - 1);
+        rc.outward[k] = rays.outward ? rays.outward[i] : 0;
+        if (rays.prefer_lo) rc.prefer_lo[k] = rays.prefer_lo[i];
+        if (rays.prefer_hi) rc.prefer_hi[k] = rays.prefer_hi[i];
+      }
     }
     rtcIntersect8(valid, impl_->scene, &rc.context, &rh);
     for (std::size_t k = 0; k < 8; ++k)

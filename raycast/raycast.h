@@ -42,6 +42,11 @@ struct RayBatch {
   // lies along +direction), 0 when it travels inwards (outside along -direction, the usual ray
   // from a cage). Null: every ray travels inwards.
   const std::uint8_t* outward = nullptr;
+  // For a HitRule: per ray, the part of it where hits are looked for first, prefer_lo <= t <=
+  // prefer_hi (null: 0, and infinity): a hit outside it is taken only when none lies inside, and
+  // then the one nearest to it (the part of a ray beyond a cage that a neighbouring part limits).
+  const float* prefer_lo = nullptr;
+  const float* prefer_hi = nullptr;
 };
 // Their hits, the same way: triangle[i] is no_hit for a miss (t, u, v then unspecified).
 struct HitBatch {
@@ -62,6 +67,8 @@ struct HitBatch {
 // With corner_normals, a front-face hit whose interpolated normal points away from the low-poly's
 // outside (dot <= 0: it would bake as a texel facing into the surface, as grazing hits on the
 // side of another part do) is taken only when the ray finds no other: then the first of those.
+// In order: a front-face hit inside the ray's preferred part (RayBatch::prefer_lo/hi), the first
+// along the ray; else one outside it, the nearest to it; else one whose normal points away.
 struct HitRule {
   const std::int8_t* facing = nullptr;  // per triangle, +1 or -1; null: +1 for all
   bool skip_backfaces = true;
@@ -72,6 +79,7 @@ struct HitRule {
 enum HitFlags : std::uint8_t {
   hit_passed_backface = 1,   // the first surface along the ray was a back face, passed over
   hit_normal_disagrees = 2,  // the hit taken is one whose normal points away (no other was found)
+  hit_outside_preferred = 4,  // the hit taken lies outside the ray's preferred part (none inside)
 };
 
 // Rays held as arrays, with room for their hits: the arrays for Scene::intersect(RayBatch,
@@ -131,7 +139,8 @@ class Scene {
   // indexed by the triangles given at construction). Thread-safe.
   void intersect(const RayBatch& rays, const HitBatch& hits, std::size_t count, const HitRule* rule = nullptr) const;
   // Single rays under a rule (`outward` as in RayBatch); `flags` receives the HitFlags when not null.
-  Hit intersect(const Ray& ray, const HitRule& rule, bool outward = false, std::uint8_t* flags = nullptr) const;
+  Hit intersect(const Ray& ray, const HitRule& rule, bool outward = false, std::uint8_t* flags = nullptr, float prefer_lo = 0.0f,
+                float prefer_hi = std::numeric_limits<float>::infinity()) const;
 
   std::size_t triangle_count() const;
 

@@ -50,7 +50,7 @@ TEST(ErrorEstimate, RebakedTexelsMatchTheBake) {
     std::vector<std::uint32_t> texels;
     for (std::uint32_t i = 0; i < r.coverage.size(); ++i)
       if (r.coverage[i]) texels.push_back(i);
-    const std::vector<glm::dvec3> v = bake_texel_values(low, high, nullptr, o, r.stats, texels, o.samples);
+    const std::vector<glm::dvec3> v = bake_texel_values(low, high, nullptr, o, r, texels, o.samples);
     double worst = 0.0;
     for (std::size_t i = 0; i < texels.size(); ++i) {
       ASSERT_NE(v[i], glm::dvec3(0.0)) << "texel " << texels[i];

@@ -465,11 +465,14 @@ TEST(Stability, HighPolyInsideOrOutsideTheLowPoly) {
   const Mesh low = load_low("sphere_low.obj");
   for (const char* name : {"inside_high.obj", "outside_high.obj"}) {
     const Mesh high = load(name);
-    // Auto distances probe 10% of the scene diagonal; both spheres lie 0.6 away: nothing is hit,
-    // the map is flat, every sample is counted as a miss.
-    BakeOptions o = options(64, -1.0f);
+    // Both spheres lie 0.6 away. Distances of 0.1 reach neither: nothing is hit, the map is flat,
+    // every sample is counted as a miss. (The automatic cage's probes look 20% of the scene
+    // diagonal, 0.69, far: they find both, and every sample hits.)
+    BakeOptions o = options(64, 0.1f);
+    const BakeResult a = bake_normal_map(low, high, nullptr, options(64, -1.0f));
+    measured(std::string(name) + ".auto_misses", double(a.stats.misses));
+    EXPECT_EQ(a.stats.misses, 0u) << name;
     const BakeResult r = bake_normal_map(low, high, nullptr, o);
-    measured(std::string(name) + ".auto_misses", double(r.stats.misses));
     EXPECT_EQ(r.stats.misses, r.stats.samples_covered) << name;
     EXPECT_GT(r.stats.samples_covered, 0u);
     for (std::size_t i = 0; i < r.coverage.size(); ++i) {
@@ -502,7 +505,8 @@ TEST(Stability, HighPolyInsideOrOutsideTheLowPoly) {
 }
 
 TEST(Stability, AllMissedIsAWarningThroughTheCli) {
-  const CliRun r = run_nmbake(data("sphere_low.obj") + " " + data("inside_high.obj") + " -o out.png --size 64 --report r.json");
+  const CliRun r =
+      run_nmbake(data("sphere_low.obj") + " " + data("inside_high.obj") + " -o out.png --size 64 --front 0.1 --rear 0.1 --report r.json");
   ASSERT_EQ(r.code, 0);
   EXPECT_EQ(r.report["misses"], r.report["samples_covered"]);
   EXPECT_TRUE(contains(r.err, "warning: 100.0% of samples missed " + data("inside_high.obj"))) << r.err;

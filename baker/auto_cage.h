@@ -1,0 +1,64 @@
+// Ray distances per low-poly vertex, measured locally: the automatic cage.
+//
+// A single front/rear distance for the whole scene cannot serve a model whose parts need different
+// reaches (a bulge on one finger beside a narrow gap to the next). Here every vertex gets its own:
+// probes from the vertex and from points of the triangles around it, cast both ways along the ray
+// normals, find how far the high-poly lies outside (front) and inside (rear) the low-poly there;
+// probes against the low-poly itself find how far the next part of the low-poly lies along the
+// normal, and the cage stops half way to it, so that cages of facing parts never cross and no ray
+// starts beyond a neighbouring part. Needs are spread over neighbours and limits eased off with
+// distance (each changes by at most its edge's length along an edge), so the cage has neither
+// spikes nor notches; positions are welded by value first, so hard edges (split normals) open no
+// cracks. All coordinates are re-centred scene units.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "raycast.h"
+
+namespace nmbake {
+
+// The high-poly as the probes see it: its BVH, positions, and per BVH triangle its vertex indices
+// and the side its normals point to (raycast::HitRule::facing).
+struct ProbeTarget {
+  const raycast::Scene* scene = nullptr;
+  const glm::vec3* positions = nullptr;
+  const std::uint32_t* index = nullptr;  // 3 per BVH triangle
+  const std::int8_t* facing = nullptr;   // per BVH triangle
+};
+
+// The low-poly: re-centred positions (file vertices), 3 position indices per triangle, and the ray
+// normal of each position (unit, the same for positions with equal coordinates).
+struct CageBase {
+  const std::vector<glm::vec3>* positions = nullptr;
+  const std::vector<std::uint32_t>* index = nullptr;
+  const std::vector<glm::vec3>* ray_normals = nullptr;
+};
+
+struct LocalDistances {
+  // Per low-poly position (file vertex), scene units, at least `floor`.
+  std::vector<float> front, rear;
+  // Per low-poly position: how far out the high-poly was found, before any limit (at least the
+  // scene's front distance): rays search that far out, and take a hit beyond the cage only when
+  // none lies within it.
+  std::vector<float> search;
+  // Welded vertices whose measured need the limit (half the distance to the next part) cut.
+  std::size_t front_limited = 0, rear_limited = 0;
+  std::size_t vertices = 0;  // welded
+  std::size_t probes = 0;    // probe points (each cast both ways against both meshes)
+};
+
+// `reach`: how far a probe looks (farther is another part of the model); `floor`: the least
+// distance (coincident meshes); `front_base`, `rear_base`: the distances measured for the whole
+// scene (the bake's global probe), which every vertex gets at least unless a neighbouring part
+// limits it: local needs (1.25 x the distance found plus floor) only add where the high-poly lies
+// farther. `slope`: how much a distance may change per unit of length along an edge (the cage's
+// tilt against the low-poly, and so the rays', stays within atan(slope)).
+LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& high, double reach, double floor, double front_base,
+                                       double rear_base, double slope, int threads);
+
+}  // namespace nmbake
