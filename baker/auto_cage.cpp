@@ -68,7 +68,7 @@ void ease(std::vector<double>& value, const std::vector<std::vector<std::pair<st
 }  // namespace
 
 LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& high, double reach, double floor, double front_base,
-                                       double rear_base, double slope, int threads) {
+                                       double rear_base, double need_slope, double limit_slope, int threads) {
   const std::vector<glm::vec3>& pos = *low.positions;
   const std::vector<std::uint32_t>& index = *low.index;
   const std::vector<glm::vec3>& rn = *low.ray_normals;
@@ -176,8 +176,9 @@ LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& h
       rear_cap[w] = std::min(rear_cap[w], 0.5 * gap_in[i]);
     }
 
-  // Neither spikes nor notches: along every edge a need falls, and a limit rises, by at most slope
-  // times the edge's length.
+  // Neither spikes nor notches: along every edge a need falls by at most need_slope times the
+  // edge's length (it reaches as far around as it is tall), and a limit rises by at most
+  // limit_slope times it (a neighbouring part's limit fades out gently).
   std::vector<std::vector<std::pair<std::uint32_t, double>>> adjacent(nw);
   {
     std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
@@ -198,10 +199,10 @@ LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& h
       adjacent[b].push_back({a, len});
     }
   }
-  ease(front, adjacent, slope, true);
-  ease(rear, adjacent, slope, true);
-  ease(front_cap, adjacent, slope, false);
-  ease(rear_cap, adjacent, slope, false);
+  ease(front, adjacent, need_slope, true);
+  ease(rear, adjacent, need_slope, true);
+  ease(front_cap, adjacent, limit_slope, false);
+  ease(rear_cap, adjacent, limit_slope, false);
   const std::vector<double> search = front;
   for (std::size_t w = 0; w < nw; ++w) {
     out.front_limited += front_cap[w] < front[w];

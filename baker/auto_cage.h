@@ -56,9 +56,10 @@ struct LocalDistances {
 // distance (coincident meshes); `front_base`, `rear_base`: the distances measured for the whole
 // scene (the bake's global probe), which every vertex gets at least unless a neighbouring part
 // limits it: local needs (1.25 x the distance found plus floor) only add where the high-poly lies
-// farther. `slope`: how much a distance may change per unit of length along an edge (the cage's
-// tilt against the low-poly, and so the rays', stays within atan(slope)).
+// farther. `need_slope`: how much a need falls per unit of length along an edge (a bulge's need
+// covers its surroundings as far as it is tall with 1); `limit_slope`: how much a limit rises (the
+// cage's tilt where a neighbouring part limits it stays within atan(limit_slope)).
 LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& high, double reach, double floor, double front_base,
-                                       double rear_base, double slope, int threads);
+                                       double rear_base, double need_slope, double limit_slope, int threads);
 
 }  // namespace nmbake

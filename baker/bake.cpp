@@ -44,12 +44,21 @@ constexpr int kTile = 16;            // texels per tile side
 // Tangent components this close to zero are written as exactly 0: a flat result is then
 // (128,128,255) and not a coin flip between 127 and 128 decided by float noise.
 constexpr double kSnap = 1e-6;
-// How much the automatic cage's distances may change per unit length along the low-poly: rays
-// from it then tilt at most atan(0.25) = 14 degrees from the surface normal.
-constexpr double kCageSlope = 0.25;
+// How much the automatic cage's distances may change per unit length along the low-poly
+// (measure_local_distances): a need falls at 45 degrees, so a bulge's need covers around it as far
+// as it is tall; a neighbouring part's limit rises at atan(0.25) = 14 degrees.
+constexpr double kNeedSlope = 1.0;
+constexpr double kLimitSlope = 0.25;
 // How far the distance probes look, as a share of the scene diagonal: farther is another part of
 // the model. (A bulge of 15% of the diagonal, the hard-asset bench's tallest, is within it.)
 constexpr double kProbeReach = 0.2;
+
+// A low-poly triangle's cage: its corners (re-centred), and per corner the rear distance and how
+// far out rays search (LocalDistances::search; 0: to the cage only).
+struct CageTriangle {
+  glm::dvec3 corner[3];
+  double rear[3] = {0, 0, 0}, search[3] = {0, 0, 0};
+};
 
 // The scene in re-centred float coordinates, flat arrays for the hot loop.
 struct Prepared {
@@ -71,9 +80,7 @@ struct Prepared {
   std::vector<std::int8_t> high_facing;
   TangentFrames frames;
   std::vector<LowTriangle> low_tris;
-  std::vector<glm::dvec3> cage_corners;  // 3 per low-poly triangle, with a cage
-  std::vector<double> corner_rear;        // 3 per low-poly triangle: per-vertex rear distances; empty: the global one
-  std::vector<double> corner_search;      // 3 per low-poly triangle: how far out rays search (LocalDistances::search)
+  std::vector<CageTriangle> cage_tris;  // per low-poly triangle, with a cage (attach_cage, set_cage_reach)
 };
 
 // Over the positions faces use: a vertex no face uses (a stray point far away) must not move the
@@ -160,8 +167,9 @@ void run_parallel(int threads, Fn&& worker) {
 // The cage's corners, re-centred, 3 per low-poly triangle (its topology is the low-poly's).
 void attach_cage(Prepared& s, const Mesh& cage) {
   s.cage_pos = recentre(cage.positions, s.centre);
-  s.cage_corners.resize(cage.position_index.size());
-  for (std::size_t c = 0; c < s.cage_corners.size(); ++c) s.cage_corners[c] = glm::dvec3(s.cage_pos[cage.position_index[c]]);
+  s.cage_tris.resize(cage.triangle_count());
+  for (std::size_t t = 0; t < s.cage_tris.size(); ++t)
+    for (int c = 0; c < 3; ++c) s.cage_tris[t].corner[c] = glm::dvec3(s.cage_pos[cage.position_index[3 * t + c]]);
 }
 
 // A cage must enclose the low-poly: one whose vertices mostly lie inside it (moved against the ray
@@ -182,6 +190,38 @@ void check_cage_encloses(const Prepared& s, const Mesh& cage) {
                      std::to_string(inside + outside) + " moved vertices are moved inwards along the normals); a cage must enclose it");
 }
 
+// Suspect texels (BakeStats::suspect_texels) from the map before padding and the texels whose
+// samples disagree; their mask and the UV region most of them lie in.
+void find_suspects(const BakeOptions& opt, const std::vector<std::uint8_t>& disagree, BakeResult& result) {
+  BakeStats& st = result.stats;
+  const int W = opt.width, H = opt.height;
+  // The encoded z of a tangent-space normal tilted kSuspectTiltDeg from (0, 0, 1).
+  const float z_limit = float(0.5 + 0.5 * std::cos(kSuspectTiltDeg * 3.14159265358979323846 / 180.0));
+  if (opt.suspect_mask) result.suspect_mask = Image(W, H, 1, 0.0f);
+  std::size_t cells[8][8] = {};
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const std::size_t i = std::size_t(y) * W + std::size_t(x);
+      if (!result.coverage[i]) continue;
+      const bool tilted = opt.space == NormalSpace::tangent && result.map.pixels[3 * i + 2] < z_limit;
+      if (!tilted && (disagree.empty() || !disagree[i])) continue;
+      ++st.suspect_texels;
+      if (opt.suspect_mask) result.suspect_mask.pixels[i] = 1.0f;
+      ++cells[std::min(7, 8 * y / H)][std::min(7, 8 * x / W)];  // row 0 is the top: v = 1
+    }
+  if (!st.suspect_texels) return;
+  st.suspect_share = st.texels_covered ? double(st.suspect_texels) / double(st.texels_covered) : 0.0;
+  int best_r = 0, best_c = 0;
+  for (int r = 0; r < 8; ++r)
+    for (int c = 0; c < 8; ++c)
+      if (cells[r][c] > cells[best_r][best_c]) best_r = r, best_c = c;
+  st.suspect_region[0] = best_c / 8.0;
+  st.suspect_region[1] = 1.0 - (best_r + 1) / 8.0;
+  st.suspect_region[2] = (best_c + 1) / 8.0;
+  st.suspect_region[3] = 1.0 - best_r / 8.0;
+  st.suspect_region_share = double(cells[best_r][best_c]) / double(st.suspect_texels);
+}
+
 // A summary of per-vertex distances.
 void summarize(const std::vector<float>& v, BakeStats::Range& out) {
   if (v.empty()) return;
@@ -195,14 +235,16 @@ void summarize(const std::vector<float>& v, BakeStats::Range& out) {
   out.mean = sum / double(v.size());
 }
 
-// Per-vertex rear and search distances (LocalDistances) as 3 per low-poly triangle.
-void attach_rear(Prepared& s, const Mesh& low, const std::vector<float>& vertex_rear, const std::vector<float>& vertex_search) {
-  s.corner_rear.resize(low.position_index.size());
-  s.corner_search.resize(low.position_index.size());
-  for (std::size_t c = 0; c < s.corner_rear.size(); ++c) {
-    s.corner_rear[c] = double(vertex_rear[low.position_index[c]]);
-    s.corner_search[c] = double(vertex_search[low.position_index[c]]);
-  }
+// The cage triangles' rear and search distances: per vertex (LocalDistances) when measured, else
+// the one rear distance and no search beyond the cage.
+void set_cage_reach(Prepared& s, const Mesh& low, double rear, const std::vector<float>& vertex_rear,
+                    const std::vector<float>& vertex_search) {
+  for (std::size_t t = 0; t < s.cage_tris.size(); ++t)
+    for (int c = 0; c < 3; ++c) {
+      const std::uint32_t v = low.position_index[3 * t + c];
+      s.cage_tris[t].rear[c] = vertex_rear.empty() ? rear : double(vertex_rear[v]);
+      s.cage_tris[t].search[c] = vertex_search.empty() ? 0.0 : double(vertex_search[v]);
+    }
 }
 
 // Everything the rays and the shading read, from the meshes: tangent frames, re-centred
@@ -281,6 +323,41 @@ glm::dvec3 low_ray_normal(const LowTriangle& lt, const double b[3]) {
   return fl > 0.0 ? f / fl : glm::dvec3(0, 0, 1);
 }
 
+// A sample's ray with a cage: P, the unit direction from the cage point to P, the distance from
+// the cage point to P, how far out the ray searches (at least that), and the rear distance.
+struct CageRay {
+  glm::dvec3 p, d;
+  double len, search, rear;
+};
+
+inline CageRay cage_ray(const LowTriangle& lt, const CageTriangle& ct, const double b[3], double diagonal) {
+  CageRay r;
+  r.p = low_point(lt, b);
+  const glm::dvec3 pc = b[0] * ct.corner[0] + b[1] * ct.corner[1] + b[2] * ct.corner[2];
+  r.rear = b[0] * ct.rear[0] + b[1] * ct.rear[1] + b[2] * ct.rear[2];
+  const double search = b[0] * ct.search[0] + b[1] * ct.search[1] + b[2] * ct.search[2];
+  const glm::dvec3 d = r.p - pc;
+  r.len = glm::length(d);
+  if (r.len > 1e-9 * diagonal) {
+    r.d = d / r.len;
+  } else {  // a cage point on the low-poly gives no direction: the ray normal's
+    r.d = -low_ray_normal(lt, b);
+    r.len = 0.0;
+  }
+  // Where a neighbouring part limits the cage, rays search on beyond it, as far out as the
+  // high-poly was found there, for a hit to take only when none lies within the cage.
+  r.search = std::max(r.len, search);
+  return r;
+}
+
+// The inward ray of a cage sample: from `search` out along the line through the cage point to the
+// rear distance beyond P; the part before the cage point is looked at last (prefer_lo).
+inline raycast::Ray inward_ray(const CageRay& c, double* signed_base, float* prefer_lo) {
+  signed_base[0] = c.search;
+  prefer_lo[0] = c.search > c.len ? float(c.search - c.len) : 0.0f;
+  return {glm::vec3(c.p - c.search * c.d), 0.0f, glm::vec3(c.d), float(c.search + c.rear)};
+}
+
 // How a bake casts its rays (policy.h of the options, with the distances chosen).
 struct RaySetup {
   float front = 0.0f, rear = 0.0f;
@@ -296,40 +373,19 @@ inline int sample_rays(const Prepared& s, std::size_t tri, const double b[3], co
   prefer_lo[0] = prefer_lo[1] = 0.0f;
   prefer_hi[0] = prefer_hi[1] = std::numeric_limits<float>::infinity();
   const LowTriangle& lt = s.low_tris[tri];
-  const glm::dvec3 p = low_point(lt, b);
-  const glm::dvec3 n = low_ray_normal(lt, b);
   if (r.cage) {
-    glm::dvec3 pc(0.0);
-    for (int c = 0; c < 3; ++c) pc += b[c] * s.cage_corners[3 * tri + c];
-    double rear = r.rear;
-    if (!s.corner_rear.empty()) rear = b[0] * s.corner_rear[3 * tri] + b[1] * s.corner_rear[3 * tri + 1] + b[2] * s.corner_rear[3 * tri + 2];
-    glm::dvec3 d = p - pc;
-    double len = glm::length(d);
-    // A cage point on the low-poly gives no direction: use the ray normal from P.
-    if (!(len > 1e-9 * r.diagonal)) {
-      d = -n;
-      len = 0.0;
-      pc = p;
-    } else {
-      d /= len;
-    }
-    // Where a neighbouring part limits the cage, rays search on beyond it, as far out as the
-    // high-poly was found there, for a hit to take only when none lies within the cage.
-    double search = len;
-    if (!s.corner_search.empty())
-      search = std::max(len, b[0] * s.corner_search[3 * tri] + b[1] * s.corner_search[3 * tri + 1] + b[2] * s.corner_search[3 * tri + 2]);
-    if (r.closest) {  // from P out to the cage point, and in to the rear distance
+    const CageRay c = cage_ray(lt, s.cage_tris[tri], b, r.diagonal);
+    if (r.closest) {  // from P out to the cage point (and on, searching), and in to the rear distance
       signed_base[0] = signed_base[1] = 0.0;
-      rays[0] = {glm::vec3(p), 0.0f, glm::vec3(-d), float(search)};
-      rays[1] = {glm::vec3(p), 0.0f, glm::vec3(d), float(rear)};
-      if (search > len) prefer_hi[0] = float(len);
+      rays[0] = {glm::vec3(c.p), 0.0f, glm::vec3(-c.d), float(c.search)};
+      rays[1] = {glm::vec3(c.p), 0.0f, glm::vec3(c.d), float(c.rear)};
+      if (c.search > c.len) prefer_hi[0] = float(c.len);
       return 2;
     }
-    signed_base[0] = search;
-    rays[0] = {glm::vec3(p - search * d), 0.0f, glm::vec3(d), float(search + rear)};
-    if (search > len) prefer_lo[0] = float(search - len);
+    rays[0] = inward_ray(c, signed_base, prefer_lo);
     return 1;
   }
+  const glm::dvec3 p = low_point(lt, b), n = low_ray_normal(lt, b);
   if (r.closest) {
     signed_base[0] = signed_base[1] = 0.0;
     rays[0] = {glm::vec3(p), 0.0f, glm::vec3(n), r.front};
@@ -348,10 +404,13 @@ inline std::size_t chosen_hit(const raycast::HitBatch& hits, std::size_t first, 
   if (closest) {
     const std::size_t out = first, in = first + 1;
     const bool out_hit = hits.triangle[out] != raycast::no_hit, in_hit = hits.triangle[in] != raycast::no_hit;
-    // A hit whose normal points away (taken only for want of another on its ray) yields to one
-    // on the other ray that does not.
-    const auto away = [&](std::size_t i) { return hits.flags && (hits.flags[i] & raycast::hit_normal_disagrees); };
-    const bool prefer_out = out_hit && in_hit && away(out) != away(in) ? !away(out) : hits.t[out] <= hits.t[in];
+    // A hit taken only for want of another on its ray (outside the cage, then one whose normal
+    // points away) yields to a better one on the other ray.
+    const auto rank = [&](std::size_t i) {
+      const int f = hits.flags ? hits.flags[i] : 0;
+      return (f & raycast::hit_normal_disagrees) ? 2 : (f & raycast::hit_outside_preferred) ? 1 : 0;
+    };
+    const bool prefer_out = out_hit && in_hit && rank(out) != rank(in) ? rank(out) < rank(in) : hits.t[out] <= hits.t[in];
     if (out_hit && (!in_hit || prefer_out)) {
       *dist = hits.t[out];
       return out;
@@ -425,7 +484,7 @@ raycast::BuildQuality bvh_quality_for(const BakeOptions& o, std::size_t triangle
 std::uint64_t estimate_bake_bytes(const BakeOptions& o) {
   const std::uint64_t texels = std::uint64_t(std::max(o.width, 0)) * std::uint64_t(std::max(o.height, 0));
   // map (3 floats) + coverage (1 byte) + padding transform (double + int) + optional miss mask.
-  std::uint64_t per_texel = 12 + 1 + (o.padding > 0 ? 12 : 0) + (o.miss_mask ? 4 : 0);
+  std::uint64_t per_texel = 12 + 1 + (o.padding > 0 ? 12 : 0) + (o.miss_mask ? 4 : 0) + (o.suspect_mask ? 4 : 0) + (o.samples > 1 ? 1 : 0);
   return texels * per_texel;
 }
 
@@ -471,6 +530,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   // waits while another thread of the process is loading a shared library (glibc's loader lock; the
   // CLI loads its image module in the background, up to 0.2 s): in prepare's time, where it shows.
   std::exception_ptr output_error;
+  std::vector<std::uint8_t> disagree;  // per texel: its samples disagree (suspect), with several samples
   std::thread output_alloc([&] {
     try {
       const std::size_t texels = std::size_t(opt.width) * std::size_t(opt.height);
@@ -478,6 +538,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
       result.map.fault_in();
       result.coverage.assign(texels, 0);
       if (opt.miss_mask) result.miss_mask = Image(opt.width, opt.height, 1, 0.0f);
+      if (opt.samples > 1) disagree.assign(texels, 0);
     } catch (...) {
       output_error = std::current_exception();
     }
@@ -564,9 +625,9 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
       for (int c = 0; c < 3; ++c) {
         b.lo = glm::min(b.lo, low_tris[t].p[c]);
         b.hi = glm::max(b.hi, low_tris[t].p[c]);
-        if (!s.cage_corners.empty()) {
-          b.lo = glm::min(b.lo, s.cage_corners[3 * t + c]);
-          b.hi = glm::max(b.hi, s.cage_corners[3 * t + c]);
+        if (!s.cage_tris.empty()) {
+          b.lo = glm::min(b.lo, s.cage_tris[t].corner[c]);
+          b.hi = glm::max(b.hi, s.cage_tris[t].corner[c]);
         }
       }
       regions[t] = b;
@@ -667,13 +728,12 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     // Per-vertex distances (after the facing decision: the probes judge faces by it).
     const LocalDistances ld = measure_local_distances({&s.low_pos, &low.position_index, &s.ray_normal},
                                                       {&*scene, s.high_pos.data(), s.bvh_index, s.bvh_facing}, reach, floor_dist,
-                                                      global_front, global_rear, kCageSlope, threads);
+                                                      global_front, global_rear, kNeedSlope, kLimitSlope, threads);
     st.auto_distances = true;
     st.cage_front_limited = auto_cage ? ld.front_limited : 0;
     st.cage_rear_limited = ld.rear_limited;
     result.vertex_rear = ld.rear;
     result.vertex_search = ld.search;
-    attach_rear(s, low, ld.rear, ld.search);
     if (auto_cage) {
       // The cage: every vertex moved along its ray normal by its front distance, in the meshes'
       // own coordinates (float, as a cage file holds them), then re-centred like a file's.
@@ -691,6 +751,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     st.rear = float(st.vertex_rear.max);
   }
   st.cage = cage ? BakeStats::CageSource::file : auto_cage ? BakeStats::CageSource::automatic : BakeStats::CageSource::none;
+  if (any_cage) set_cage_reach(s, low, st.rear, result.vertex_rear, result.vertex_search);
   if (cage && st.front < 0.0f) st.front = 0.0f;
   st.seconds_distances = seconds_since(t0);
   if (opt.cull_far && probing) {
@@ -872,7 +933,16 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
       const std::size_t sample_count = compact_samples(slots, slot_count, tile_texels, default_rays, covered);
       // The other rays one at a time: other policies, and the special cases of the default one.
       const std::size_t ray_count = sample_count * std::size_t(rays_per_sample);
-      for (std::size_t r = 0; r < sample_count; ++r) {
+      if (any_cage && !closest) {
+        // Cage rays, straight into the arrays (sample_rays' own for them).
+        for (std::size_t r = 0; r < sample_count; ++r) {
+          const double b[3] = {sb[0][r], sb[1][r], sb[2][r]};
+          const std::size_t tri = std::size_t(sample_tri[r]);
+          rays.set(r, inward_ray(cage_ray(low_tris[tri], s.cage_tris[tri], b, ray_setup.diagonal), &signed_base[r], &prefer_lo[r]));
+          prefer_hi[r] = std::numeric_limits<float>::infinity();
+        }
+      }
+      for (std::size_t r = 0; r < sample_count && !(any_cage && !closest); ++r) {
         if (!sample_fallback[r]) continue;
         raycast::Ray one[2];
         const double b[3] = {sb[0][r], sb[1][r], sb[2][r]};
@@ -944,6 +1014,15 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
         for (int c = 0; c < 3; ++c) value_c[c][r] = v[c];
       }
       accumulate_samples(value_c, sample_texel.data(), sample_count, sums);
+      if (!disagree.empty())
+        for (int y = 0; y < th; ++y)
+          for (int x = 0; x < tw; ++x) {
+            const std::size_t i = std::size_t(y) * tile_side + std::size_t(x);
+            const double n = sums.count[i];
+            const double len2 = sums.sum[0][i] * sums.sum[0][i] + sums.sum[1][i] * sums.sum[1][i] + sums.sum[2][i] * sums.sum[2][i];
+            if (n > 1.0 && len2 < kSuspectAgreement * kSuspectAgreement * n * n)
+              disagree[std::size_t(ty0 + y) * W + std::size_t(tx0 + x)] = 1;
+          }
       // Texels: renormalized mean of their covered samples.
       const bool flip_y = opt.space == NormalSpace::tangent && opt.green_down;
       for (int y = 0; y < th; ++y) {
@@ -1027,6 +1106,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
       for (int c = 0; c < 3; ++c) result.map.pixels[3 * i + c] = flat[c];
   if (opt.space == NormalSpace::tangent)
     for (std::size_t i = 0; i < result.coverage.size(); ++i) st.texels_facing_away += result.coverage[i] && result.map.pixels[3 * i + 2] < 0.5f;
+  find_suspects(opt, disagree, result);
   st.texels_padded = pad_islands(result.map, result.coverage, opt.padding, threads);
   st.seconds_padding = seconds_since(t0);
   return result;
@@ -1050,7 +1130,7 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
     cage = &auto_mesh;
   }
   Prepared s = prepare(low, high, cage, scratch);
-  if (!baked.vertex_rear.empty()) attach_rear(s, low, baked.vertex_rear, baked.vertex_search);
+  if (cage) set_cage_reach(s, low, st.rear, baked.vertex_rear, baked.vertex_search);
   if (st.high_facing == BakeStats::HighFacing::inverted) turn_inverted_high(s, scratch.high_normals_computed);
   // Few rays: a quick BVH build pays off more than a fast one to trace. All triangles: culling
   // leaves the hits unchanged.

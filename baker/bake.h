@@ -35,6 +35,12 @@ constexpr double kCoordinateSpacingWarn = 1e-3;  // BakeStats::coordinate_spacin
 // BakeStats::backface_probe_share above which the high-poly is taken as inverted, and above which
 // (up to the first) as partly inverted, when back faces are kept.
 constexpr double kInvertedShare = 0.5;
+// Suspect texels (BakeStats::suspect_texels): the tilt from the low-poly normal above which, and
+// the length of the mean of a texel's unit sample values below which, a texel is suspect; the
+// share of covered texels above which nmbake warns.
+constexpr double kSuspectTiltDeg = 85.0;
+constexpr double kSuspectAgreement = 0.8;
+constexpr double kSuspectShareWarn = 0.005;
 constexpr double kMixedShare = 0.2;
 
 struct BakeOptions {
@@ -50,6 +56,7 @@ struct BakeOptions {
   int padding = 16;     // texels of edge padding around islands; 0 = none
   int threads = 0;      // worker threads; 0 = all cores
   bool miss_mask = false;  // fill BakeResult::miss_mask (share of missed samples per texel)
+  bool suspect_mask = false;  // fill BakeResult::suspect_mask (1 for suspect texels, BakeStats::suspect_texels)
   // Leave high-poly triangles out of the BVH when they lie farther from the low-poly (and cage)
   // than any ray reaches (cull.h). The map is the same either way; off only for comparison.
   bool cull_far = true;
@@ -119,6 +126,15 @@ struct BakeStats {
   // Welded vertices whose measured front or rear need was cut by the limit (half the distance to
   // the next part of the low-poly along the normal).
   std::size_t cage_front_limited = 0, cage_rear_limited = 0;
+  // Suspect texels: covered texels whose tangent-space normal tilts more than 85 degrees from the
+  // low-poly normal (z below cos 85 degrees: black patches where a ray took another part), or whose
+  // samples disagree strongly (their mean is shorter than kSuspectAgreement: one texel, two
+  // surfaces). suspect_share = suspect_texels / texels_covered. suspect_region: the cell of an 8 x 8
+  // grid over the UV square holding most of them (u0, v0, u1, v1), and the share of them it holds.
+  std::size_t suspect_texels = 0;
+  double suspect_share = 0.0;
+  double suspect_region[4] = {0, 0, 0, 0};
+  double suspect_region_share = 0.0;
   // Samples whose hit has a normal pointing away from the low-poly's outside (no other hit was found).
   std::uint64_t hits_facing_away = 0;
   // Seconds per stage.
@@ -133,6 +149,7 @@ struct BakeStats {
 struct BakeResult {
   Image map;                          // RGB, encoded c = n * 0.5 + 0.5
   Image miss_mask;                    // 1 channel, share of missed samples (only with options.miss_mask)
+  Image suspect_mask;                 // 1 channel, 1 for suspect texels, else 0 (only with options.suspect_mask)
   std::vector<std::uint8_t> coverage;  // per texel: 1 = covered by the UV layout
   BakeStats stats;
   // The automatic cage (BakeStats::CageSource::automatic): per low-poly position, object space as

@@ -42,7 +42,7 @@ const char* kExitCodes =
     "  130 interrupted (no output written)\n";
 
 struct Args {
-  std::string low, high, output, cage, miss_mask, report, save_cage;
+  std::string low, high, output, cage, miss_mask, report, save_cage, suspect_mask;
   std::string size = "2048";
   int samples = 1;
   double front = -1.0, rear = -1.0;
@@ -148,6 +148,9 @@ int run(int argc, char** argv) {
   app.add_option("--bits", a.bits, "8, 16 or 32 (float); default from the extension")->check(CLI::IsMember({8, 16, 32}));
   app.add_option("--padding", a.padding, "Edge padding around UV islands in texels (default 16)");
   app.add_option("--miss-mask", a.miss_mask, "Write an image of the share of missed rays per texel");
+  app.add_option("--suspect-mask", a.suspect_mask,
+                 "Write an image of the suspect texels (1: normal tilted over 85 degrees from the low-poly's, or samples "
+                 "disagreeing; suspect_texels in the report)");
   app.add_option("--report", a.report, "Write a JSON report of options, timings and counts");
   app.add_option("--threads", a.threads, "Worker threads (default: all cores)");
   app.add_flag("--no-cull", a.no_cull,
@@ -196,6 +199,7 @@ int run(int argc, char** argv) {
   o.padding = a.padding;
   o.threads = a.threads;
   o.miss_mask = !a.miss_mask.empty();
+  o.suspect_mask = !a.suspect_mask.empty();
   o.cull_far = !a.no_cull;
   o.keep_backfaces = a.keep_backfaces;
   const int bits = a.bits ? a.bits : default_bits_for(a.output);
@@ -205,7 +209,7 @@ int run(int argc, char** argv) {
     std::string ext = std::filesystem::path(a.save_cage).extension().string();
     for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
     if (ext != ".obj") throw UsageError("--save-cage " + a.save_cage + ": the cage is written as OBJ (.obj)");
-    for (const std::string* in : {&a.low, &a.high, &a.output, &a.report, &a.miss_mask})
+    for (const std::string* in : {&a.low, &a.high, &a.output, &a.report, &a.miss_mask, &a.suspect_mask})
       if (!in->empty() && same_file(*in, a.save_cage))
         throw UsageError("--save-cage " + a.save_cage + " is the same file as " + *in + "; nothing written");
     check_output_path(a.save_cage, "the cage");
@@ -216,6 +220,10 @@ int run(int argc, char** argv) {
   check_output_format(a.output, bits);
   if (const std::string problem = image_io_problem(); !problem.empty()) throw OutputError(a.output + ": " + problem);
   if (!a.miss_mask.empty()) check_output_format(a.miss_mask, default_bits_for(a.miss_mask));
+  if (!a.suspect_mask.empty()) {
+    check_output_path(a.suspect_mask, "the suspect mask");
+    check_output_format(a.suspect_mask, default_bits_for(a.suspect_mask));
+  }
 
   std::signal(SIGINT, on_sigint);
   const bool tty = !a.quiet && ::isatty(STDERR_FILENO);
@@ -227,6 +235,7 @@ int run(int argc, char** argv) {
   run.cage_path = a.cage;
   run.output_path = a.output;
   run.miss_mask_path = a.miss_mask;
+  run.suspect_mask_path = a.suspect_mask;
   run.bits = bits;
   auto t0 = Clock::now();
   LoadOptions low_opts;
@@ -291,6 +300,11 @@ int run(int argc, char** argv) {
     WriteOptions mo;
     mo.bits = default_bits_for(a.miss_mask);
     write_image(a.miss_mask, r.miss_mask, mo);
+  }
+  if (!a.suspect_mask.empty()) {
+    WriteOptions mo;
+    mo.bits = default_bits_for(a.suspect_mask);
+    write_image(a.suspect_mask, r.suspect_mask, mo);
   }
   if (!a.save_cage.empty()) {
     Mesh cage_mesh;

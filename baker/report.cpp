@@ -30,6 +30,7 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
       {"cage", r.cage_path.empty() ? json(nullptr) : json(r.cage_path)},
       {"output", r.output_path},
       {"miss_mask", r.miss_mask_path.empty() ? json(nullptr) : json(r.miss_mask_path)},
+      {"suspect_mask", r.suspect_mask_path.empty() ? json(nullptr) : json(r.suspect_mask_path)},
       {"size", {o.width, o.height}},
       {"samples", o.samples},
       {"front", s.front},
@@ -94,6 +95,12 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
                       : s.high_facing == BakeStats::HighFacing::mixed  ? "mixed"
                                                                        : "sound"},
       {"hits_facing_away", s.hits_facing_away},
+      {"suspect_texels", s.suspect_texels},
+      {"suspect_share", s.suspect_share},
+      {"suspect_region",
+       {{"u", {s.suspect_region[0], s.suspect_region[2]}},
+        {"v", {s.suspect_region[1], s.suspect_region[3]}},
+        {"share", s.suspect_region_share}}},
       {"cage",
        {{"source", s.cage == BakeStats::CageSource::automatic ? "automatic"
                    : s.cage == BakeStats::CageSource::file    ? "file"

@@ -13,7 +13,7 @@
 namespace nmbake {
 
 struct RunInfo {
-  std::string low_path, high_path, cage_path, output_path, miss_mask_path;
+  std::string low_path, high_path, cage_path, output_path, miss_mask_path, suspect_mask_path;
   int bits = 8;
   MeshLoadInfo low_info, high_info, cage_info;
   MeshTopology high_topology;  // inspect_topology(high)

@@ -47,6 +47,11 @@ std::vector<std::string> bake_warnings(const BakeStats& s, const MeshTopology& t
     out.push_back(format("warning: %s: some of its parts look inverted (%.0f%% of the surfaces nearest the low-poly face into it): "
                          "back faces are kept for this bake, as with --keep-backfaces",
                          high.c_str(), 100.0 * s.backface_probe_share));
+  if (s.suspect_share > kSuspectShareWarn)
+    out.push_back(format("warning: %.2f%% of covered texels are suspect (normal tilted over %.0f degrees from the low-poly's, or "
+                         "samples disagreeing), %.0f%% of them in UV u %.3g-%.3g, v %.3g-%.3g; see --suspect-mask",
+                         100.0 * s.suspect_share, kSuspectTiltDeg, 100.0 * s.suspect_region_share, s.suspect_region[0],
+                         s.suspect_region[2], s.suspect_region[1], s.suspect_region[3]));
   if (s.coordinate_spacing > kCoordinateSpacingWarn)
     out.push_back(format("warning: coordinates reach %.3g, far from the origin for a scene this size: float precision there is "
                          "%.2g of the scene diagonal (above %.0e the map degrades measurably); move the meshes near the origin",

@@ -32,6 +32,11 @@ void check_device(RTCDevice device) {
                                         std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
 }
 
+// Hits on faces within 26 degrees of the outside (cos^2 = 0.81) skip the vertex-normal test (on
+// the Suzanne sculpts at 1024^2: 76 texels facing away against 65 with every hit tested, 278 with
+// the test from 60 degrees on).
+constexpr float kNormalTestCos2 = 0.81f;
+
 // The context a call under a HitRule hands Embree: its filter finds the rule and the per-ray
 // state of the packet being traced here. A ray's id is its lane in the packet.
 struct RuleContext {
@@ -91,7 +96,11 @@ struct RuleContext {
         continue;
       }
       const float u = RTCHitN_u(args->hit, n, i), v = RTCHitN_v(args->hit, n, i);
-      if (rule.corner_normals) {
+      // Near the outside, the face's vertex normals point out too: their test is for grazing hits
+      // and for faces whose vertex normals lean far from the face (sculpted creases), and reading
+      // them here costs a cache miss per hit.
+      const bool grazing = front < 0.0f || front * front < kNormalTestCos2 * glm::dot(ng, ng) * glm::dot(out, out);
+      if (rule.corner_normals && grazing) {
         const glm::vec3* c = rule.corner_normals + 3 * std::size_t(prim);
         const glm::vec3 nh = (1.0f - u - v) * c[0] + u * c[1] + v * c[2];
         if (!(glm::dot(nh, out) > 0.0f)) {

@@ -1,4 +1,5 @@
 // Embree against the brute-force reference intersector on fixed-seed random rays.
+#include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -110,12 +111,13 @@ TEST(Raycast, RespectsTnearAndTfar) {
 // ---- Hit rules (back faces, normals that point away) ----
 namespace {
 
-// Two unit quads at z = 0 and z = 1 over [-1,1]^2; `flip_top` winds the upper one clockwise seen
-// from +z (its geometric normal points down).
-Mesh two_planes(bool flip_top) {
+// Two quads at z = 0 and z = 1 over [-half_x, half_x] x [-1, 1]; `flip_top` winds the upper one
+// clockwise seen from +z (its geometric normal points down).
+Mesh two_planes(bool flip_top, float half_x = 1.0f) {
   Mesh m;
   for (float z : {0.0f, 1.0f})
-    for (glm::vec2 xy : {glm::vec2(-1, -1), glm::vec2(1, -1), glm::vec2(1, 1), glm::vec2(-1, 1)}) m.positions.push_back({xy, z});
+    for (glm::vec2 xy : {glm::vec2(-half_x, -1), glm::vec2(half_x, -1), glm::vec2(half_x, 1), glm::vec2(-half_x, 1)})
+      m.positions.push_back({xy, z});
   m.position_index = {0, 1, 2, 0, 2, 3};
   if (flip_top)
     m.position_index.insert(m.position_index.end(), {4, 6, 5, 4, 7, 6});
@@ -201,24 +203,67 @@ TEST(RaycastRule, OutwardRaysJudgeFacesByTheOutside) {
 }
 
 TEST(RaycastRule, NormalPointingAwayIsTakenOnlyWithoutAnother) {
-  const Mesh m = two_planes(false);
+  // A grazing ray (63 degrees from the planes' normal: the vertex normals are tested only beyond
+  // 60 degrees, where a face's vertex normals can point away while its front faces the ray).
+  const Mesh m = two_planes(false, 3.0f);
   raycast::Scene scene(&m.positions[0].x, m.positions.size(), m.position_index.data(), m.triangle_count());
-  const raycast::Ray down{{0.3f, 0.2f, 2.0f}, 0.0f, {0, 0, -1}, 10.0f};
+  const raycast::Ray down{{-1.0f, 0.2f, 1.05f}, 0.0f, glm::normalize(glm::vec3(2, 0, -1)), 10.0f};
+  const float t_top = 0.05f * std::sqrt(5.0f), t_bottom = 1.05f * std::sqrt(5.0f);
   // The top plane's normals point down (away from the outside), the bottom's up.
   std::vector<glm::vec3> normals(12, glm::vec3(0, 0, 1));
   for (int c = 6; c < 12; ++c) normals[c] = {0.2f, 0.0f, -1.0f};
   raycast::HitRule rule;
   rule.corner_normals = normals.data();
   RuleCase r = trace(scene, down, rule, false);
-  EXPECT_NEAR(r.hit.t, 2.0f, 1e-6f);
+  EXPECT_NEAR(r.hit.t, t_bottom, 1e-5f);
   EXPECT_EQ(r.flags, 0);
   // With both pointing away, the nearer of them, flagged.
   for (int c = 0; c < 6; ++c) normals[c] = {0.0f, 0.0f, -1.0f};
   r = trace(scene, down, rule, false);
   ASSERT_TRUE(r.hit.hit());
-  EXPECT_NEAR(r.hit.t, 1.0f, 1e-6f);
+  EXPECT_NEAR(r.hit.t, t_top, 1e-5f);
   EXPECT_GE(r.hit.triangle, 2u);
   EXPECT_EQ(r.flags, raycast::hit_normal_disagrees);
+  // A ray straight down meets the top plane head on: taken without its normals being read.
+  const raycast::Ray straight{{0.3f, 0.2f, 2.0f}, 0.0f, {0, 0, -1}, 10.0f};
+  r = trace(scene, straight, rule, false);
+  EXPECT_NEAR(r.hit.t, 1.0f, 1e-6f);
+  EXPECT_EQ(r.flags, 0);
+}
+
+TEST(RaycastRule, HitsOutsideThePreferredPartWaitForOneInside) {
+  const Mesh m = two_planes(false);
+  raycast::Scene scene(&m.positions[0].x, m.positions.size(), m.position_index.data(), m.triangle_count());
+  const raycast::HitRule rule;
+  const raycast::Ray down{{0.3f, 0.2f, 2.0f}, 0.0f, {0, 0, -1}, 10.0f};
+  std::uint8_t flags = 0;
+  // The top plane (t = 1) lies before the preferred part [1.5, inf): the bottom (t = 2) is taken.
+  raycast::Hit h = scene.intersect(down, rule, false, &flags, 1.5f);
+  EXPECT_NEAR(h.t, 2.0f, 1e-6f);
+  EXPECT_EQ(flags, 0);
+  // With only the top plane in reach, it is taken after all, flagged.
+  raycast::Ray short_ray = down;
+  short_ray.tfar = 1.8f;
+  h = scene.intersect(short_ray, rule, false, &flags, 1.5f);
+  EXPECT_NEAR(h.t, 1.0f, 1e-6f);
+  EXPECT_EQ(flags, raycast::hit_outside_preferred);
+  // Both outside [0, 0.5]: the nearer to it.
+  h = scene.intersect(down, rule, false, &flags, 0.0f, 0.5f);
+  EXPECT_NEAR(h.t, 1.0f, 1e-6f);
+  EXPECT_EQ(flags, raycast::hit_outside_preferred);
+  // And in a packet, per ray.
+  std::vector<raycast::Ray> rays(3, down);
+  raycast::RayArrays arrays(rays.data(), rays.size());
+  const std::vector<float> lo = {1.5f, 0.0f, 0.0f}, hi = {1e30f, 0.5f, 1e30f};
+  raycast::RayBatch batch = arrays.rays();
+  batch.prefer_lo = lo.data();
+  batch.prefer_hi = hi.data();
+  scene.intersect(batch, arrays.hits(), arrays.size(), &rule);
+  EXPECT_NEAR(arrays.hit(0).t, 2.0f, 1e-6f);
+  EXPECT_NEAR(arrays.hit(1).t, 1.0f, 1e-6f);
+  EXPECT_EQ(arrays.flags(1), raycast::hit_outside_preferred);
+  EXPECT_NEAR(arrays.hit(2).t, 1.0f, 1e-6f);
+  EXPECT_EQ(arrays.flags(2), 0);
 }
 
 TEST(RaycastRule, MatchesBruteForceOnClosedTorus) {

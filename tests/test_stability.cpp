@@ -7,13 +7,9 @@
 
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
-#include <fstream>
 #include <functional>
-#include <sstream>
 
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include "bake.h"
 #include "image_io.h"
@@ -25,7 +21,10 @@
 
 using namespace nmbake;
 using test::angle_deg;
+using test::CliRun;
+using test::contains;
 using test::decode_rgb;
+using test::run_nmbake;
 
 namespace {
 
@@ -89,34 +88,8 @@ double max_texel_angle(const BakeResult& a, const BakeResult& b, double* mean = 
   return worst;
 }
 
-// Runs the nmbake binary in a scratch folder: exit code, stdout, stderr, and the --report JSON
-// when one was asked for (args may use LOW/HIGH-style absolute paths built with data()).
-struct CliRun {
-  int code = -1;
-  std::string out, err, dir;
-  nlohmann::json report;
-};
+// Absolute path of a case in data/stability, for run_nmbake's command lines.
 std::string data(const std::string& name) { return test::data_path("stability/" + name); }
-CliRun run_nmbake(const std::string& args, const std::string& prefix = "") {
-  CliRun r;
-  r.dir = test::scratch_dir();
-  const std::string exe = std::string(NMBAKE_BINARY_DIR) + "/baker/nmbake";
-  const std::string cmd = "cd '" + r.dir + "' && " + prefix + " '" + exe + "' " + args + " >out.txt 2>err.txt";
-  const int status = std::system(("bash -c \"" + cmd + "\"").c_str());
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  auto slurp = [](const std::string& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-  };
-  r.out = slurp(r.dir + "/out.txt");
-  r.err = slurp(r.dir + "/err.txt");
-  if (test::exists(r.dir + "/r.json")) r.report = nlohmann::json::parse(slurp(r.dir + "/r.json"));
-  std::printf("$ nmbake %s\n-> exit %d\n%s%s", args.c_str(), r.code, r.out.c_str(), r.err.c_str());
-  return r;
-}
-bool contains(const std::string& s, const std::string& what) { return s.find(what) != std::string::npos; }
 
 }  // namespace
 

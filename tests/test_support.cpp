@@ -1,7 +1,13 @@
 #include "test_support.h"
 
+#include <sys/wait.h>
+
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
 #include <gtest/gtest.h>
 
@@ -28,6 +34,29 @@ std::string scratch_dir() {
   std::filesystem::create_directories(dir);
   return dir.string();
 }
+
+CliRun run_nmbake(const std::string& args, const std::string& prefix, const std::string& dir) {
+  CliRun r;
+  r.dir = dir.empty() ? scratch_dir() : dir;
+  std::filesystem::remove(r.dir + "/r.json");
+  const std::string exe = std::string(NMBAKE_BINARY_DIR) + "/baker/nmbake";
+  const std::string cmd = "cd '" + r.dir + "' && " + prefix + " '" + exe + "' " + args + " >out.txt 2>err.txt";
+  const int status = std::system(("bash -c \"" + cmd + "\"").c_str());
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  auto slurp = [](const std::string& p) {
+    std::ifstream in(p);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  };
+  r.out = slurp(r.dir + "/out.txt");
+  r.err = slurp(r.dir + "/err.txt");
+  if (exists(r.dir + "/r.json")) r.report = nlohmann::json::parse(slurp(r.dir + "/r.json"));
+  std::printf("$ nmbake %s\n-> exit %d\n%s%s", args.c_str(), r.code, r.out.c_str(), r.err.c_str());
+  return r;
+}
+
+bool contains(const std::string& s, const std::string& what) { return s.find(what) != std::string::npos; }
 
 Mesh make_grid(int nx, int ny, float x0, float x1, float y0, float y1) {
   Mesh m;

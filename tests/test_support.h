@@ -1,4 +1,5 @@
-// Helpers shared by the test programs: data paths, scratch folders, procedural meshes.
+// Helpers shared by the test programs: data paths, scratch folders, procedural meshes, running the
+// nmbake binary.
 #pragma once
 
 #include <cstddef>
@@ -6,6 +7,7 @@
 #include <string>
 
 #include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
 
 #include "image.h"
 
@@ -19,6 +21,23 @@ bool exists(const std::string& path);
 
 // A fresh empty folder under the build tree, named after the running test.
 std::string scratch_dir();
+
+// One run of the nmbake binary: its exit code (-1 when it did not exit normally), stdout, stderr,
+// the folder it ran in, and the report it wrote to r.json there (null when it wrote none).
+struct CliRun {
+  int code = -1;
+  std::string out, err, dir;
+  nlohmann::json report;
+};
+
+// Runs <build>/baker/nmbake with `args` (shell words; relative paths are relative to the folder)
+// in `dir`, or in a fresh scratch_dir() when `dir` is empty, after the shell command `prefix`
+// (e.g. "ulimit -v 3000000 &&"). stdout and stderr go to out.txt and err.txt in the folder; an
+// r.json left there by an earlier run is removed first. Prints the command and what it printed.
+CliRun run_nmbake(const std::string& args, const std::string& prefix = "", const std::string& dir = "");
+
+// Whether `what` occurs in `s`.
+bool contains(const std::string& s, const std::string& what);
 
 // A planar grid of nx x ny quads (two triangles each) covering [x0,x1] x [y0,y1] at z = 0,
 // normals +Z, UVs mapping the grid onto [0,1]^2 (u along x, v along y).
