@@ -134,13 +134,20 @@ int run(int argc, char** argv) {
   app.add_option("-o,--output", a.output, "Output map: .png (8-bit), .tif (16-bit), .exr (float)")->required();
   app.add_option("--size", a.size, "Map size N or WxH in texels (default 2048)");
   app.add_option("--samples", a.samples, "Sample points per texel, 1-1024 (default 1)");
-  app.add_option("--front", a.front, "Ray start distance outside the low-poly, scene units (default: measured)");
-  app.add_option("--rear", a.rear, "Ray reach inside the low-poly, scene units (default: measured)");
-  app.add_option("--cage", a.cage, "Cage mesh with the low-poly's topology: rays go from cage to low-poly");
+  app.add_option("--front", a.front,
+                 "One ray start distance outside the low-poly for the whole scene, scene units (default: the automatic cage, "
+                 "measured per vertex)");
+  app.add_option("--rear", a.rear, "One ray reach inside the low-poly for the whole scene, scene units (default: measured per vertex)");
+  app.add_option("--cage", a.cage,
+                 "Cage mesh with the low-poly's topology: rays go from cage to low-poly and on by --rear (default: measured per "
+                 "vertex)");
   app.add_option("--save-cage", a.save_cage,
                  "Write the automatic cage (made when --cage, --front and --rear are absent) as OBJ with the low-poly's "
                  "topology and UVs; baking with --cage that file gives the same map");
-  app.add_option("--policy", a.policy, "cage-first (default) or closest")->check(CLI::IsMember({"cage-first", "closest"}));
+  app.add_option("--policy", a.policy,
+                 "cage-first (default: the first hit from the cage) or closest (the hit nearest the low-poly either way); "
+                 "back faces are skipped in both")
+      ->check(CLI::IsMember({"cage-first", "closest"}));
   app.add_option("--space", a.space, "tangent (default) or object")->check(CLI::IsMember({"tangent", "object"}));
   app.add_option("--green", a.green, "up = OpenGL/Blender/glTF (default), down = DirectX/Unreal")->check(CLI::IsMember({"up", "down"}));
   app.add_option("--bitangent", a.bitangent, "pixel = B from interpolated N,T (MikkTSpace, default); vertex = interpolated B")

@@ -3,6 +3,7 @@
 // high-poly with flipped winding. Each baked texel is compared with the exact normal of the
 // analytic surface its ray should land on (the part the texel's low-poly triangle belongs to).
 #include <cmath>
+#include <fstream>
 #include <map>
 
 #include <gtest/gtest.h>
@@ -263,4 +264,26 @@ TEST(RobustHits, SculptsHaveAlmostNoTexelFacingAway) {
     ++baked;
   }
   if (!baked) GTEST_SKIP() << "../shared/data/sculpts not found";
+}
+
+TEST(RobustHits, SuspectTexelsAreWarnedAboutAndWrittenByTheCli) {
+  const HardAsset a = procedural::make_close_tubes(0.012, 0.04, 24, 8, 96, 48);
+  const std::string dir = test::scratch_dir();
+  for (const auto& [name, mesh] : {std::pair{"low.obj", &a.low}, std::pair{"high.obj", &a.high}}) {
+    std::ofstream(dir + "/" + name) << obj_text(*mesh, a.name);
+  }
+  const std::string files = "low.obj high.obj -o map.png --size 128 --report r.json --suspect-mask s.png";
+  test::CliRun bad = test::run_nmbake(files + " --keep-backfaces --front 0.06 --rear 0.06", "", dir);
+  ASSERT_EQ(bad.code, 0) << bad.err;
+  EXPECT_GT(bad.report["suspect_share"].get<double>(), kSuspectShareWarn);
+  EXPECT_TRUE(test::contains(bad.err, "of covered texels are suspect (normal tilted over 85 degrees from the low-poly's, or samples "
+                                      "disagreeing)"))
+      << bad.err;
+  EXPECT_TRUE(test::exists(dir + "/s.png"));
+  EXPECT_EQ(bad.report["options"]["suspect_mask"], "s.png");
+  test::CliRun good = test::run_nmbake(files, "", dir);
+  ASSERT_EQ(good.code, 0) << good.err;
+  EXPECT_LT(good.report["suspect_share"].get<double>(), kSuspectShareWarn);
+  EXPECT_FALSE(test::contains(good.err, "are suspect")) << good.err;
+  EXPECT_EQ(good.report["cage"]["source"], "automatic");
 }
