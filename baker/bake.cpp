@@ -763,8 +763,12 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
       for (std::size_t t = 0; t < all.size(); ++t) all[t] = std::uint32_t(t);
     }
     const std::vector<std::uint32_t>& current = kept.empty() ? all : kept;
-    std::vector<std::uint32_t> nearer =
-        triangles_near(regions, ray_margin(st.front, st.rear), s.high_pos, high.position_index, &current);
+    // Rays from a cage reach the rear distance beyond P and, where they search beyond the cage,
+    // as far out as they search.
+    double reach_out = 0.0;
+    for (float d : result.vertex_search) reach_out = std::max(reach_out, double(d));
+    std::vector<std::uint32_t> nearer = triangles_near(regions, ray_margin(st.front, std::max<double>(st.rear, reach_out)), s.high_pos,
+                                                       high.position_index, &current);
     if (double(nearer.size()) < 0.8 * double(current.size())) {
       kept = std::move(nearer);
       build_scene();

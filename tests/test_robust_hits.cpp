@@ -287,3 +287,27 @@ TEST(RobustHits, SuspectTexelsAreWarnedAboutAndWrittenByTheCli) {
   EXPECT_FALSE(test::contains(good.err, "are suspect")) << good.err;
   EXPECT_EQ(good.report["cage"]["source"], "automatic");
 }
+
+TEST(RobustHits, CullingLeavesTheAutomaticCagesMapUnchanged) {
+  // Rays search beyond a cage limited by a neighbouring tube as far out as the bulge: the BVH
+  // must keep what they reach there.
+  // A copy of the high-poly 0.1 beyond the tubes' ends, within the probes' reach but not the
+  // rays': the BVH is rebuilt without it, and must not lose the bulge on the way.
+  const HardAsset a = procedural::make_close_tubes(0.012, 0.14, 24, 8, 96, 48);
+  Mesh high = a.high;
+  const std::uint32_t np = std::uint32_t(high.positions.size()), nn = std::uint32_t(high.normals.size());
+  for (const glm::vec3& p : a.high.positions) high.positions.push_back(p + glm::vec3(0.0f, 0.0f, 0.7f));
+  high.normals.insert(high.normals.end(), a.high.normals.begin(), a.high.normals.end());
+  for (std::uint32_t i : a.high.position_index) high.position_index.push_back(i + np);
+  for (std::uint32_t i : a.high.normal_index) high.normal_index.push_back(i + nn);
+  high.source_face.assign(high.triangle_count(), 0);
+  BakeOptions o = options(128);
+  const BakeResult on = bake_normal_map(a.low, high, nullptr, o);
+  o.cull_far = false;
+  const BakeResult off = bake_normal_map(a.low, high, nullptr, o);
+  std::printf("measured: culled %zu of %zu\n", on.stats.high_triangles_culled, high.triangle_count());
+  EXPECT_GT(on.stats.high_triangles_culled, a.high.triangle_count() / 2);
+  EXPECT_TRUE(on.map.pixels == off.map.pixels);
+  EXPECT_EQ(on.stats.hits, off.stats.hits);
+  EXPECT_GT(on.stats.cage_front_limited, 0u);
+}
