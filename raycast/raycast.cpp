@@ -45,6 +45,10 @@ struct RuleContext {
   std::uint8_t outward[8] = {};
   float prefer_lo[8], prefer_hi[8];  // the preferred part of each ray
   float backface_t[8];               // nearest back face passed over
+  // The hit accepted so far: of hits at one distance (a ray through an edge), the lower triangle
+  // index is kept, whichever Embree met first, so the hit does not depend on the BVH's shape.
+  float accepted_t[8];
+  std::uint32_t accepted_prim[8];
   // Hits kept for want of a better one: [0] the front-face hit outside the preferred part nearest
   // to it (key: that distance), [1] the first hit whose normal disagrees (key: t).
   struct Kept {
@@ -60,6 +64,8 @@ struct RuleContext {
     constexpr float inf = std::numeric_limits<float>::infinity();
     for (int k = 0; k < 8; ++k) {
       backface_t[k] = inf;
+      accepted_t[k] = inf;
+      accepted_prim[k] = no_hit;
       prefer_lo[k] = 0.0f;
       prefer_hi[k] = inf;
       for (auto& kk : kept) kk[k] = {inf, 0.0f, 0.0f, 0.0f, no_hit};
@@ -112,7 +118,14 @@ struct RuleContext {
       if (t < rc.prefer_lo[lane] || t > rc.prefer_hi[lane]) {
         keep(rc.kept[0][lane], t < rc.prefer_lo[lane] ? rc.prefer_lo[lane] - t : t - rc.prefer_hi[lane], t, u, v, prim);
         args->valid[i] = 0;
+        continue;
       }
+      if (t == rc.accepted_t[lane] && prim > rc.accepted_prim[lane]) {
+        args->valid[i] = 0;
+        continue;
+      }
+      rc.accepted_t[lane] = t;
+      rc.accepted_prim[lane] = prim;
     }
   }
 
