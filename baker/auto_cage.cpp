@@ -1,14 +1,13 @@
 #include "auto_cage.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <limits>
 #include <queue>
-#include <thread>
 #include <utility>
 
 #include "mesh_topology.h"
+#include "parallel.h"
 
 namespace nmbake {
 
@@ -28,18 +27,6 @@ glm::dvec3 unit_or_face(const glm::dvec3& n, const glm::dvec3& p0, const glm::dv
   const glm::dvec3 f = glm::cross(p1 - p0, p2 - p0);
   const double fl = glm::length(f);
   return fl > 0.0 ? f / fl : glm::dvec3(0, 0, 1);
-}
-
-template <typename Fn>
-void parallel_chunks(int threads, std::size_t count, std::size_t chunk, Fn&& fn) {
-  std::atomic<std::size_t> next{0};
-  auto work = [&] {
-    for (std::size_t i; (i = next.fetch_add(chunk)) < count;) fn(i, std::min(count, i + chunk));
-  };
-  std::vector<std::thread> pool;
-  for (int i = 1; i < threads; ++i) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
 }
 
 // Over the edges (a, b, length): raises values so that none is more than `length` below a

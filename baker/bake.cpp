@@ -123,9 +123,10 @@ std::vector<glm::vec3> position_averaged_normals(const Mesh& low, const TangentF
   return out;
 }
 
-// Ray normals: one per position, the normalized mean of the distinct normals its corners use, so
-// split normals (hard edges) open no gaps between the rays of neighbouring faces. Positions are
-// welded by value first: glTF-style files split hard edges into separate vertices.
+// Ray normals: one per position, the normalized mean of its corners' normals (a normal shared by
+// more corners weighs more), so split normals (hard edges) open no gaps between the rays of
+// neighbouring faces. Positions are welded by value first: glTF-style files split hard edges into
+// separate vertices.
 std::vector<glm::vec3> position_averaged_normals(const Mesh& low, const TangentFrames& frames) {
   std::size_t np = 0;
   const std::vector<std::uint32_t> weld = weld_positions(low.positions, &np);
@@ -300,6 +301,14 @@ Prepared prepare(const Mesh& low, const Mesh& high, const Mesh* cage, BakeStats&
   return s;
 }
 
+// The facing array for a HitRule, or null when every triangle faces the way its winding does
+// (the usual case): the filter then reads no byte per hit for it.
+const std::int8_t* facing_if_needed(const std::int8_t* facing, std::size_t triangles) {
+  for (std::size_t t = 0; t < triangles; ++t)
+    if (facing[t] != 1) return facing;
+  return nullptr;
+}
+
 // The high-poly found inverted (BakeStats::HighFacing): fronts are taken the other way round, and
 // normals nmbake computed itself are turned outwards with them (a file's normals are kept: the map
 // then is what it was without the rule). Applies to the BVH's copies too.
@@ -451,6 +460,8 @@ glm::dvec3 shade_sample(const Prepared& s, std::size_t tri, const double b[3], c
 }
 
 }  // namespace
+
+std::vector<glm::vec3> low_ray_normals(const Mesh& low) { return position_averaged_normals(low, compute_tangent_frames(low)); }
 
 std::vector<glm::dvec2> sample_offsets(int samples) {
   std::vector<glm::dvec2> out;
@@ -712,6 +723,8 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
       // Cover all but the farthest 0.1% of probes, with a 25% margin and a floor for coincident meshes.
       global_front = 1.25 * quantile(outside, 0.999) + floor_dist;
       global_rear = 1.25 * quantile(inside, 0.999) + floor_dist;
+      st.scene_front = global_front;
+      st.scene_rear = global_rear;
     }
     if (auto_distances) {
       const double front = global_front, rear = global_rear;
@@ -840,7 +853,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
 
   // The hit rule (raycast::HitRule), over the BVH's triangles as finally built.
   raycast::HitRule rule;
-  rule.facing = s.bvh_facing;
+  rule.facing = facing_if_needed(s.bvh_facing, st.high_triangles - st.high_triangles_culled);
   rule.corner_normals = s.bvh_normals;
   const raycast::HitRule* const hit_rule = st.backfaces_skipped ? &rule : nullptr;
 
@@ -1141,7 +1154,7 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
   raycast::Scene scene(&s.high_pos[0].x, s.high_pos.size(), high.position_index.data(), high.triangle_count(),
                        raycast::BuildQuality::low, opt.threads);
   raycast::HitRule rule;
-  rule.facing = s.high_facing.data();
+  rule.facing = facing_if_needed(s.high_facing.data(), s.high_facing.size());
   rule.corner_normals = s.high_corner_normals.data();
   const raycast::HitRule* const hit_rule = st.backfaces_skipped ? &rule : nullptr;
   RaySetup ray_setup;

@@ -126,6 +126,9 @@ struct BakeStats {
   // Welded vertices whose measured front or rear need was cut by the limit (half the distance to
   // the next part of the low-poly along the normal).
   std::size_t cage_front_limited = 0, cage_rear_limited = 0;
+  // The distances measured for the whole scene (1.25 x the 99.9th percentile of the probes' nearest
+  // facing hits, each side), which every vertex of the automatic cage gets at least; 0 when not measured.
+  double scene_front = 0.0, scene_rear = 0.0;
   // Suspect texels: covered texels whose tangent-space normal tilts more than 85 degrees from the
   // low-poly normal (z below cos 85 degrees: black patches where a ray took another part), or whose
   // samples disagree strongly (their mean is shorter than kSuspectAgreement: one texel, two
@@ -179,6 +182,11 @@ raycast::BuildQuality bvh_quality_for(const BakeOptions& options, std::size_t tr
 
 // Bytes the bake will allocate for its images at this size (for the memory check and reports).
 std::uint64_t estimate_bake_bytes(const BakeOptions& options);
+
+// The direction rays follow at each low-poly position (unit, re-centring aside exactly the bake's):
+// the mean of the normals of the corners at that position (positions compared by value), so split
+// normals (hard edges) open no gaps between the rays of neighbouring faces.
+std::vector<glm::vec3> low_ray_normals(const Mesh& low);
 
 // The sample offsets inside a texel for `samples` samples, in [0,1)^2: the centre for 1, a
 // regular grid for square counts, otherwise a stratified (Hammersley) set.

@@ -107,6 +107,8 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
                                                               : "none"},
         {"front", {{"min", s.vertex_front.min}, {"mean", s.vertex_front.mean}, {"max", s.vertex_front.max}}},
         {"rear", {{"min", s.vertex_rear.min}, {"mean", s.vertex_rear.mean}, {"max", s.vertex_rear.max}}},
+        {"scene_front", s.scene_front},
+        {"scene_rear", s.scene_rear},
         {"front_limited_vertices", s.cage_front_limited},
         {"rear_limited_vertices", s.cage_rear_limited}}},
       {"coordinate_spacing", s.coordinate_spacing},

@@ -10,6 +10,8 @@
 //    show.
 //  - Real scenes: the reference is a 64-sample bake at the same size.
 //  - Appearance: nmview --compare RMSE of the written map, when nmview is given.
+//  - Hard assets (accuracy_hard_assets.h): known-answer models where rays can land on the wrong
+//    part, with four hit settings; hard_assets.csv and a section of accuracy.md.
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -29,10 +31,12 @@
 #include <thread>
 #include <vector>
 
+#include "accuracy_hard_assets.h"
 #include "accuracy_plot.h"
 #include "bake.h"
 #include "image_io.h"
 #include "mesh_io.h"
+#include "parallel.h"
 #include "procedural.h"
 #include "rasterize.h"
 #include "raycast.h"
@@ -48,19 +52,6 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = 180.0 / kPi;
 
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-template <typename Fn>
-void parallel_for(std::size_t n, std::size_t chunk, Fn&& fn) {
-  const int threads = std::max(1, int(std::thread::hardware_concurrency()));
-  std::atomic<std::size_t> next{0};
-  auto work = [&] {
-    for (std::size_t i; (i = next.fetch_add(chunk)) < n;) fn(i, std::min(n, i + chunk));
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
-}
 
 double angle_deg(const glm::dvec3& a, const glm::dvec3& b) { return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b)) * kDeg; }
 
@@ -321,7 +312,7 @@ std::vector<TexelRef> texel_references(const Mesh& low, const TangentFrames& fra
     if (!tt[t].valid() || tt[t].xmax < tt[t].xmin || tt[t].ymax < tt[t].ymin) continue;
     for (int b = tt[t].ymin / kBand; b <= tt[t].ymax / kBand; ++b) band_tris[std::size_t(b)].push_back(std::uint32_t(t));
   }
-  parallel_for(std::size_t(bands), 1, [&](std::size_t b0, std::size_t b1) {
+  parallel_chunks(0, std::size_t(bands), 1, [&](std::size_t b0, std::size_t b1) {
     std::vector<std::uint32_t> mask;
     std::vector<glm::dvec3> acc;
     for (std::size_t band = b0; band < b1; ++band) {
@@ -382,7 +373,7 @@ struct ErrorStats {
 ErrorStats measure(const Image& map, const std::vector<std::uint8_t>& coverage, const std::vector<TexelRef>& refs,
                    const Image* ref_map, const TangentFrames& frames, int bits) {
   std::vector<float> err(refs.size(), -1.0f);
-  parallel_for(refs.size(), 4096, [&](std::size_t i0, std::size_t i1) {
+  parallel_chunks(0, refs.size(), 4096, [&](std::size_t i0, std::size_t i1) {
     for (std::size_t i = i0; i < i1; ++i) {
       const TexelRef& r = refs[i];
       if (r.tri < 0 || !coverage[i]) continue;
@@ -518,8 +509,10 @@ const char* kUsage =
     "usage: nmbake_accuracy [--quick] [--scenes a,b] [--out DIR] [--data DIR] [--nmview PATH|none] [--font TTF]\n"
     "Bakes every scene at sizes 512, 1024, 2048 (height_field also 4096) with 1, 4 and 16 samples and writes\n"
     "DIR/accuracy.csv, DIR/accuracy.md and DIR/accuracy.png (default DIR: docs/accuracy).\n"
-    "Scenes: height_field, displaced_sphere (analytic), suz_L4, torus_s3 (sculpts), bunny00 (scan; needs --data).\n"
-    "--quick: sizes 64 and 128 (real scenes 128), samples 1 and 4, a coarse sphere: a smoke check of seconds.\n"
+    "Scenes: height_field, displaced_sphere (analytic), suz_L4, torus_s3 (sculpts), bunny00 (scan; needs --data),\n"
+    "hard_assets (the known-answer models of tests/procedural at 512 and 1024 with 1 sample and four hit settings;\n"
+    "writes DIR/hard_assets.csv and a section of accuracy.md).\n"
+    "--quick: sizes 64 and 128 (real scenes 128, hard assets 256), samples 1 and 4, a coarse sphere: a smoke check of seconds.\n"
     "--check: exit 1 unless on every analytic scene the float error of the largest size and samples is below a\n"
     "quarter of the smallest's (the smoke test in ctest).\n";
 
@@ -565,8 +558,8 @@ int main(int argc, char** argv) {
   }
   const bool default_scenes = a.scenes.empty();
   if (default_scenes)
-    a.scenes = a.quick ? std::vector<std::string>{"height_field", "displaced_sphere"}
-                       : std::vector<std::string>{"height_field", "displaced_sphere", "suz_L4", "torus_s3", "bunny00"};
+    a.scenes = a.quick ? std::vector<std::string>{"height_field", "displaced_sphere", "hard_assets"}
+                       : std::vector<std::string>{"height_field", "displaced_sphere", "suz_L4", "torus_s3", "bunny00", "hard_assets"};
   const std::vector<int> sample_counts = a.quick ? std::vector<int>{1, 4} : std::vector<int>{1, 4, 16};
   const auto start = Clock::now();
   const std::string commit = git_commit(), date = utc_now();
@@ -578,9 +571,18 @@ int main(int argc, char** argv) {
     std::vector<std::string> notes;
     std::map<std::string, double> floor8, floor16;  // per analytic scene, mean over its sizes
     double appearance_seconds = 0;  // nmview runs
+    std::vector<bench::HardAssetRow> hard_rows;
+    std::vector<std::string> hard_notes;
+    double hard_seconds = 0;
     for (const std::string& name : a.scenes) {
       Scene sc;
       auto t0 = Clock::now();
+      if (name == "hard_assets") {
+        hard_rows = bench::run_hard_assets(a.quick ? std::vector<int>{256} : std::vector<int>{512, 1024}, hard_notes);
+        hard_seconds = since(t0);
+        std::fprintf(stderr, "nmbake_accuracy: hard_assets done in %.0f s, %.0f s since the start\n", hard_seconds, since(start));
+        continue;
+      }
       if (name == "height_field") sc = height_field_scene(a.quick);
       else if (name == "displaced_sphere") sc = displaced_sphere_scene(a.quick);
       else if (name == "suz_L4" || name == "torus_s3" || name == "suz_L3" || name == "torus_demo") {
@@ -674,7 +676,8 @@ int main(int argc, char** argv) {
     const double run_seconds = since(start);
 
     // CSV.
-    {
+    if (!hard_rows.empty()) bench::write_hard_assets_csv((fs::path(a.out) / "hard_assets.csv").string(), hard_rows);
+    if (!rows.empty()) {
       std::ofstream f(fs::path(a.out) / "accuracy.csv");
       f << "scene,reference,size,samples,bits,texels,mean_deg,rms_deg,p95_deg,max_deg,share_over_1deg,misses,rays,"
            "prepare_s,bvh_s,distances_s,trace_s,padding_s,total_s,rays_per_s,reference_s,appearance_rmse\n";
@@ -696,39 +699,42 @@ int main(int argc, char** argv) {
         << fmt("%.0f", run_seconds) << " s"
         << (a.nmview.empty() ? std::string() : " (" + fmt("%.0f", appearance_seconds) + " s of it in nmview)")
         << "; load average " << load_at_start << " at the start, " << load_average() << " at the end.\n\n";
-      f << "Angular error in degrees over the texels whose centre lies in the UV layout (analytic scenes: whose 4x4 "
-           "Gauss-Legendre points all do), the map and the reference both decoded with the low-poly tangent frame at the "
-           "texel centre. Float map unless `bits` says 8 or 16 (the map rounded as the PNG/TIFF writer rounds it). "
-           "Reference `analytic`: the exact normal of the analytic surface where the bake's ray meets it, averaged over "
-           "the texel (4x4 Gauss-Legendre, in the tangent frame), i.e. what an infinitely sampled bake of the exact surface "
-           "would hold; reference `64-sample bake`: a bake with 64 samples per texel at the same size. Seconds are the "
-           "in-process bake (`bake_normal_map`: prepare, BVH, ray distances, trace, padding; no file loading or writing), "
-           "rays/s = rays / trace seconds. The 4096^2 size is baked with 1 and 4 samples only.";
-      if (!a.nmview.empty()) f << " `view rmse`: `nmview --compare` RMSE (0..1) of the map written as 16-bit PNG, 800x400, 10 views.";
-      f << "\n\n";
-      for (const std::string& n : notes) f << "- " << n << "\n";
-      for (const auto& [scene, v] : floor8)
-        f << "- Quantisation floor of `" << scene << "` (its reference rounded and decoded): 8-bit " << fmt("%.4f", v)
-          << " deg mean, 16-bit " << fmt("%.5f", floor16[scene]) << " deg mean.\n";
-      f << "\n| scene | reference | size | samples | bits | mean | RMS | p95 | max | >1 deg | misses | prepare s | bvh s | "
-           "distances s | trace s | padding s | total s | Mrays/s |"
-        << (a.nmview.empty() ? "" : " view rmse |") << "\n";
-      f << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|" << (a.nmview.empty() ? "" : "---|") << "\n";
-      for (const Row& r : rows) {
-        f << "| " << r.scene << " | " << r.reference << " | " << r.size << " | " << r.samples << " | "
-          << (r.bits == 32 ? std::string("float") : std::to_string(r.bits)) << " | " << fmt("%.4f", r.err.mean) << " | "
-          << fmt("%.4f", r.err.rms) << " | " << fmt("%.4f", r.err.p95) << " | " << fmt("%.3f", r.err.max) << " | "
-          << fmt("%.2f%%", 100 * r.err.over1) << " | " << r.misses << " | " << fmt("%.3f", r.prepare) << " | "
-          << fmt("%.3f", r.bvh) << " | " << fmt("%.3f", r.distances) << " | " << fmt("%.3f", r.trace) << " | "
-          << fmt("%.3f", r.padding) << " | " << fmt("%.3f", r.total) << " | "
-          << fmt("%.2f", r.trace > 0 ? 1e-6 * double(r.rays) / r.trace : 0.0) << " |";
-        if (!a.nmview.empty()) f << ' ' << (r.appearance >= 0 ? fmt("%.5f", r.appearance) : std::string("-")) << " |";
-        f << "\n";
+      if (!rows.empty()) {
+        f << "Angular error in degrees over the texels whose centre lies in the UV layout (analytic scenes: whose 4x4 "
+             "Gauss-Legendre points all do), the map and the reference both decoded with the low-poly tangent frame at the "
+             "texel centre. Float map unless `bits` says 8 or 16 (the map rounded as the PNG/TIFF writer rounds it). "
+             "Reference `analytic`: the exact normal of the analytic surface where the bake's ray meets it, averaged over "
+             "the texel (4x4 Gauss-Legendre, in the tangent frame), i.e. what an infinitely sampled bake of the exact surface "
+             "would hold; reference `64-sample bake`: a bake with 64 samples per texel at the same size. Seconds are the "
+             "in-process bake (`bake_normal_map`: prepare, BVH, ray distances, trace, padding; no file loading or writing), "
+             "rays/s = rays / trace seconds. The 4096^2 size is baked with 1 and 4 samples only.";
+        if (!a.nmview.empty()) f << " `view rmse`: `nmview --compare` RMSE (0..1) of the map written as 16-bit PNG, 800x400, 10 views.";
+        f << "\n\n";
+        for (const std::string& n : notes) f << "- " << n << "\n";
+        for (const auto& [scene, v] : floor8)
+          f << "- Quantisation floor of `" << scene << "` (its reference rounded and decoded): 8-bit " << fmt("%.4f", v)
+            << " deg mean, 16-bit " << fmt("%.5f", floor16[scene]) << " deg mean.\n";
+        f << "\n| scene | reference | size | samples | bits | mean | RMS | p95 | max | >1 deg | misses | prepare s | bvh s | "
+             "distances s | trace s | padding s | total s | Mrays/s |"
+          << (a.nmview.empty() ? "" : " view rmse |") << "\n";
+        f << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|" << (a.nmview.empty() ? "" : "---|") << "\n";
+        for (const Row& r : rows) {
+          f << "| " << r.scene << " | " << r.reference << " | " << r.size << " | " << r.samples << " | "
+            << (r.bits == 32 ? std::string("float") : std::to_string(r.bits)) << " | " << fmt("%.4f", r.err.mean) << " | "
+            << fmt("%.4f", r.err.rms) << " | " << fmt("%.4f", r.err.p95) << " | " << fmt("%.3f", r.err.max) << " | "
+            << fmt("%.2f%%", 100 * r.err.over1) << " | " << r.misses << " | " << fmt("%.3f", r.prepare) << " | "
+            << fmt("%.3f", r.bvh) << " | " << fmt("%.3f", r.distances) << " | " << fmt("%.3f", r.trace) << " | "
+            << fmt("%.3f", r.padding) << " | " << fmt("%.3f", r.total) << " | "
+            << fmt("%.2f", r.trace > 0 ? 1e-6 * double(r.rays) / r.trace : 0.0) << " |";
+          if (!a.nmview.empty()) f << ' ' << (r.appearance >= 0 ? fmt("%.5f", r.appearance) : std::string("-")) << " |";
+          f << "\n";
+        }
       }
+      if (!hard_rows.empty()) f << (rows.empty() ? "" : "\n") << bench::hard_assets_markdown(hard_rows, hard_notes, hard_seconds);
       if (!f) throw OutputError((fs::path(a.out) / "accuracy.md").string() + ": cannot write");
     }
     // Plot: mean error against bake seconds, one polyline per scene and size (samples 1 -> 4 -> 16).
-    {
+    if (!rows.empty()) {
       std::vector<bench::PlotSeries> series;
       std::map<std::string, std::size_t> index;
       for (const Row& r : rows) {
@@ -752,7 +758,9 @@ int main(int argc, char** argv) {
                                     " cores, " + cpu_model(),
                                 a.font);
     }
-    std::fprintf(stderr, "nmbake_accuracy: wrote %s/accuracy.{csv,md,png}; %zu rows in %.0f s\n", a.out.c_str(), rows.size(), run_seconds);
+    std::fprintf(stderr, "nmbake_accuracy: wrote %s/%s; %zu rows%s in %.0f s\n", a.out.c_str(),
+                 rows.empty() ? "accuracy.md" : "accuracy.{csv,md,png}", rows.size(),
+                 hard_rows.empty() ? "" : (", hard_assets.csv (" + std::to_string(hard_rows.size()) + " rows)").c_str(), run_seconds);
     if (a.check) {
       std::map<std::string, std::pair<double, double>> first_last;  // analytic scene -> (first, last) float mean error
       for (const Row& r : rows)

@@ -1,0 +1,26 @@
+// A loop over [0, count) in chunks shared out to `threads` threads (the caller's among them):
+// fn(begin, end) for each chunk, in no particular order. threads <= 0: all cores.
+#pragma once
+
+#include <algorithm>
+#include <atomic>
+#include <cstddef>
+#include <thread>
+#include <vector>
+
+namespace nmbake {
+
+template <typename Fn>
+void parallel_chunks(int threads, std::size_t count, std::size_t chunk, Fn&& fn) {
+  if (threads <= 0) threads = std::max(1, int(std::thread::hardware_concurrency()));
+  std::atomic<std::size_t> next{0};
+  auto work = [&] {
+    for (std::size_t i; (i = next.fetch_add(chunk)) < count;) fn(i, std::min(count, i + chunk));
+  };
+  std::vector<std::thread> pool;
+  for (int i = 1; i < threads; ++i) pool.emplace_back(work);
+  work();
+  for (auto& t : pool) t.join();
+}
+
+}  // namespace nmbake
