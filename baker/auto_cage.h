@@ -28,7 +28,7 @@ struct ProbeTarget {
   const raycast::Scene* scene = nullptr;
   const glm::vec3* positions = nullptr;
   const std::uint32_t* index = nullptr;  // 3 per BVH triangle
-  const std::int8_t* facing = nullptr;   // per BVH triangle
+  const std::int8_t* facing = nullptr;   // per BVH triangle (raycast::HitRule::facing: its sign)
 };
 
 // The low-poly: re-centred positions (file vertices), 3 position indices per triangle, and the ray

@@ -21,6 +21,7 @@
 #include "mesh_topology.h"
 #include "normals.h"
 #include "padding.h"
+#include "parallel.h"
 #include "rasterize.h"
 #include "raycast.h"
 #include "shade_batch.h"
@@ -143,17 +144,34 @@ double quantile(std::vector<float>& v, double q) {
   return v[k];
 }
 
-// Per triangle, +1 when its corner normals (3 per triangle) point to the side of
-// cross(p1 - p0, p2 - p0), -1 when to the other; +1 where that cannot be told (no area, normals
-// that cancel).
+// Per triangle, its raycast::HitRule::facing code: the side its corner normals (3 per triangle)
+// point to, + that of cross(p1 - p0, p2 - p0) (also where that cannot be told: no area, normals
+// that cancel), and how far they lean from the face.
 std::vector<std::int8_t> triangle_facing(const std::vector<glm::vec3>& pos, const std::vector<std::uint32_t>& index,
                                          const std::vector<glm::vec3>& corner_normals) {
-  std::vector<std::int8_t> out(index.size() / 3, 1);
-  for (std::size_t t = 0; t < out.size(); ++t) {
-    const glm::dvec3 p0(pos[index[3 * t]]), p1(pos[index[3 * t + 1]]), p2(pos[index[3 * t + 2]]);
-    const glm::dvec3 n = glm::dvec3(corner_normals[3 * t]) + glm::dvec3(corner_normals[3 * t + 1]) + glm::dvec3(corner_normals[3 * t + 2]);
-    if (glm::dot(glm::cross(p1 - p0, p2 - p0), n) < 0.0) out[t] = -1;
+  std::vector<std::int8_t> out(index.size() / 3);
+  parallel_chunks(0, out.size(), 65536, [&](std::size_t t0, std::size_t t1) {
+  for (std::size_t t = t0; t < t1; ++t) {
+    const glm::vec3 p0 = pos[index[3 * t]], p1 = pos[index[3 * t + 1]], p2 = pos[index[3 * t + 2]];
+    const glm::vec3* c = &corner_normals[3 * t];
+    glm::vec3 f = glm::cross(p1 - p0, p2 - p0);
+    const int sign = glm::dot(f, c[0] + c[1] + c[2]) < 0.0f ? -1 : 1;
+    const float f2 = glm::dot(f, f);
+    double lean = 2.0;  // unknown
+    if (f2 > 0.0f) {
+      f *= float(sign) / std::sqrt(f2);
+      lean = 0.0;
+      for (int k = 0; k < 3 && lean < 1.0; ++k) {
+        const float n2 = glm::dot(c[k], c[k]);
+        // The sine of the angle from the face, rounded up by a little for the float arithmetic;
+        // a normal past 90 degrees (or of no length) leaves it unknown.
+        if (!(n2 > 0.0f) || !(glm::dot(c[k], f) > 0.0f)) lean = 2.0;
+        else lean = std::max(lean, double(glm::length(glm::cross(c[k], f)) / std::sqrt(n2)) + 1e-4);
+      }
+    }
+    out[t] = raycast::facing_code(sign, lean);
   }
+  });
   return out;
 }
 
@@ -301,20 +319,13 @@ Prepared prepare(const Mesh& low, const Mesh& high, const Mesh* cage, BakeStats&
   return s;
 }
 
-// The facing array for a HitRule, or null when every triangle faces the way its winding does
-// (the usual case): the filter then reads no byte per hit for it.
-const std::int8_t* facing_if_needed(const std::int8_t* facing, std::size_t triangles) {
-  for (std::size_t t = 0; t < triangles; ++t)
-    if (facing[t] != 1) return facing;
-  return nullptr;
-}
-
 // The high-poly found inverted (BakeStats::HighFacing): fronts are taken the other way round, and
 // normals nmbake computed itself are turned outwards with them (a file's normals are kept: the map
 // then is what it was without the rule). Applies to the BVH's copies too.
 void turn_inverted_high(Prepared& s, bool normals_computed) {
+  // A file's normals now point against the fronts: how far they lean is then unknown (127).
   for (auto* v : {&s.high_facing, &s.kept_facing})
-    for (std::int8_t& f : *v) f = std::int8_t(-f);
+    for (std::int8_t& f : *v) f = normals_computed ? std::int8_t(-f) : raycast::facing_code(f < 0 ? 1 : -1, 2.0);
   if (normals_computed)
     for (auto* v : {&s.high_corner_normals, &s.kept_normals})
       for (glm::vec3& n : *v) n = -n;
@@ -690,7 +701,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
       if (!hits[i].hit()) continue;
       const std::uint32_t* v = s.bvh_index + 3 * std::size_t(hits[i].triangle);
       const glm::vec3 ng = glm::cross(s.high_pos[v[1]] - s.high_pos[v[0]], s.high_pos[v[2]] - s.high_pos[v[0]]);
-      is_back[i] = float(s.bvh_facing[hits[i].triangle]) * glm::dot(ng, rays[i & ~std::size_t(1)].direction) < 0.0f;
+      is_back[i] = (s.bvh_facing[hits[i].triangle] < 0 ? -1.0f : 1.0f) * glm::dot(ng, rays[i & ~std::size_t(1)].direction) < 0.0f;
     }
     for (std::size_t i = 0; i < pairs; ++i) {  // how the faces point: by the nearest hit either way
       const raycast::Hit &o = hits[2 * i], &in = hits[2 * i + 1];
@@ -853,7 +864,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
 
   // The hit rule (raycast::HitRule), over the BVH's triangles as finally built.
   raycast::HitRule rule;
-  rule.facing = facing_if_needed(s.bvh_facing, st.high_triangles - st.high_triangles_culled);
+  rule.facing = s.bvh_facing;
   rule.corner_normals = s.bvh_normals;
   const raycast::HitRule* const hit_rule = st.backfaces_skipped ? &rule : nullptr;
 
@@ -1154,7 +1165,7 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
   raycast::Scene scene(&s.high_pos[0].x, s.high_pos.size(), high.position_index.data(), high.triangle_count(),
                        raycast::BuildQuality::low, opt.threads);
   raycast::HitRule rule;
-  rule.facing = facing_if_needed(s.high_facing.data(), s.high_facing.size());
+  rule.facing = s.high_facing.data();
   rule.corner_normals = s.high_corner_normals.data();
   const raycast::HitRule* const hit_rule = st.backfaces_skipped ? &rule : nullptr;
   RaySetup ray_setup;

@@ -11,7 +11,8 @@
 //  - Real scenes: the reference is a 64-sample bake at the same size.
 //  - Appearance: nmview --compare RMSE of the written map, when nmview is given.
 //  - Hard assets (accuracy_hard_assets.h): known-answer models where rays can land on the wrong
-//    part, with four hit settings; hard_assets.csv and a section of accuracy.md.
+//    part, with four hit settings; hard_assets.csv and a section of accuracy.md (hard_assets.md
+//    when they run alone).
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -511,7 +512,7 @@ const char* kUsage =
     "DIR/accuracy.csv, DIR/accuracy.md and DIR/accuracy.png (default DIR: docs/accuracy).\n"
     "Scenes: height_field, displaced_sphere (analytic), suz_L4, torus_s3 (sculpts), bunny00 (scan; needs --data),\n"
     "hard_assets (the known-answer models of tests/procedural at 512 and 1024 with 1 sample and four hit settings;\n"
-    "writes DIR/hard_assets.csv and a section of accuracy.md).\n"
+    "writes DIR/hard_assets.csv and a section of accuracy.md, or DIR/hard_assets.md when it runs alone).\n"
     "--quick: sizes 64 and 128 (real scenes 128, hard assets 256), samples 1 and 4, a coarse sphere: a smoke check of seconds.\n"
     "--check: exit 1 unless on every analytic scene the float error of the largest size and samples is below a\n"
     "quarter of the smallest's (the smoke test in ctest).\n";
@@ -691,9 +692,11 @@ int main(int argc, char** argv) {
           << (r.appearance >= 0 ? fmt("%.6f", r.appearance) : std::string()) << '\n';
       if (!f) throw OutputError((fs::path(a.out) / "accuracy.csv").string() + ": cannot write");
     }
-    // Markdown.
+    // Markdown: accuracy.md, or hard_assets.md when only the hard assets ran (so that run does
+    // not overwrite the accuracy table).
+    const std::string md_name = rows.empty() && !hard_rows.empty() ? "hard_assets.md" : "accuracy.md";
     {
-      std::ofstream f(fs::path(a.out) / "accuracy.md");
+      std::ofstream f(fs::path(a.out) / md_name);
       f << "Written by `" << command << "` on " << date << ", commit `" << commit << "`, "
         << std::thread::hardware_concurrency() << " cores (" << cpu_model() << "); the whole run took "
         << fmt("%.0f", run_seconds) << " s"
@@ -731,7 +734,7 @@ int main(int argc, char** argv) {
         }
       }
       if (!hard_rows.empty()) f << (rows.empty() ? "" : "\n") << bench::hard_assets_markdown(hard_rows, hard_notes, hard_seconds);
-      if (!f) throw OutputError((fs::path(a.out) / "accuracy.md").string() + ": cannot write");
+      if (!f) throw OutputError((fs::path(a.out) / md_name).string() + ": cannot write");
     }
     // Plot: mean error against bake seconds, one polyline per scene and size (samples 1 -> 4 -> 16).
     if (!rows.empty()) {
@@ -759,7 +762,7 @@ int main(int argc, char** argv) {
                                 a.font);
     }
     std::fprintf(stderr, "nmbake_accuracy: wrote %s/%s; %zu rows%s in %.0f s\n", a.out.c_str(),
-                 rows.empty() ? "accuracy.md" : "accuracy.{csv,md,png}", rows.size(),
+                 rows.empty() ? md_name.c_str() : "accuracy.{csv,md,png}", rows.size(),
                  hard_rows.empty() ? "" : (", hard_assets.csv (" + std::to_string(hard_rows.size()) + " rows)").c_str(), run_seconds);
     if (a.check) {
       std::map<std::string, std::pair<double, double>> first_last;  // analytic scene -> (first, last) float mean error

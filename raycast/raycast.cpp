@@ -32,11 +32,6 @@ void check_device(RTCDevice device) {
                                         std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
 }
 
-// Hits on faces within 26 degrees of the outside (cos^2 = 0.81) skip the vertex-normal test (on
-// the Suzanne sculpts at 1024^2: 76 texels facing away against 65 with every hit tested, 278 with
-// the test from 60 degrees on).
-constexpr float kNormalTestCos2 = 0.81f;
-
 // The context a call under a HitRule hands Embree: its filter finds the rule and the per-ray
 // state of the packet being traced here. A ray's id is its lane in the packet.
 struct RuleContext {
@@ -94,19 +89,20 @@ struct RuleContext {
                           side * RTCRayN_dir_z(args->ray, n, i));
       const glm::vec3 ng(RTCHitN_Ng_x(args->hit, n, i), RTCHitN_Ng_y(args->hit, n, i), RTCHitN_Ng_z(args->hit, n, i));
       const float t = RTCRayN_tfar(args->ray, n, i);
-      float front = glm::dot(ng, out);
-      if (rule.facing) front *= float(rule.facing[prim]);
+      const int code = rule.facing ? rule.facing[prim] : 127;
+      const float front = code < 0 ? -glm::dot(ng, out) : glm::dot(ng, out);
       if (front < 0.0f && rule.skip_backfaces) {
         rc.backface_t[lane] = std::min(rc.backface_t[lane], t);
         args->valid[i] = 0;
         continue;
       }
       const float u = RTCHitN_u(args->hit, n, i), v = RTCHitN_v(args->hit, n, i);
-      // Near the outside, the face's vertex normals point out too: their test is for grazing hits
-      // and for faces whose vertex normals lean far from the face (sculpted creases), and reading
-      // them here costs a cache miss per hit.
-      const bool grazing = front < 0.0f || front * front < kNormalTestCos2 * glm::dot(ng, ng) * glm::dot(out, out);
-      if (rule.corner_normals && grazing) {
+      // The normals are read only when they could point away: the face is no nearer the outside
+      // than they lean from it (HitRule).
+      const int m = code < 0 ? -code : code;
+      const float lean = float(m - 1) * (1.0f / 126.0f);
+      if (rule.corner_normals &&
+          (m >= 127 || front <= 0.0f || front * front <= lean * lean * glm::dot(ng, ng) * glm::dot(out, out))) {
         const glm::vec3* c = rule.corner_normals + 3 * std::size_t(prim);
         const glm::vec3 nh = (1.0f - u - v) * c[0] + u * c[1] + v * c[2];
         if (!(glm::dot(nh, out) > 0.0f)) {

@@ -6,6 +6,8 @@
 // (1 - u - v) * p0 + u * p1 + v * p2 for triangle (p0, p1, p2).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -59,21 +61,34 @@ struct HitBatch {
 // Which hits a ray takes (Scene::intersect with a rule). Without a rule the first hit along the
 // ray counts, whatever it is.
 //
-// A triangle's front is the side its vertex normals point to (facing[t] = +1: the side of
-// cross(p1 - p0, p2 - p0), -1: the other), so a triangle wound against its neighbours is judged by
+// A triangle's front is the side its vertex normals point to (the sign of facing[t]: + the side of
+// cross(p1 - p0, p2 - p0), - the other), so a triangle wound against its neighbours is judged by
 // its normals. A hit is on a back face when that front faces away from the low-poly's outside
 // (RayBatch::outward): on a closed high-poly that is the inside of some part, never the surface
 // the ray looks for. With skip_backfaces such hits are passed over and the ray takes the next one.
 // With corner_normals, a front-face hit whose interpolated normal points away from the low-poly's
 // outside (dot <= 0: it would bake as a texel facing into the surface, as grazing hits on the
 // side of another part do) is taken only when the ray finds no other: then the first of those.
+// The magnitude m of facing[t] (1 to 127) bounds how far the triangle's corner normals lean from
+// its face: the sine of the largest angle between one and the face's normal is at most
+// (m - 1) / 126 (127: unknown, or past 90 degrees). An interpolated normal leans no farther, so
+// for a face nearer the outside than that the normals are not read.
 // In order: a front-face hit inside the ray's preferred part (RayBatch::prefer_lo/hi), the first
-// along the ray; else one outside it, the nearest to it; else one whose normal points away.
+// along the ray; else one outside it, the nearest to it; else one whose normal points away. Of
+// hits at one distance (a ray through an edge) the lower triangle index is taken.
 struct HitRule {
-  const std::int8_t* facing = nullptr;  // per triangle, +1 or -1; null: +1 for all
+  const std::int8_t* facing = nullptr;  // per triangle, as above; null: +127 for all
   bool skip_backfaces = true;
   const glm::vec3* corner_normals = nullptr;  // 3 per triangle (any length), or null: no normal test
 };
+
+// facing[t] for a triangle whose normals point to the side `sign` (+1 or -1) of its winding and
+// lean from its face by at most an angle of sine `lean` (>= 1 or not finite: unknown).
+inline std::int8_t facing_code(int sign, double lean) {
+  const double m = lean >= 0.0 && lean < 1.0 ? 1.0 + std::ceil(126.0 * lean) : 127.0;
+  const int code = int(std::min(m, 127.0));
+  return std::int8_t(sign < 0 ? -code : code);
+}
 
 // HitBatch::flags bits.
 enum HitFlags : std::uint8_t {

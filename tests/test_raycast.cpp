@@ -1,4 +1,5 @@
 // Embree against the brute-force reference intersector on fixed-seed random rays.
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -203,8 +204,7 @@ TEST(RaycastRule, OutwardRaysJudgeFacesByTheOutside) {
 }
 
 TEST(RaycastRule, NormalPointingAwayIsTakenOnlyWithoutAnother) {
-  // A grazing ray (63 degrees from the planes' normal: the vertex normals are tested only beyond
-  // 60 degrees, where a face's vertex normals can point away while its front faces the ray).
+  // A grazing ray, 63 degrees from the planes' normal.
   const Mesh m = two_planes(false, 3.0f);
   raycast::Scene scene(&m.positions[0].x, m.positions.size(), m.position_index.data(), m.triangle_count());
   const raycast::Ray down{{-1.0f, 0.2f, 1.05f}, 0.0f, glm::normalize(glm::vec3(2, 0, -1)), 10.0f};
@@ -224,11 +224,34 @@ TEST(RaycastRule, NormalPointingAwayIsTakenOnlyWithoutAnother) {
   EXPECT_NEAR(r.hit.t, t_top, 1e-5f);
   EXPECT_GE(r.hit.triangle, 2u);
   EXPECT_EQ(r.flags, raycast::hit_normal_disagrees);
-  // A ray straight down meets the top plane head on: taken without its normals being read.
+  // Facing codes that say the normals lean at most asin(30/126) = 14 degrees from the faces: the
+  // normals are trusted to agree with a face less than 76 degrees from the ray and not read, so
+  // both the ray straight down and the grazing one (63 degrees) take the top plane.
+  std::vector<std::int8_t> facing(4, raycast::facing_code(1, 30.0 / 126.0));
+  EXPECT_EQ(facing[0], 31);
+  rule.facing = facing.data();
   const raycast::Ray straight{{0.3f, 0.2f, 2.0f}, 0.0f, {0, 0, -1}, 10.0f};
   r = trace(scene, straight, rule, false);
   EXPECT_NEAR(r.hit.t, 1.0f, 1e-6f);
   EXPECT_EQ(r.flags, 0);
+  r = trace(scene, down, rule, false);
+  EXPECT_NEAR(r.hit.t, t_top, 1e-5f);
+  EXPECT_EQ(r.flags, 0);
+  // A lean of up to 30 degrees (sine 0.5) reaches past 90 from a face 63 degrees off: the grazing
+  // ray reads the normals again, the straight one still does not.
+  std::fill(facing.begin(), facing.end(), raycast::facing_code(1, 0.5));
+  EXPECT_EQ(facing[0], 64);
+  r = trace(scene, down, rule, false);
+  EXPECT_NEAR(r.hit.t, t_top, 1e-5f);
+  EXPECT_EQ(r.flags, raycast::hit_normal_disagrees);
+  r = trace(scene, straight, rule, false);
+  EXPECT_EQ(r.flags, 0);
+  // Unknown lean (127, also null facing): always read.
+  std::fill(facing.begin(), facing.end(), raycast::facing_code(1, 2.0));
+  EXPECT_EQ(facing[0], 127);
+  r = trace(scene, straight, rule, false);
+  EXPECT_NEAR(r.hit.t, 1.0f, 1e-6f);
+  EXPECT_EQ(r.flags, raycast::hit_normal_disagrees);
 }
 
 TEST(RaycastRule, HitsOutsideThePreferredPartWaitForOneInside) {
