@@ -32,6 +32,27 @@ void check_device(RTCDevice device) {
                                         std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
 }
 
+// One ray for rtcIntersect1, with no hit yet; its id (a packet lane for the filter) is 0.
+RTCRayHit ray_hit(const Ray& ray) {
+  RTCRayHit rh;
+  rh.ray.org_x = ray.origin.x;
+  rh.ray.org_y = ray.origin.y;
+  rh.ray.org_z = ray.origin.z;
+  rh.ray.tnear = ray.tnear;
+  rh.ray.dir_x = ray.direction.x;
+  rh.ray.dir_y = ray.direction.y;
+  rh.ray.dir_z = ray.direction.z;
+  rh.ray.time = 0.0f;
+  rh.ray.tfar = ray.tfar;
+  rh.ray.mask = 0xffffffffu;
+  rh.ray.id = 0;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  return rh;
+}
+
 // The context a call under a HitRule hands Embree: its filter finds the rule and the per-ray
 // state of the packet being traced here. A ray's id is its lane in the packet.
 struct RuleContext {
@@ -212,22 +233,7 @@ std::size_t Scene::triangle_count() const { return impl_->triangles; }
 Hit Scene::intersect(const Ray& ray) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  RTCRayHit rh;
-  rh.ray.org_x = ray.origin.x;
-  rh.ray.org_y = ray.origin.y;
-  rh.ray.org_z = ray.origin.z;
-  rh.ray.tnear = ray.tnear;
-  rh.ray.dir_x = ray.direction.x;
-  rh.ray.dir_y = ray.direction.y;
-  rh.ray.dir_z = ray.direction.z;
-  rh.ray.time = 0.0f;
-  rh.ray.tfar = ray.tfar;
-  rh.ray.mask = 0xffffffffu;
-  rh.ray.id = 0;
-  rh.ray.flags = 0;
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  RTCRayHit rh = ray_hit(ray);
   rtcIntersect1(impl_->scene, &context, &rh);
   Hit h;
   if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
@@ -245,22 +251,7 @@ Hit Scene::intersect(const Ray& ray, const HitRule& rule, bool outward, std::uin
   rc.outward[0] = outward;
   rc.prefer_lo[0] = prefer_lo;
   rc.prefer_hi[0] = prefer_hi;
-  RTCRayHit rh;
-  rh.ray.org_x = ray.origin.x;
-  rh.ray.org_y = ray.origin.y;
-  rh.ray.org_z = ray.origin.z;
-  rh.ray.tnear = ray.tnear;
-  rh.ray.dir_x = ray.direction.x;
-  rh.ray.dir_y = ray.direction.y;
-  rh.ray.dir_z = ray.direction.z;
-  rh.ray.time = 0.0f;
-  rh.ray.tfar = ray.tfar;
-  rh.ray.mask = 0xffffffffu;
-  rh.ray.id = 0;
-  rh.ray.flags = 0;
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  RTCRayHit rh = ray_hit(ray);
   rtcIntersect1(impl_->scene, &rc.context, &rh);
   Hit h;
   std::uint32_t prim = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID ? rh.hit.primID : no_hit;
