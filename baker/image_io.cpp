@@ -245,6 +245,7 @@ std::map<std::string, std::string> read_image_metadata(const std::string& path) 
 }
 
 void preload_image_io() {}  // linked directly: nothing to load
+void wait_for_image_io() {}
 std::string image_io_problem() { return {}; }
 
 }  // namespace nmbake

@@ -46,6 +46,12 @@ std::map<std::string, std::string> read_image_metadata(const std::string& path);
 // does nothing where it is linked. Optional: the functions above load it when first called.
 void preload_image_io();
 
+// Waits until a background load started by preload_image_io() has finished (at once where there
+// is none). Call before the process exits: exiting while the library's static constructors run
+// can abort (one of OpenImageIO's plugins, gdcm, asserts), which turned an early error's exit
+// code 2 into an abort.
+void wait_for_image_io();
+
 // Why images cannot be written, found without waiting for the background load (the module file
 // is missing or already failed to load), or "" (always "" where OpenImageIO is linked).
 std::string image_io_problem();

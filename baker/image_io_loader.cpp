@@ -66,8 +66,7 @@ void start() {
   std::call_once(g_started, [] {
     std::packaged_task<Loaded()> task(load);
     g_loaded = task.get_future().share();
-    // Detached: a process that exits before it finishes (--help, a usage error) simply waits for
-    // the loader lock at exit, as it would have waited for the libraries at start.
+    // Detached; main() waits for it before the process exits (wait_for_image_io).
     std::thread(std::move(task)).detach();
   });
 }
@@ -91,6 +90,10 @@ const ImageIoModule& module(const std::string& path, ExitCode failure) {
 }  // namespace
 
 void preload_image_io() { start(); }
+
+void wait_for_image_io() {
+  if (g_loaded.valid()) g_loaded.wait();
+}
 
 std::string image_io_problem() {
   start();

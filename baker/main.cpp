@@ -356,19 +356,22 @@ int run(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   preload_image_io();  // OpenImageIO loads on its own thread while the command line and meshes are read
+  int code = 0;
   try {
-    return run(argc, argv);
+    code = run(argc, argv);
   } catch (const nmbake::Cancelled&) {
     std::fprintf(stderr, "error: interrupted; no output written\n");
-    return 130;
+    code = 130;
   } catch (const nmbake::Error& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
-    return int(e.code());
+    code = int(e.code());
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "error: out of memory\n");
-    return int(nmbake::ExitCode::memory);
+    code = int(nmbake::ExitCode::memory);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
-    return 2;
+    code = 2;
   }
+  wait_for_image_io();  // never exit while the image library's constructors run
+  return code;
 }
