@@ -104,10 +104,15 @@ LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& h
   const raycast::Scene self(&pos[0].x, pos.size(), index.data(), tris, raycast::BuildQuality::low, threads);
   raycast::HitRule facing_start;  // an "inward" ray under this rule takes surfaces facing its start
   facing_start.facing = low_facing.data();
+  raycast::HitRule high_facing_start;
+  high_facing_start.facing = high.facing;
 
   // Per probe: the distances found (infinity: none). Front/rear needs from the high-poly's first
   // hits that face the low-poly's outside; limits from the low-poly.
   const double inf = std::numeric_limits<double>::infinity();
+  // high_back_out: where a next part of the low-poly lies along the normal, the first high-poly
+  // surface before the half-way point that faces back at the probe (that part's, standing out).
+  std::vector<double> high_back_out(probes.size(), inf);
   std::vector<double> need_out(probes.size(), inf), need_in(probes.size(), inf), gap_out(probes.size(), inf),
       gap_in(probes.size(), inf);
   const float tnear = float(1e-2 * floor);
@@ -149,6 +154,15 @@ LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& h
         r.tnear = std::nextafter(h.t, std::numeric_limits<float>::infinity());
       }
     }
+    // Towards a next part: its high-poly surface facing back at the probe, before half way (this
+    // part's own surface, met from inside, is passed over: an "inward" ray under the rule takes
+    // the surfaces that face its start).
+    for (std::size_t i = i0; i < i1; ++i) {
+      if (!(gap_out[i] < inf)) continue;
+      const raycast::Ray r{glm::vec3(probes[i].p), tnear, glm::vec3(probes[i].n), float(0.5 * gap_out[i])};
+      const raycast::Hit h = high.scene->intersect(r, high_facing_start);
+      if (h.hit()) high_back_out[i] = h.t;
+    }
   });
 
   // Per welded vertex: the largest need and the smallest limit its probes found.
@@ -160,6 +174,10 @@ LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& h
       if (need_out[i] < inf) front[w] = std::max(front[w], 1.25 * need_out[i] + floor);
       if (need_in[i] < inf) rear[w] = std::max(rear[w], 1.25 * need_in[i] + floor);
       front_cap[w] = std::min(front_cap[w], 0.5 * gap_out[i]);
+      // Nor past the high-poly surface of that next part, where it stands out towards this one
+      // beyond the half-way point. (With no next part of the low-poly along the normal, a surface
+      // facing back is this part's own overhang, whose lip the cage must pass: not looked for.)
+      front_cap[w] = std::min(front_cap[w], 0.9 * high_back_out[i]);
       rear_cap[w] = std::min(rear_cap[w], 0.5 * gap_in[i]);
     }
 

@@ -6,7 +6,8 @@
 // normals, find how far the high-poly lies outside (front) and inside (rear) the low-poly there;
 // probes against the low-poly itself find how far the next part of the low-poly lies along the
 // normal, and the cage stops half way to it, so that cages of facing parts never cross and no ray
-// starts beyond a neighbouring part. Needs are spread over neighbours and limits eased off with
+// starts beyond a neighbouring part; where that part's high-poly stands out towards this one past
+// the half-way point, the cage stops before its surface. Needs are spread over neighbours and limits eased off with
 // distance (each changes by at most its edge's length along an edge), so the cage has neither
 // spikes nor notches; positions are welded by value first, so hard edges (split normals) open no
 // cracks. All coordinates are re-centred scene units.

@@ -250,3 +250,45 @@ TEST(RobustHits, CullingLeavesTheAutomaticCagesMapUnchanged) {
   EXPECT_EQ(on.stats.hits, off.stats.hits);
   EXPECT_GT(on.stats.cage_front_limited, 0u);
 }
+
+TEST(RobustHits, CageStopsBeforeANeighbouringPartsHighPoly) {
+  // Two facing sheets 0.1 apart: A at z = 0 facing up, B at z = 0.1 facing down, B's high-poly
+  // standing 0.07 out towards A (at z = 0.03), past the half-way point. A's cage stops before it
+  // (0.9 x 0.03), not at half way (0.05) nor at the scene-wide front distance B's bulge sets.
+  auto sheet = [](float z, bool down, float u0) {
+    Mesh m = test::make_grid(4, 4);
+    for (glm::vec3& p : m.positions) p.z = z;
+    for (glm::vec2& t : m.uvs) t.x = u0 + 0.45f * t.x;
+    m.normals = {glm::vec3(0, 0, down ? -1.0f : 1.0f)};
+    m.normal_index.assign(m.position_index.size(), 0);
+    if (down)
+      for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+        std::swap(m.position_index[3 * t + 1], m.position_index[3 * t + 2]);
+        std::swap(m.uv_index[3 * t + 1], m.uv_index[3 * t + 2]);
+      }
+    return m;
+  };
+  auto join = [](Mesh a, const Mesh& b) {
+    const std::uint32_t np = std::uint32_t(a.positions.size()), nt = std::uint32_t(a.uvs.size()), nn = std::uint32_t(a.normals.size());
+    a.positions.insert(a.positions.end(), b.positions.begin(), b.positions.end());
+    a.uvs.insert(a.uvs.end(), b.uvs.begin(), b.uvs.end());
+    a.normals.insert(a.normals.end(), b.normals.begin(), b.normals.end());
+    for (std::uint32_t i : b.position_index) a.position_index.push_back(i + np);
+    for (std::uint32_t i : b.uv_index) a.uv_index.push_back(i + nt);
+    for (std::uint32_t i : b.normal_index) a.normal_index.push_back(i + nn);
+    a.source_face.assign(a.triangle_count(), 0);
+    return a;
+  };
+  const Mesh low = join(sheet(0.0f, false, 0.0f), sheet(0.1f, true, 0.55f));
+  const Mesh high = join(sheet(0.0f, false, 0.0f), sheet(0.03f, true, 0.55f));
+  const BakeResult r = bake_normal_map(low, high, nullptr, options(64));
+  ASSERT_EQ(r.cage_positions.size(), low.positions.size());
+  std::printf("measured: scene front %.4f, A's cage at z %.5f\n", r.stats.scene_front, double(r.cage_positions[0].z));
+  EXPECT_GT(r.stats.scene_front, 0.08);
+  for (std::size_t i = 0; i < 25; ++i) {  // A's vertices
+    EXPECT_LE(r.cage_positions[i].z, 0.9f * 0.03f + 1e-5f) << "vertex " << i;
+    EXPECT_GE(r.cage_positions[i].z, 0.02f) << "vertex " << i;
+  }
+  EXPECT_EQ(r.stats.misses, 0u);
+  EXPECT_EQ(r.stats.texels_facing_away, 0u);
+}
