@@ -129,11 +129,8 @@ LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& h
       for (int k = 0; k < 2; ++k) {
         const raycast::Hit& h = hits[2 * (i - i0) + k];
         if (!h.hit()) continue;
-        const std::uint32_t* v = high.index + 3 * std::size_t(h.triangle);
-        const glm::vec3 ng = glm::cross(high.positions[v[1]] - high.positions[v[0]], high.positions[v[2]] - high.positions[v[0]]);
         // The low-poly's outside is +n: a front face there is the surface the probe looks for.
-        const float front = (high.facing[h.triangle] < 0 ? -1.0f : 1.0f) * glm::dot(ng, glm::vec3(probes[i].n));
-        if (front > 0.0f) (k == 0 ? need_out : need_in)[i] = h.t;
+        if (front_along(high, h.triangle, glm::vec3(probes[i].n)) > 0.0f) (k == 0 ? need_out : need_in)[i] = h.t;
       }
     for (std::size_t i = 0; i < rays.size(); ++i) {
       // The surface around the probe is its own part, however it folds: triangles that share a

@@ -32,6 +32,14 @@ struct ProbeTarget {
   const std::int8_t* facing = nullptr;   // per BVH triangle (raycast::HitRule::facing: its sign)
 };
 
+// For BVH triangle t: the dot product of its front's (unnormalized) normal with `dir`: positive
+// when its front faces along dir.
+inline float front_along(const ProbeTarget& high, std::uint32_t t, const glm::vec3& dir) {
+  const std::uint32_t* v = high.index + 3 * std::size_t(t);
+  const glm::vec3 ng = glm::cross(high.positions[v[1]] - high.positions[v[0]], high.positions[v[2]] - high.positions[v[0]]);
+  return (high.facing[t] < 0 ? -1.0f : 1.0f) * glm::dot(ng, dir);
+}
+
 // The low-poly: re-centred positions (file vertices), 3 position indices per triangle, and the ray
 // normal of each position (unit, the same for positions with equal coordinates).
 struct CageBase {

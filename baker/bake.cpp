@@ -183,12 +183,13 @@ void run_parallel(int threads, Fn&& worker) {
   for (auto& t : pool) t.join();
 }
 
-// The cage's corners, re-centred, 3 per low-poly triangle (its topology is the low-poly's).
-void attach_cage(Prepared& s, const Mesh& cage) {
-  s.cage_pos = recentre(cage.positions, s.centre);
-  s.cage_tris.resize(cage.triangle_count());
+// The cage's corners, re-centred, 3 per low-poly triangle (its topology is the low-poly's: 3
+// position indices per triangle).
+void attach_cage(Prepared& s, const std::vector<glm::vec3>& positions, const std::vector<std::uint32_t>& index) {
+  s.cage_pos = recentre(positions, s.centre);
+  s.cage_tris.resize(index.size() / 3);
   for (std::size_t t = 0; t < s.cage_tris.size(); ++t)
-    for (int c = 0; c < 3; ++c) s.cage_tris[t].corner[c] = glm::dvec3(s.cage_pos[cage.position_index[3 * t + c]]);
+    for (int c = 0; c < 3; ++c) s.cage_tris[t].corner[c] = glm::dvec3(s.cage_pos[index[3 * t + c]]);
 }
 
 // A cage must enclose the low-poly: one whose vertices mostly lie inside it (moved against the ray
@@ -312,7 +313,7 @@ Prepared prepare(const Mesh& low, const Mesh& high, const Mesh* cage, BakeStats&
       s.low_tris[t].n[c] = glm::dvec3(s.frames.normal[3 * t + c]);
       s.low_tris[t].t[c] = glm::dvec4(s.frames.tangent[3 * t + c]);
     }
-  if (cage) attach_cage(s, *cage);
+  if (cage) attach_cage(s, cage->positions, cage->position_index);
   s.bvh_index = high.position_index.data();
   s.bvh_normals = s.high_corner_normals.data();
   s.bvh_facing = s.high_facing.data();
@@ -697,12 +698,9 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     // A back face: its front (by its normals) faces away from the low-poly's outside, +direction
     // of the outward probe (the first of a pair).
     std::vector<std::uint8_t> is_back(rays.size(), 0);
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-      if (!hits[i].hit()) continue;
-      const std::uint32_t* v = s.bvh_index + 3 * std::size_t(hits[i].triangle);
-      const glm::vec3 ng = glm::cross(s.high_pos[v[1]] - s.high_pos[v[0]], s.high_pos[v[2]] - s.high_pos[v[0]]);
-      is_back[i] = (s.bvh_facing[hits[i].triangle] < 0 ? -1.0f : 1.0f) * glm::dot(ng, rays[i & ~std::size_t(1)].direction) < 0.0f;
-    }
+    const ProbeTarget target{&*scene, s.high_pos.data(), s.bvh_index, s.bvh_facing};
+    for (std::size_t i = 0; i < rays.size(); ++i)
+      if (hits[i].hit()) is_back[i] = front_along(target, hits[i].triangle, rays[i & ~std::size_t(1)].direction) < 0.0f;
     for (std::size_t i = 0; i < pairs; ++i) {  // how the faces point: by the nearest hit either way
       const raycast::Hit &o = hits[2 * i], &in = hits[2 * i + 1];
       if (!o.hit() && !in.hit()) continue;
@@ -764,10 +762,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
       result.cage_positions.resize(low.positions.size());
       for (std::size_t i = 0; i < low.positions.size(); ++i)
         result.cage_positions[i] = glm::vec3(glm::dvec3(low.positions[i]) + double(ld.front[i]) * glm::dvec3(s.ray_normal[i]));
-      Mesh auto_mesh;
-      auto_mesh.positions = result.cage_positions;
-      auto_mesh.position_index = low.position_index;
-      attach_cage(s, auto_mesh);
+      attach_cage(s, result.cage_positions, low.position_index);
     }
     summarize(auto_cage ? ld.front : std::vector<float>(), st.vertex_front);
     summarize(ld.rear, st.vertex_rear);
@@ -1151,14 +1146,10 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
   const int threads = opt.threads > 0 ? opt.threads : std::max(1, int(std::thread::hardware_concurrency()));
   const int W = opt.width, H = opt.height;
   BakeStats scratch;
-  Mesh auto_mesh;  // the bake's automatic cage
-  if (!cage && !baked.cage_positions.empty()) {
-    auto_mesh.positions = baked.cage_positions;
-    auto_mesh.position_index = low.position_index;
-    cage = &auto_mesh;
-  }
   Prepared s = prepare(low, high, cage, scratch);
-  if (cage) set_cage_reach(s, low, st.rear, baked.vertex_rear, baked.vertex_search);
+  if (!cage && !baked.cage_positions.empty()) attach_cage(s, baked.cage_positions, low.position_index);  // the bake's automatic cage
+  const bool any_cage = !s.cage_tris.empty();
+  if (any_cage) set_cage_reach(s, low, st.rear, baked.vertex_rear, baked.vertex_search);
   if (st.high_facing == BakeStats::HighFacing::inverted) turn_inverted_high(s, scratch.high_normals_computed);
   // Few rays: a quick BVH build pays off more than a fast one to trace. All triangles: culling
   // leaves the hits unchanged.
@@ -1171,7 +1162,7 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
   RaySetup ray_setup;
   ray_setup.front = st.front;
   ray_setup.rear = st.rear;
-  ray_setup.cage = cage != nullptr;
+  ray_setup.cage = any_cage;
   ray_setup.closest = opt.policy == RayPolicy::closest;
   ray_setup.diagonal = s.diagonal;
   const int rays_per_sample = ray_setup.closest ? 2 : 1;
