@@ -34,14 +34,14 @@
 
 #include "accuracy_hard_assets.h"
 #include "accuracy_plot.h"
-#include "bake.h"
-#include "image_io.h"
-#include "mesh_io.h"
-#include "parallel.h"
+#include "pipeline/bake.h"
+#include "io/image_io.h"
+#include "io/mesh_io.h"
+#include "core/parallel.h"
 #include "procedural.h"
-#include "rasterize.h"
+#include "core/rasterize.h"
 #include "raycast.h"
-#include "tangent_frames.h"
+#include "core/tangent_frames.h"
 
 using namespace nmbake;
 namespace fs = std::filesystem;

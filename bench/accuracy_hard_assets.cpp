@@ -6,8 +6,8 @@
 #include <cstdio>
 #include <fstream>
 
-#include "bake.h"
-#include "errors.h"
+#include "pipeline/bake.h"
+#include "core/errors.h"
 #include "hard_asset_answers.h"
 #include "hard_assets.h"
 

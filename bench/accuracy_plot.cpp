@@ -7,7 +7,7 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 
-#include "errors.h"
+#include "core/errors.h"
 
 namespace nmbake::bench {
 

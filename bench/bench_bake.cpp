@@ -26,10 +26,10 @@
 #include <thread>
 #include <vector>
 
-#include "bake.h"
+#include "pipeline/bake.h"
 #include "bench_support.h"
-#include "image_io.h"
-#include "mesh_io.h"
+#include "io/image_io.h"
+#include "io/mesh_io.h"
 #include "raycast.h"
 
 using namespace nmbake;
@@ -111,7 +111,7 @@ std::vector<glm::vec3> recentred(const Mesh& high, const glm::dvec3& centre) {
   return pos;
 }
 
-// The BVH build quality the bake picks (bake.h), so the bare loop traces the same kind of tree.
+// The BVH build quality the bake picks (pipeline/bake.h), so the bare loop traces the same kind of tree.
 raycast::BuildQuality bake_quality(const BakeOptions& o, std::size_t kept_triangles) {
   return bvh_quality_for(o, kept_triangles);
 }
@@ -341,7 +341,7 @@ int main(int argc, char** argv) {
   std::printf("Load average %s.\n\n", load_average().c_str());
   std::printf("Each round runs the bake, then the bare loops, back to back on the rays the bake recorded; CPU = process CPU\n"
               "seconds (all threads), less disturbed by other load than wall time. The bare loops trace a BVH of the build quality\n"
-              "the bake picks (bvh_quality_for in bake.h: low below 16 rays per triangle, else high; column \"BVH\").\n"
+              "the bake picks (bvh_quality_for in pipeline/bake.h: low below 16 rays per triangle, else high; column \"BVH\").\n"
               "Targets (wall, trace / best bare): issue 2 <= 1.3x for 1 and 4 samples, issue 6 <= 1.15x for 1 and 16 samples.\n"
               "Bare loops: one rtcIntersect1 per ray; 8-wide packets (rtcIntersect8) filled from Ray structs; 8-wide packets from\n"
               "arrays already in Embree's packet layout (filled before the clock starts; the bake writes its rays this way). The\n"

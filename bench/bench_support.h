@@ -9,8 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "image.h"
-#include "mesh.h"
+#include "core/image.h"
+#include "core/mesh.h"
 #include "raycast.h"
 
 namespace nmbake::bench {

@@ -11,9 +11,9 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include "errors.h"
-#include "image_io.h"
-#include "mesh_io.h"
+#include "core/errors.h"
+#include "io/image_io.h"
+#include "io/mesh_io.h"
 #include "nmdiff.h"
 
 namespace {

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <cstdio>
 
-#include "errors.h"
-#include "rasterize.h"
+#include "core/errors.h"
+#include "core/rasterize.h"
 
 namespace nmbake::diff {
 namespace {

@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "image.h"
-#include "mesh.h"
+#include "core/image.h"
+#include "core/mesh.h"
 
 namespace nmbake::diff {
 

@@ -4,9 +4,9 @@
 
 #include <gtest/gtest.h>
 
-#include "bake.h"
+#include "pipeline/bake.h"
 #include "procedural.h"
-#include "rasterize.h"
+#include "core/rasterize.h"
 #include "raycast.h"
 #include "test_support.h"
 

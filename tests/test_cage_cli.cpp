@@ -13,8 +13,8 @@
 
 #include <gtest/gtest.h>
 
-#include "image_io.h"
-#include "mesh_io.h"
+#include "io/image_io.h"
+#include "io/mesh_io.h"
 #include "nmdiff.h"
 #include "test_support.h"
 

@@ -2,8 +2,8 @@
 // one without, bit for bit, while leaving the unreachable triangles out of the BVH.
 #include <gtest/gtest.h>
 
-#include "bake.h"
-#include "cull.h"
+#include "pipeline/bake.h"
+#include "core/cull.h"
 #include "test_support.h"
 
 using namespace nmbake;

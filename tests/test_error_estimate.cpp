@@ -5,8 +5,8 @@
 
 #include <gtest/gtest.h>
 
-#include "bake.h"
-#include "error_estimate.h"
+#include "pipeline/bake.h"
+#include "pipeline/error_estimate.h"
 #include "test_support.h"
 
 using namespace nmbake;

@@ -6,9 +6,9 @@
 
 #include <gtest/gtest.h>
 
-#include "bake.h"
-#include "image_io.h"
-#include "mesh_io.h"
+#include "pipeline/bake.h"
+#include "io/image_io.h"
+#include "io/mesh_io.h"
 #include "nmdiff.h"
 #include "test_support.h"
 

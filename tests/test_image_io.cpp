@@ -1,5 +1,5 @@
 // image_io: exact quantisation round trips, atomic writes, and the error kinds.
-#include "image_io.h"
+#include "io/image_io.h"
 
 #include <cmath>
 #include <filesystem>
@@ -12,7 +12,7 @@
 
 #include <gtest/gtest.h>
 
-#include "errors.h"
+#include "core/errors.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;

@@ -18,8 +18,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "errors.h"
-#include "mesh_io.h"
+#include "core/errors.h"
+#include "io/mesh_io.h"
 #include "test_support.h"
 
 namespace nmbake {

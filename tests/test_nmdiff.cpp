@@ -9,7 +9,7 @@
 
 #include <gtest/gtest.h>
 
-#include "errors.h"
+#include "core/errors.h"
 #include "test_support.h"
 
 using nmbake::Image;

@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-#include "padding.h"
+#include "core/padding.h"
 
 using namespace nmbake;
 

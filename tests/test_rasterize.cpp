@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "rasterize.h"
+#include "core/rasterize.h"
 #include "test_support.h"
 
 using namespace nmbake;

@@ -8,10 +8,10 @@
 
 #include <gtest/gtest.h>
 
-#include "bake.h"
+#include "pipeline/bake.h"
 #include "hard_asset_answers.h"
 #include "hard_assets.h"
-#include "mesh_io.h"
+#include "io/mesh_io.h"
 #include "test_support.h"
 
 using namespace nmbake;

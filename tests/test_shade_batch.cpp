@@ -6,8 +6,8 @@
 
 #include <gtest/gtest.h>
 
-#include "shade_batch.h"
-#include "tangent_frames.h"
+#include "trace/shade_batch.h"
+#include "core/tangent_frames.h"
 
 using namespace nmbake;
 

@@ -11,11 +11,11 @@
 
 #include <gtest/gtest.h>
 
-#include "bake.h"
-#include "image_io.h"
-#include "mesh_io.h"
-#include "mesh_topology.h"
-#include "rasterize.h"
+#include "pipeline/bake.h"
+#include "io/image_io.h"
+#include "io/mesh_io.h"
+#include "core/mesh_topology.h"
+#include "core/rasterize.h"
 #include "raycast.h"
 #include "test_support.h"
 

@@ -11,8 +11,8 @@
 
 #include <gtest/gtest.h>
 
-#include "rasterize.h"
-#include "tangent_frames.h"
+#include "core/rasterize.h"
+#include "core/tangent_frames.h"
 
 namespace nmbake::test {
 

@@ -9,9 +9,9 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
-#include "image.h"
+#include "core/image.h"
 
-#include "mesh.h"
+#include "core/mesh.h"
 
 namespace nmbake::test {
 

@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "tangent_frames.h"
+#include "core/tangent_frames.h"
 #include "test_support.h"
 
 using namespace nmbake;

@@ -7,8 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include "rasterize.h"
-#include "tile_kernels.h"
+#include "core/rasterize.h"
+#include "trace/tile_kernels.h"
 
 using namespace nmbake;
 

@@ -1,6 +1,6 @@
 #include "decoding.h"
 
-#include "errors.h"
+#include "core/errors.h"
 
 namespace nmview {
 namespace {

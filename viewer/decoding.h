@@ -10,7 +10,7 @@
 #include <map>
 #include <string>
 
-#include "tangent_frames.h"
+#include "core/tangent_frames.h"
 
 namespace nmview {
 

@@ -8,7 +8,7 @@
 #include <epoxy/gl.h>
 #include <GLFW/glfw3.h>
 
-#include "errors.h"
+#include "core/errors.h"
 
 namespace nmview {
 namespace {

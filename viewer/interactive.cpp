@@ -7,7 +7,7 @@
 #include <epoxy/gl.h>
 #include <GLFW/glfw3.h>
 
-#include "errors.h"
+#include "core/errors.h"
 #include "gl_context.h"
 
 namespace nmview {

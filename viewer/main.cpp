@@ -15,7 +15,7 @@
 #include <CLI/CLI.hpp>
 
 #include "compare.h"
-#include "errors.h"
+#include "core/errors.h"
 #include "gl_context.h"
 #include "interactive.h"
 #include "renderer.h"

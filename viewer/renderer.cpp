@@ -6,7 +6,7 @@
 
 #include <epoxy/gl.h>
 
-#include "errors.h"
+#include "core/errors.h"
 #include "font.h"
 #include "shaders.h"
 

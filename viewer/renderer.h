@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "decoding.h"
-#include "image.h"
+#include "core/image.h"
 #include "metrics.h"
 #include "vertex_data.h"
 #include "view.h"

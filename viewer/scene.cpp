@@ -2,11 +2,11 @@
 
 #include <algorithm>
 
-#include "errors.h"
-#include "image_io.h"
-#include "mesh_io.h"
-#include "normals.h"
-#include "tangent_frames.h"
+#include "core/errors.h"
+#include "io/image_io.h"
+#include "io/mesh_io.h"
+#include "core/normals.h"
+#include "core/tangent_frames.h"
 
 namespace nmview {
 

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "decoding.h"
-#include "image.h"
+#include "core/image.h"
 #include "metrics.h"
 #include "vertex_data.h"
 

@@ -13,8 +13,8 @@
 
 #include <glm/glm.hpp>
 
-#include "mesh.h"
-#include "tangent_frames.h"
+#include "core/mesh.h"
+#include "core/tangent_frames.h"
 
 namespace nmview {
 

@@ -14,10 +14,10 @@
 #include <string>
 #include <string_view>
 
-#include "errors.h"
-#include "mesh_io.h"
-#include "normals.h"
-#include "tangent_frames.h"
+#include "core/errors.h"
+#include "io/mesh_io.h"
+#include "core/normals.h"
+#include "core/tangent_frames.h"
 
 namespace {
 

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "rasterize.h"
-#include "tangent_frames.h"
-#include "parallel.h"
+#include "core/rasterize.h"
+#include "core/tangent_frames.h"
+#include "core/parallel.h"
 
 namespace nmbake::procedural {
 

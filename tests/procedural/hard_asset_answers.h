@@ -10,7 +10,7 @@
 
 #include <glm/glm.hpp>
 
-#include "bake.h"
+#include "pipeline/bake.h"
 #include "hard_assets.h"
 
 namespace nmbake::procedural {

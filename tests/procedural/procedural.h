@@ -6,7 +6,7 @@
 
 #include <glm/glm.hpp>
 
-#include "mesh.h"
+#include "core/mesh.h"
 
 namespace nmbake::procedural {
 

@@ -6,8 +6,8 @@
 
 #include <glm/glm.hpp>
 
-#include "image.h"
-#include "image_io.h"
+#include "core/image.h"
+#include "io/image_io.h"
 
 namespace nmview::test {
 namespace {

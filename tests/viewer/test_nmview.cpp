@@ -24,8 +24,8 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
-#include "image.h"
-#include "image_io.h"
+#include "core/image.h"
+#include "io/image_io.h"
 #include "scene_maker.h"
 #include "test_support.h"
 

@@ -7,12 +7,12 @@
 #include <gtest/gtest.h>
 
 #include "decoding.h"
-#include "errors.h"
+#include "core/errors.h"
 #include "font.h"
 #include "gl_context.h"
 #include "metrics.h"
 #include "renderer.h"
-#include "tangent_frames.h"
+#include "core/tangent_frames.h"
 #include "test_support.h"
 #include "vertex_data.h"
 #include "view.h"

@@ -5,7 +5,7 @@
 #include <random>
 #include <string>
 
-#include "image_io.h"
+#include "io/image_io.h"
 
 namespace {
 

@@ -1,0 +1,151 @@
+#include "cli/report.h"
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+
+#include "core/errors.h"
+
+namespace nmbake {
+
+const char* to_string(RayPolicy p) { return p == RayPolicy::closest ? "closest" : "cage-first"; }
+const char* to_string(NormalSpace s) { return s == NormalSpace::object ? "object" : "tangent"; }
+const char* to_string(BitangentMode m) { return m == BitangentMode::per_vertex ? "vertex" : "pixel"; }
+
+std::uint64_t peak_memory_bytes() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return std::uint64_t(ru.ru_maxrss) * 1024;  // Linux reports KiB
+}
+
+nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunInfo& r) {
+  using nlohmann::json;
+  json options = {
+      {"low", r.low_path},
+      {"high", r.high_path},
+      {"cage", r.cage_path.empty() ? json(nullptr) : json(r.cage_path)},
+      {"output", r.output_path},
+      {"miss_mask", r.miss_mask_path.empty() ? json(nullptr) : json(r.miss_mask_path)},
+      {"suspect_mask", r.suspect_mask_path.empty() ? json(nullptr) : json(r.suspect_mask_path)},
+      {"size", {o.width, o.height}},
+      {"samples", o.samples},
+      {"front", s.front},
+      {"rear", s.rear},
+      {"front_rear_auto", s.auto_distances},
+      {"policy", to_string(o.policy)},
+      {"space", to_string(o.space)},
+      {"green", o.green_down ? "down" : "up"},
+      {"bitangent", to_string(o.bitangent)},
+      {"bits", r.bits},
+      {"padding", o.padding},
+      {"threads", r.threads_used},
+      {"cull", o.cull_far},
+      {"keep_backfaces", o.keep_backfaces},
+  };
+  auto mesh_json = [](const MeshLoadInfo& info, std::size_t triangles) {
+    return json{{"format", info.format},
+                {"faces", info.file_faces},
+                {"triangles", triangles},
+                {"polygons_triangulated", info.polygons_triangulated},
+                {"normals_renormalized", info.normals_renormalized},
+                {"zero_normals", info.zero_normals}};
+  };
+  json report = {
+      {"nmbake_version", NMBAKE_VERSION},
+      {"options", options},
+      {"seconds",
+       {{"load", r.seconds_load},
+        {"prepare", s.seconds_prepare},
+        {"bvh", s.seconds_bvh},
+        {"distances", s.seconds_distances},
+        {"trace", s.seconds_trace},
+        {"padding", s.seconds_padding},
+        {"write", r.seconds_write},
+        {"total", r.seconds_total}}},
+      {"rays", s.rays},
+      {"rays_per_second", s.seconds_trace > 0 ? double(s.rays) / s.seconds_trace : 0.0},
+      {"samples_covered", s.samples_covered},
+      {"hits", s.hits},
+      {"misses", s.misses},
+      {"texels", {{"total", s.texels_total}, {"covered", s.texels_covered}, {"padded", s.texels_padded}}},
+      {"coverage", s.coverage},
+      {"hit_distance", {{"min", s.hit_distance_min}, {"mean", s.hit_distance_mean}, {"max", s.hit_distance_max}}},
+      {"auto_distance_probes_beyond", s.auto_probe_beyond},
+      {"degenerate",
+       {{"uv_triangles", s.degenerate_uv_triangles},
+        {"triangles_3d", s.degenerate_3d_triangles},
+        {"corners_without_tangent", s.corners_without_tangent}}},
+      {"uv_outside_triangles", s.uv_outside_triangles},
+      {"overlapping_samples", s.overlapping_samples},
+      {"low_mesh", mesh_json(r.low_info, s.low_triangles)},
+      {"high_mesh", mesh_json(r.high_info, s.high_triangles)},
+      {"high_normals_computed", s.high_normals_computed},
+      {"peak_memory_bytes", r.peak_memory_bytes},
+      {"uv_outside_entirely_triangles", s.uv_outside_entirely_triangles},
+      {"high_faces_reoriented", s.high_faces_reoriented},
+      {"texels_facing_away", s.texels_facing_away},
+      {"backfaces_skipped", s.backfaces_skipped},
+      {"backface_skips", s.backface_skips},
+      {"backface_probe_share", s.backface_probe_share},
+      {"high_facing", s.high_facing == BakeStats::HighFacing::inverted ? "inverted"
+                      : s.high_facing == BakeStats::HighFacing::mixed  ? "mixed"
+                                                                       : "sound"},
+      {"hits_facing_away", s.hits_facing_away},
+      {"suspect_texels", s.suspect_texels},
+      {"suspect_share", s.suspect_share},
+      {"suspect_region",
+       {{"u", {s.suspect_region[0], s.suspect_region[2]}},
+        {"v", {s.suspect_region[1], s.suspect_region[3]}},
+        {"share", s.suspect_region_share}}},
+      {"cage",
+       {{"source", s.cage == BakeStats::CageSource::automatic ? "automatic"
+                   : s.cage == BakeStats::CageSource::file    ? "file"
+                                                              : "none"},
+        {"front", {{"min", s.vertex_front.min}, {"mean", s.vertex_front.mean}, {"max", s.vertex_front.max}}},
+        {"rear", {{"min", s.vertex_rear.min}, {"mean", s.vertex_rear.mean}, {"max", s.vertex_rear.max}}},
+        {"scene_front", s.scene_front},
+        {"scene_rear", s.scene_rear},
+        {"front_limited_vertices", s.cage_front_limited},
+        {"rear_limited_vertices", s.cage_rear_limited}}},
+      {"coordinate_spacing", s.coordinate_spacing},
+      {"largest_coordinate", s.largest_coordinate},
+  };
+  const MeshTopology& t = r.high_topology;
+  json& high = report["high_mesh"];
+  high["welded_vertices"] = t.welded_vertices;
+  high["isolated_vertices"] = t.isolated_vertices;
+  high["duplicate_faces"] = t.duplicate_faces;
+  high["boundary_edges"] = t.boundary_edges;
+  high["non_manifold_edges"] = t.non_manifold_edges;
+  high["inconsistent_winding_faces"] = t.inconsistent_winding_faces;
+  high["triangles_culled"] = s.high_triangles_culled;
+  report["bvh_quality"] = s.bvh_quality == raycast::BuildQuality::low      ? "low"
+                          : s.bvh_quality == raycast::BuildQuality::medium ? "medium"
+                                                                           : "high";
+  return report;
+}
+
+void write_text_atomically(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw OutputError(path + ": cannot write: " + std::strerror(errno));
+    out << text;
+    out.flush();
+    if (!out) {
+      std::remove(tmp.c_str());
+      throw OutputError(path + ": cannot write: " + std::strerror(errno));
+    }
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const int err = errno;
+    std::remove(tmp.c_str());
+    throw OutputError(path + ": cannot write: " + std::strerror(err));
+  }
+}
+
+}  // namespace nmbake

@@ -1,0 +1,37 @@
+// The --report JSON of a bake, and atomic text output.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "pipeline/bake.h"
+#include "core/mesh.h"
+#include "core/mesh_topology.h"
+
+namespace nmbake {
+
+struct RunInfo {
+  std::string low_path, high_path, cage_path, output_path, miss_mask_path, suspect_mask_path;
+  int bits = 8;
+  MeshLoadInfo low_info, high_info, cage_info;
+  MeshTopology high_topology;  // inspect_topology(high)
+  double seconds_load = 0, seconds_write = 0, seconds_total = 0;
+  std::uint64_t peak_memory_bytes = 0;
+  unsigned threads_used = 0;
+};
+
+const char* to_string(RayPolicy p);
+const char* to_string(NormalSpace s);
+const char* to_string(BitangentMode m);
+
+nlohmann::json make_report(const BakeOptions& options, const BakeStats& stats, const RunInfo& run);
+
+// Writes `text` to a temporary file beside `path` and renames it into place; OutputError on failure.
+void write_text_atomically(const std::string& path, const std::string& text);
+
+// Peak resident memory of this process so far (bytes).
+std::uint64_t peak_memory_bytes();
+
+}  // namespace nmbake

@@ -1,0 +1,79 @@
+#include "core/cull.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace nmbake {
+
+std::vector<std::uint32_t> triangles_near(const std::vector<Box>& regions, double margin,
+                                          const std::vector<glm::vec3>& positions,
+                                          const std::vector<std::uint32_t>& indices,
+                                          const std::vector<std::uint32_t>* candidates) {
+  const std::size_t tris = indices.size() / 3;
+  std::vector<std::uint32_t> kept;
+  if (regions.empty()) return kept;
+  // Grown regions and their union.
+  std::vector<Box> grown(regions.size());
+  Box all{glm::dvec3(std::numeric_limits<double>::max()), glm::dvec3(-std::numeric_limits<double>::max())};
+  glm::dvec3 mean_extent(0.0);
+  for (std::size_t i = 0; i < regions.size(); ++i) {
+    grown[i] = {regions[i].lo - margin, regions[i].hi + margin};
+    all.lo = glm::min(all.lo, grown[i].lo);
+    all.hi = glm::max(all.hi, grown[i].hi);
+    mean_extent += grown[i].hi - grown[i].lo;
+  }
+  mean_extent /= double(regions.size());
+  // A grid over the union with about 8 cells per region, but cells no smaller than half a mean
+  // region, so that marking touches a bounded number of cells per region.
+  const glm::dvec3 extent = glm::max(all.hi - all.lo, glm::dvec3(1e-30));
+  const double target_cells = std::clamp(8.0 * double(regions.size()), 4096.0, double(1 << 22));
+  double h = std::cbrt(extent.x * extent.y * extent.z / target_cells);
+  h = std::max({h, 0.5 * std::max({mean_extent.x, mean_extent.y, mean_extent.z}), 1e-30});
+  int dim[3];
+  for (int a = 0; a < 3; ++a) dim[a] = int(std::clamp(std::ceil(extent[a] / h), 1.0, 512.0));
+  const glm::dvec3 inv(dim[0] / extent.x, dim[1] / extent.y, dim[2] / extent.z);
+  auto cell_range = [&](const glm::dvec3& lo, const glm::dvec3& hi, int c0[3], int c1[3]) {
+    for (int a = 0; a < 3; ++a) {
+      c0[a] = int(std::clamp(std::floor((lo[a] - all.lo[a]) * inv[a]), 0.0, double(dim[a] - 1)));
+      c1[a] = int(std::clamp(std::floor((hi[a] - all.lo[a]) * inv[a]), 0.0, double(dim[a] - 1)));
+    }
+  };
+  std::vector<std::uint8_t> marked(std::size_t(dim[0]) * dim[1] * dim[2], 0);
+  for (const Box& b : grown) {
+    int c0[3], c1[3];
+    cell_range(b.lo, b.hi, c0, c1);
+    for (int z = c0[2]; z <= c1[2]; ++z)
+      for (int y = c0[1]; y <= c1[1]; ++y)
+        for (int x = c0[0]; x <= c1[0]; ++x) marked[(std::size_t(z) * dim[1] + y) * dim[0] + x] = 1;
+  }
+  auto near = [&](std::size_t t) {
+    glm::dvec3 lo(positions[indices[3 * t]]), hi = lo;
+    for (int c = 1; c < 3; ++c) {
+      const glm::dvec3 p(positions[indices[3 * t + c]]);
+      lo = glm::min(lo, p);
+      hi = glm::max(hi, p);
+    }
+    // NaN-free inputs are the loader's promise; a box outside the union cannot overlap a region.
+    for (int a = 0; a < 3; ++a)
+      if (!(hi[a] >= all.lo[a] && lo[a] <= all.hi[a])) return false;
+    int c0[3], c1[3];
+    cell_range(lo, hi, c0, c1);
+    for (int z = c0[2]; z <= c1[2]; ++z)
+      for (int y = c0[1]; y <= c1[1]; ++y)
+        for (int x = c0[0]; x <= c1[0]; ++x)
+          if (marked[(std::size_t(z) * dim[1] + y) * dim[0] + x]) return true;
+    return false;
+  };
+  if (candidates) {
+    for (std::uint32_t t : *candidates)
+      if (near(t)) kept.push_back(t);
+  } else {
+    kept.reserve(tris);
+    for (std::size_t t = 0; t < tris; ++t)
+      if (near(t)) kept.push_back(std::uint32_t(t));
+  }
+  return kept;
+}
+
+}  // namespace nmbake

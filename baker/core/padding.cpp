@@ -1,0 +1,128 @@
+#include "core/padding.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <thread>
+
+namespace nmbake {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// 1D squared distance transform of sampled function f (Felzenszwalb and Huttenlocher 2012):
+// d[q] = min_p (f[p] + (q - p)^2), arg[q] = the minimizing p (or -1 when all f are infinite).
+void distance_1d(const double* f, int n, double* d, int* arg, int* v, double* z) {
+  int k = -1;
+  for (int q = 0; q < n; ++q) {
+    if (f[q] == kInf) continue;
+    if (k < 0) {
+      k = 0;
+      v[0] = q;
+      z[0] = -kInf;
+      z[1] = kInf;
+      continue;
+    }
+    // z[0] = -inf stops the loop at k = 0, since s is finite.
+    double s = 0.0;
+    while (true) {
+      const int p = v[k];
+      s = ((f[q] + double(q) * q) - (f[p] + double(p) * p)) / (2.0 * (q - p));
+      if (s <= z[k]) {
+        --k;
+        continue;
+      }
+      break;
+    }
+    ++k;
+    v[k] = q;
+    z[k] = s;
+    z[k + 1] = kInf;
+  }
+  if (k < 0) {
+    for (int q = 0; q < n; ++q) {
+      d[q] = kInf;
+      arg[q] = -1;
+    }
+    return;
+  }
+  int j = 0;
+  for (int q = 0; q < n; ++q) {
+    while (z[j + 1] < q) ++j;
+    const int p = v[j];
+    d[q] = double(q - p) * (q - p) + f[p];
+    arg[q] = p;
+  }
+}
+
+}  // namespace
+
+std::size_t pad_islands(Image& image, const std::vector<std::uint8_t>& covered, int padding, int threads) {
+  if (padding <= 0) return 0;
+  const int w = image.width, h = image.height;
+  const std::size_t n = std::size_t(w) * h;
+  // Nothing to fill from, or nothing to fill: skip the distance transform.
+  const std::size_t covered_count = std::size_t(std::count_if(covered.begin(), covered.end(), [](std::uint8_t c) { return c != 0; }));
+  if (covered_count == 0 || covered_count == n) return 0;
+  if (threads <= 0) threads = std::max(1, int(std::thread::hardware_concurrency()));
+  // Both passes split into independent parts (columns, then rows) shared out to the threads; each
+  // part's result is the same whichever thread computes it.
+  auto parallel = [threads](int parts, auto&& part) {
+    std::atomic<int> next{0};
+    auto worker = [&] {
+      for (int i; (i = next.fetch_add(1)) < parts;) part(i);
+    };
+    std::vector<std::thread> pool;
+    for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
+    worker();
+    for (auto& t : pool) t.join();
+  };
+  // Pass 1, columns: squared distance to the nearest covered texel in the same column. Columns go
+  // in blocks of kBlock neighbours, so the image is read and written a row segment at a time.
+  constexpr int kBlock = 16;
+  std::vector<double> g(n);
+  std::vector<int> gy(n);
+  const int m = std::max(w, h);
+  parallel((w + kBlock - 1) / kBlock, [&](int block) {
+    const int x0 = block * kBlock, nb = std::min(kBlock, w - x0);
+    std::vector<double> f(std::size_t(kBlock) * h), d(std::size_t(kBlock) * h), z(m + 1);
+    std::vector<int> arg(std::size_t(kBlock) * h), v(m);
+    for (int y = 0; y < h; ++y)
+      for (int j = 0; j < nb; ++j) f[std::size_t(j) * h + y] = covered[std::size_t(y) * w + x0 + j] ? 0.0 : kInf;
+    for (int j = 0; j < nb; ++j)
+      distance_1d(&f[std::size_t(j) * h], h, &d[std::size_t(j) * h], &arg[std::size_t(j) * h], v.data(), z.data());
+    for (int y = 0; y < h; ++y)
+      for (int j = 0; j < nb; ++j) {
+        g[std::size_t(y) * w + x0 + j] = d[std::size_t(j) * h + y];
+        gy[std::size_t(y) * w + x0 + j] = arg[std::size_t(j) * h + y];
+      }
+  });
+  // Pass 2, rows: combine into the exact Euclidean nearest covered texel, then copy it. A row
+  // writes only its own uncovered texels and reads only covered ones.
+  const double limit = double(padding) * padding;
+  constexpr int kRows = 16;
+  std::vector<std::size_t> filled((h + kRows - 1) / kRows, 0);
+  parallel(int(filled.size()), [&](int part) {
+    std::vector<double> d(m), z(m + 1);
+    std::vector<int> arg(m), v(m);
+    for (int y = part * kRows; y < std::min(h, (part + 1) * kRows); ++y) {
+      const double* row = &g[std::size_t(y) * w];
+      distance_1d(row, w, d.data(), arg.data(), v.data(), z.data());
+      for (int x = 0; x < w; ++x) {
+        if (covered[std::size_t(y) * w + x] || arg[x] < 0 || d[x] > limit) continue;
+        const int sx = arg[x], sy = gy[std::size_t(y) * w + sx];
+        const float* src = image.at(sx, sy);
+        float* dst = image.at(x, y);
+        for (int c = 0; c < image.channels; ++c) dst[c] = src[c];
+        ++filled[std::size_t(part)];
+      }
+    }
+  });
+  std::size_t total = 0;
+  for (std::size_t f : filled) total += f;
+  return total;
+}
+
+}  // namespace nmbake

@@ -1,0 +1,63 @@
+// Reading and writing images through OpenImageIO: the only code that includes OpenImageIO.
+//
+// Two builds of the same interface: image_io.cpp links OpenImageIO directly (the library nmbake::io
+// that nmdiff, nmview and the tests use); the nmbake command instead loads it as a module on a
+// background thread (image_io_loader.cpp), because loading OpenImageIO and its ~260 libraries takes
+// a sizeable part of a quick bake.
+#pragma once
+
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/image.h"
+
+namespace nmbake {
+
+// Bit depth implied by a file name: .png -> 8, .tif/.tiff -> 16, .exr -> 32 (float), others 8.
+int default_bits_for(const std::string& path);
+
+// Throws UsageError when the extension is not one OpenImageIO can write, or the format cannot hold
+// `bits` (8, 16 or 32; 32 means float: EXR and TIFF only; EXR with 16 is half float).
+void check_output_format(const std::string& path, int bits);
+
+struct WriteOptions {
+  int bits = 0;  // 8, 16 or 32 (float); 0 = default_bits_for(path)
+  std::vector<std::pair<std::string, std::string>> metadata;  // written as string attributes
+};
+
+// Writes `image` (values in [0,1] for integer formats, rounded to nearest) to a temporary file in
+// the same folder and renames it into place, so `path` is either the old file or the complete new
+// one. Throws OutputError (file named) when it cannot be written.
+void write_image(const std::string& path, const Image& image, const WriteOptions& options = {});
+
+// Reads any format OpenImageIO reads, converted to float (integer formats scaled to [0,1]).
+// Throws InputError naming the file when it cannot be read.
+Image read_image(const std::string& path);
+
+// The string attributes stored with an image (e.g. "nmbake:green" -> "down", as the baker writes
+// them with WriteOptions::metadata), including "nmbake:key=value" items of the description tag,
+// where TIFF keeps them. Reads the header only. Throws InputError naming the file when it cannot
+// be opened.
+std::map<std::string, std::string> read_image_metadata(const std::string& path);
+
+// Starts loading the image library in the background where it is a module (the nmbake command);
+// does nothing where it is linked. Optional: the functions above load it when first called.
+void preload_image_io();
+
+// Waits until a background load started by preload_image_io() has finished (at once where there
+// is none). Call before the process exits: exiting while the library's static constructors run
+// can abort (one of OpenImageIO's plugins, gdcm, asserts), which turned an early error's exit
+// code 2 into an abort.
+void wait_for_image_io();
+
+// Why images cannot be written, found without waiting for the background load (the module file
+// is missing or already failed to load), or "" (always "" where OpenImageIO is linked).
+std::string image_io_problem();
+
+namespace image_io_detail {
+std::string lower_extension(const std::string& path);  // ".png" for "A/b.PNG"
+}
+
+}  // namespace nmbake

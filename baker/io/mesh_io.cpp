@@ -1,0 +1,250 @@
+// load_mesh(): reads the file once into memory, hands it to the reader for its extension, then
+// applies the checks and repairs every format shares. The readers live in mesh_io_obj.cpp,
+// mesh_io_ply.cpp and mesh_io_openmesh.cpp (OFF, STL).
+#include "io/mesh_io.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <new>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/errors.h"
+#include "io/mesh_io_detail.h"
+
+namespace nmbake {
+namespace {
+
+using mesh_io_detail::fail;
+using mesh_io_detail::ParsedMesh;
+
+// A normal shorter than this carries no direction; a file normal off unit length by more than
+// kUnitTolerance is counted as renormalized (6-digit exports are never exactly unit, which is fine).
+constexpr float kZeroNormalLength = 1e-6f;
+constexpr float kUnitTolerance = 1e-3f;
+
+std::string lower_extension(const std::string& path) {
+  std::size_t slash = path.find_last_of('/');
+  std::size_t dot = path.find_last_of('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+  std::string ext = path.substr(dot + 1);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+std::string cannot_open(int error) { return std::string("cannot open: ") + std::strerror(error); }
+
+// Non-regular files are refused so a FIFO or a device cannot block or flood us.
+void check_regular_file(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) fail(path, cannot_open(errno));
+  if (S_ISDIR(st.st_mode)) fail(path, "is a directory");
+  if (!S_ISREG(st.st_mode)) fail(path, "is not a regular file");
+}
+
+// The whole file in one read.
+std::string read_file(const std::string& path) {
+  int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) fail(path, cannot_open(errno));
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) {
+    int error = errno;
+    ::close(fd);
+    fail(path, cannot_open(error));
+  }
+  std::string bytes;
+  try {
+    bytes.resize(static_cast<std::size_t>(st.st_size));
+  } catch (const std::bad_alloc&) {
+    ::close(fd);
+    throw ResourceError(path + ": out of memory reading " + std::to_string(st.st_size) + " bytes");
+  }
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    ssize_t n = ::read(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      int error = errno;
+      ::close(fd);
+      fail(path, std::string("cannot read: ") + std::strerror(error));
+    }
+    if (n == 0) break;  // the file shrank while we read it
+    done += static_cast<std::size_t>(n);
+  }
+  ::close(fd);
+  bytes.resize(done);
+  return bytes;
+}
+
+bool is_whitespace_only(std::string_view bytes) {
+  for (char c : bytes)
+    if (!mesh_io_detail::is_space(c)) return false;
+  return true;
+}
+
+// A byte-order mark, or ASCII characters interleaved with zero bytes.
+bool looks_like_utf16(std::string_view b) {
+  auto byte = [&](std::size_t i) { return static_cast<unsigned char>(b[i]); };
+  if (b.size() >= 2 && ((byte(0) == 0xFE && byte(1) == 0xFF) || (byte(0) == 0xFF && byte(1) == 0xFE))) return true;
+  if (b.size() < 4) return false;
+  bool big_endian = byte(0) == 0 && byte(1) != 0 && byte(2) == 0 && byte(3) != 0;
+  bool little_endian = byte(0) != 0 && byte(1) == 0 && byte(2) != 0 && byte(3) == 0;
+  return big_endian || little_endian;
+}
+
+std::string_view skip_utf8_bom(std::string_view text) {
+  if (text.size() >= 3 && text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
+  return text;
+}
+
+ParsedMesh parse_by_extension(const std::string& path, const std::string& ext, std::string_view bytes) {
+  if (ext == "obj") return mesh_io_detail::parse_obj(path, skip_utf8_bom(bytes));
+  if (ext == "ply") return mesh_io_detail::parse_ply(path, bytes);
+  if (ext == "off") return mesh_io_detail::parse_off(path, skip_utf8_bom(bytes));
+  return mesh_io_detail::parse_stl(path, bytes);
+}
+
+// Keeps UVs only when every face has them.
+void settle_uvs(ParsedMesh& parsed, const std::string& path, const LoadOptions& options, MeshLoadInfo& info) {
+  Mesh& m = parsed.mesh;
+  if (parsed.faces_with_uvs == parsed.faces) return;
+  if (options.require_uvs) fail(path, parsed.first_face_without_uvs + " has no UVs");
+  if (parsed.faces_with_uvs > 0) {
+    info.uvs_dropped = true;
+    info.faces_without_uvs = parsed.faces - parsed.faces_with_uvs;
+  }
+  m.uv_index.clear();
+  m.uvs.clear();
+}
+
+// Keeps normals only when every face has them and none is ~zero; makes the kept ones unit length.
+void settle_normals(ParsedMesh& parsed, MeshLoadInfo& info) {
+  Mesh& m = parsed.mesh;
+  bool keep = parsed.faces_with_normals == parsed.faces;
+  if (!keep && parsed.faces_with_normals > 0) {
+    info.normals_dropped = true;
+    info.faces_without_normals = parsed.faces - parsed.faces_with_normals;
+  }
+  if (keep) {
+    // Only normals some corner uses count: an unused zero normal in an OBJ harms nobody.
+    std::vector<bool> used(m.normals.size(), false);
+    for (std::uint32_t i : m.normal_index) used[i] = true;
+    for (std::size_t i = 0; i < m.normals.size(); ++i) {
+      if (!used[i]) continue;
+      // In double: the squared length of a float normal with components near 1e20 or more
+      // overflows float, and dividing by an infinite length would give a zero normal.
+      const glm::dvec3 n(m.normals[i]);
+      const double length = glm::length(n);
+      if (length < kZeroNormalLength) {
+        ++info.zero_normals;
+        continue;
+      }
+      if (std::fabs(length - 1.0) > kUnitTolerance) ++info.normals_renormalized;
+      m.normals[i] = glm::vec3(n / length);
+    }
+    if (info.zero_normals > 0) {
+      keep = false;
+      info.normals_dropped = true;
+      info.normals_renormalized = 0;
+    }
+  }
+  if (!keep) {
+    m.normal_index.clear();
+    m.normals.clear();
+  }
+}
+
+Mesh finish_mesh(ParsedMesh parsed, const std::string& path, const LoadOptions& options, MeshLoadInfo& info) {
+  if (parsed.faces == 0) fail(path, "no faces");
+  info.format = parsed.format;
+  info.file_faces = parsed.file_faces;
+  info.polygons_triangulated = parsed.polygons_triangulated;
+  info.degenerate_faces_dropped = parsed.degenerate_faces_dropped;
+  settle_uvs(parsed, path, options, info);
+  settle_normals(parsed, info);
+  parsed.mesh.source = path;
+  return std::move(parsed.mesh);
+}
+
+void check_extension(const std::string& path) {
+  std::string ext = lower_extension(path);
+  if (ext != "obj" && ext != "ply" && ext != "off" && ext != "stl")
+    fail(path, (ext.empty() ? std::string("has no file extension") : "unknown file type '." + ext + "'") +
+                   "; supported: .obj .ply .off .stl");
+}
+
+Mesh parse_bytes(const std::string& path, std::string_view bytes, const LoadOptions& options, MeshLoadInfo& info) {
+  const std::string ext = lower_extension(path);
+  if (bytes.empty() || is_whitespace_only(bytes)) fail(path, "file is empty");
+  // Binary STL is the only binary format whose first bytes are arbitrary.
+  if (!(ext == "stl" && mesh_io_detail::is_binary_stl(bytes)) && looks_like_utf16(bytes))
+    fail(path, "looks like UTF-16 text; save it as UTF-8");
+  return finish_mesh(parse_by_extension(path, ext, bytes), path, options, info);
+}
+
+}  // namespace
+
+Mesh load_mesh_from_memory(const std::string& name, std::string_view bytes, const LoadOptions& options,
+                           MeshLoadInfo* info) {
+  MeshLoadInfo local_info;
+  MeshLoadInfo& out_info = info ? *info : local_info;
+  out_info = MeshLoadInfo{};
+  try {
+    check_extension(name);
+    return parse_bytes(name, bytes, options, out_info);
+  } catch (const std::bad_alloc&) {
+    throw ResourceError(name + ": out of memory while loading");
+  } catch (const std::length_error&) {
+    throw ResourceError(name + ": out of memory while loading");
+  }
+}
+
+Mesh load_mesh(const std::string& path, const LoadOptions& options, MeshLoadInfo* info) {
+  MeshLoadInfo local_info;
+  MeshLoadInfo& out_info = info ? *info : local_info;
+  out_info = MeshLoadInfo{};
+  try {
+    check_regular_file(path);
+    check_extension(path);
+    return parse_bytes(path, read_file(path), options, out_info);
+  } catch (const std::bad_alloc&) {
+    throw ResourceError(path + ": out of memory while loading");
+  } catch (const std::length_error&) {
+    throw ResourceError(path + ": out of memory while loading");
+  }
+}
+
+std::string obj_text(const Mesh& mesh, const std::string& comment) {
+  std::string out = "# " + comment + "\n";
+  char line[160];
+  for (const glm::vec3& p : mesh.positions) {
+    std::snprintf(line, sizeof line, "v %.9g %.9g %.9g\n", double(p.x), double(p.y), double(p.z));
+    out += line;
+  }
+  for (const glm::vec2& t : mesh.uvs) {
+    std::snprintf(line, sizeof line, "vt %.9g %.9g\n", double(t.x), double(t.y));
+    out += line;
+  }
+  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+    out += "f";
+    for (int c = 0; c < 3; ++c) {
+      if (mesh.has_uvs())
+        std::snprintf(line, sizeof line, " %u/%u", mesh.position_index[3 * t + c] + 1, mesh.uv_index[3 * t + c] + 1);
+      else
+        std::snprintf(line, sizeof line, " %u", mesh.position_index[3 * t + c] + 1);
+      out += line;
+    }
+    out += "\n";
+  }
+  return out;
+}
+
+}  // namespace nmbake

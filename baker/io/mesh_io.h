@@ -1,0 +1,34 @@
+// Loading meshes from OBJ, PLY (ascii and binary), OFF and STL. The only code that includes
+// OpenMesh.
+//
+// Every error in the file throws InputError with the file name and the element, e.g.
+// "high.ply: vertex 17 has a non-finite coordinate" or "low.obj: line 812: face index 9001 out of
+// range (8000 vertices)". Polygons are fanned into triangles. Nothing is rescaled.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "core/mesh.h"
+
+namespace nmbake {
+
+struct LoadOptions {
+  bool require_uvs = false;  // throw "<file>: face N has no UVs" when any face lacks them
+};
+
+// Reads `path`. Throws InputError on a missing, empty, unreadable or invalid file (no faces,
+// non-finite coordinates, indices out of range, truncated binary data, ...).
+Mesh load_mesh(const std::string& path, const LoadOptions& options = {}, MeshLoadInfo* info = nullptr);
+
+// The same checks and parsing on a file's bytes already in memory: `name` picks the reader by its
+// extension and names the file in messages (the fuzz target, tests/fuzz, uses this).
+Mesh load_mesh_from_memory(const std::string& name, std::string_view bytes, const LoadOptions& options = {},
+                           MeshLoadInfo* info = nullptr);
+
+// The mesh as OBJ text: positions (each float exactly, %.9g), UVs when it has them, and its
+// triangles (v/vt), in the mesh's own vertex order, so reading it back gives the same arrays.
+// `comment` becomes the first line (after "# ").
+std::string obj_text(const Mesh& mesh, const std::string& comment);
+
+}  // namespace nmbake

@@ -1,0 +1,132 @@
+// Internals shared by the mesh readers (mesh_io*.cpp). Not part of the library's interface.
+//
+// Each reader turns the whole file, already in memory, into a ParsedMesh; load_mesh() then applies
+// the checks and repairs every format shares (no faces, partial normals or UVs, zero normals).
+// Element numbers in messages follow the format's own indexing so a user can find them in the
+// file: OBJ counts vertices and faces from 1 and names lines, PLY, OFF and STL count from 0.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <string_view>
+
+#include "core/errors.h"
+#include "core/mesh.h"
+
+namespace nmbake::mesh_io_detail {
+
+// A reader's result. Every corner gets a slot in normal_index and uv_index (0 for a face that has
+// none), so that per-corner arrays stay aligned; load_mesh() clears them when they are unusable.
+// A reader that knows up front the file has no UVs (normals) turns the slots off.
+struct ParsedMesh {
+  Mesh mesh;
+  bool corner_uvs = true;
+  bool corner_normals = true;
+  std::string format;  // see MeshLoadInfo::format
+  std::size_t file_faces = 0;
+  std::size_t faces = 0;  // faces that became triangles
+  std::size_t polygons_triangulated = 0;
+  std::size_t faces_with_uvs = 0;
+  std::size_t faces_with_normals = 0;
+  std::string first_face_without_uvs;  // "line 40: face 3" or "face 0", for the require_uvs message
+  std::size_t degenerate_faces_dropped = 0;
+};
+
+// Throws InputError("<path>: <problem>").
+[[noreturn]] inline void fail(const std::string& path, const std::string& problem) {
+  throw InputError(path + ": " + problem);
+}
+
+ParsedMesh parse_obj(const std::string& path, std::string_view text);
+ParsedMesh parse_ply(const std::string& path, std::string_view bytes);
+ParsedMesh parse_off(const std::string& path, std::string_view text);
+ParsedMesh parse_stl(const std::string& path, std::string_view bytes);
+
+// True when the size matches a binary STL's facet count (84 + 50 bytes per facet).
+bool is_binary_stl(std::string_view bytes);
+
+// (position, uv, normal) indices of one corner.
+using Corner = std::array<std::uint32_t, 3>;
+
+// Appends the fan (0,i,i+1) of a polygon's `n` corners as triangles of file face `face`.
+inline void add_polygon(ParsedMesh& out, const Corner* corners, std::size_t n, std::uint32_t face) {
+  Mesh& m = out.mesh;
+  for (std::size_t i = 1; i + 1 < n; ++i) {
+    for (std::size_t c : {std::size_t(0), i, i + 1}) {
+      m.position_index.push_back(corners[c][0]);
+      if (out.corner_uvs) m.uv_index.push_back(corners[c][1]);
+      if (out.corner_normals) m.normal_index.push_back(corners[c][2]);
+    }
+    m.source_face.push_back(face);
+  }
+  ++out.faces;
+  if (n > 3) ++out.polygons_triangulated;
+}
+
+// Text scanning -------------------------------------------------------------------------------
+
+inline bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
+inline bool is_space(char c) { return is_blank(c) || c == '\n'; }
+
+// The next whitespace-separated token of `line` from `pos` (empty at the end); advances pos.
+inline std::string_view next_token(std::string_view line, std::size_t& pos) {
+  while (pos < line.size() && is_space(line[pos])) ++pos;
+  std::size_t start = pos;
+  while (pos < line.size() && !is_space(line[pos])) ++pos;
+  return line.substr(start, pos - start);
+}
+
+// A token quoted for a message, shortened so a binary blob cannot flood the terminal.
+inline std::string quote(std::string_view token) {
+  std::string s(token.substr(0, 32));
+  for (char& c : s)
+    if (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) > 126) c = '?';
+  return "'" + s + (token.size() > 32 ? "...'" : "'");
+}
+
+// Parses the whole token as a float or double (a leading '+' is accepted, as C's strtod does).
+// Values beyond the type's range come back as +-inf so the caller's finiteness check reports them;
+// values below it become 0 or a denormal. Returns false when the token is not entirely a number.
+template <typename Real>
+bool parse_real(std::string_view token, Real& out) {
+  const char* first = token.data();
+  const char* last = first + token.size();
+  if (last - first > 1 && *first == '+' && first[1] != '-' && first[1] != '+') ++first;
+  auto result = std::from_chars(first, last, out);
+  if (first == last || result.ptr != last) return false;
+  if (result.ec == std::errc::result_out_of_range) {
+    // from_chars leaves `out` untouched here; strtod tells overflow (inf) from underflow (0).
+    char buffer[64];
+    std::size_t n = std::min<std::size_t>(std::size_t(last - first), sizeof buffer - 1);
+    std::memcpy(buffer, first, n);
+    buffer[n] = '\0';
+    out = static_cast<Real>(std::strtod(buffer, nullptr));
+    return true;
+  }
+  return result.ec == std::errc();
+}
+
+// Parses the whole token as a decimal integer, '+' allowed. False on junk or more than 18 digits.
+// Hand-written because face indices are the most frequent tokens of an OBJ file.
+inline bool parse_int(std::string_view token, long long& out) {
+  std::size_t i = 0;
+  bool negative = false;
+  if (i < token.size() && (token[i] == '-' || token[i] == '+')) negative = token[i++] == '-';
+  if (i == token.size() || token.size() - i > 18) return false;
+  long long value = 0;
+  for (; i < token.size(); ++i) {
+    unsigned digit = static_cast<unsigned char>(token[i]) - unsigned('0');
+    if (digit > 9) return false;
+    value = value * 10 + digit;
+  }
+  out = negative ? -value : value;
+  return true;
+}
+
+}  // namespace nmbake::mesh_io_detail

@@ -1,0 +1,205 @@
+// bake_normal_map: the whole bake on in-memory meshes, from tangent frames to padded map.
+//
+// For every sample point of every texel covered by the low-poly's UV layout it finds the low-poly
+// point P and ray normal N, casts a ray onto the high-poly (policy below), interpolates the
+// high-poly normal at the hit with the hit's own barycentrics, and expresses it in the low-poly
+// tangent frame at P (the exact inverse of the renderer's decoding, tangent_frames.h). A texel's
+// value is the renormalized mean of its covered samples; uncovered texels are filled by padding.
+// Conventions: ../shared/docs/baking.md. Meshes are never rotated or scaled; internally all
+// coordinates are re-centred on the scene's bounding-box centre for precision.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/errors.h"
+#include "core/image.h"
+#include "core/mesh.h"
+#include "raycast.h"
+#include "core/tangent_frames.h"
+
+namespace nmbake {
+
+enum class RayPolicy {
+  cage_first,  // start at P + front*N (or on the cage), travel inward to rear, first hit wins
+  closest,     // cast outward up to front and inward up to rear from P, nearest hit wins
+};
+
+enum class NormalSpace { tangent, object };
+
+constexpr int kMaxMapSide = 65536;  // texels per side; larger maps are refused (ResourceError)
+constexpr int kMaxSamples = 1024;   // sample points per texel
+constexpr double kCoordinateSpacingWarn = 1e-3;  // BakeStats::coordinate_spacing above this: warn
+// BakeStats::backface_probe_share above which the high-poly is taken as inverted, and above which
+// (up to the first) as partly inverted, when back faces are kept.
+constexpr double kInvertedShare = 0.5;
+// Suspect texels (BakeStats::suspect_texels): the tilt from the low-poly normal above which, and
+// the length of the mean of a texel's unit sample values below which, a texel is suspect; the
+// share of covered texels above which nmbake warns.
+constexpr double kSuspectTiltDeg = 85.0;
+constexpr double kSuspectAgreement = 0.8;
+constexpr double kSuspectShareWarn = 0.005;
+constexpr double kMixedShare = 0.2;
+
+struct BakeOptions {
+  int width = 2048;   // map width in texels
+  int height = 2048;  // map height in texels
+  int samples = 1;    // sample points per texel; 1 = the texel centre only (no AA loop)
+  float front = -1.0f;  // scene units the ray starts outside the low-poly; < 0 = auto (measured)
+  float rear = -1.0f;   // scene units the ray reaches inside the low-poly; < 0 = auto (measured)
+  RayPolicy policy = RayPolicy::cage_first;
+  NormalSpace space = NormalSpace::tangent;
+  bool green_down = false;  // DirectX "Y-" maps: negate the bitangent component
+  BitangentMode bitangent = BitangentMode::per_pixel;
+  int padding = 16;     // texels of edge padding around islands; 0 = none
+  int threads = 0;      // worker threads; 0 = all cores
+  bool miss_mask = false;  // fill BakeResult::miss_mask (share of missed samples per texel)
+  bool suspect_mask = false;  // fill BakeResult::suspect_mask (1 for suspect texels, BakeStats::suspect_texels)
+  // Leave high-poly triangles out of the BVH when they lie farther from the low-poly (and cage)
+  // than any ray reaches (cull.h). The map is the same either way; off only for comparison.
+  bool cull_far = true;
+  // Take the first hit along the ray whatever it faces (earlier nmbake's rule). By default a hit on
+  // a back face (the inside of some part of the high-poly, judged against the side the low-poly's
+  // normal points to) is passed over for the next one, and a hit whose normal points away from the
+  // low-poly's outside is taken only when the ray finds no other (raycast::HitRule).
+  bool keep_backfaces = false;
+  // Bytes the bake's buffers may take (estimate_bake_bytes); 0 = what the machine has
+  // (memory_budget_bytes: MemAvailable, cgroup limit, ulimit -v). Larger bakes are refused.
+  std::uint64_t memory_limit = 0;
+  // For the bench: when set, receives a copy of every ray the trace stage cast (order unspecified),
+  // in coordinates re-centred on BakeStats::centre.
+  std::vector<raycast::Ray>* record_rays = nullptr;
+  // Called from the calling thread with the fraction done in [0,1]; return false to cancel
+  // (bake_normal_map then throws Cancelled).
+  std::function<bool(double)> progress;
+};
+
+struct BakeStats {
+  float front = 0.0f, rear = 0.0f;  // distances used (scene units)
+  glm::dvec3 centre{0.0};           // subtracted from every coordinate before tracing (bounding-box centre)
+  bool auto_distances = false;      // front/rear were measured, not given
+  double auto_probe_beyond = 0.0;   // share of probe points farther than the chosen distances
+  std::uint64_t rays = 0, hits = 0, misses = 0;  // misses/hits count samples, rays count casts
+  std::uint64_t samples_covered = 0;
+  std::uint64_t overlapping_samples = 0;  // samples covered by more than one UV triangle
+  std::size_t texels_total = 0, texels_covered = 0, texels_padded = 0;
+  double coverage = 0.0;  // texels_covered / texels_total
+  // Signed distance from the low-poly surface to the hit along the ray (positive: in front of /
+  // outside the low-poly), over all hits.
+  double hit_distance_min = 0.0, hit_distance_mean = 0.0, hit_distance_max = 0.0;
+  std::size_t low_triangles = 0, high_triangles = 0;
+  std::size_t high_triangles_culled = 0;  // left out of the BVH: out of every ray's reach
+  raycast::BuildQuality bvh_quality = raycast::BuildQuality::medium;  // of the BVH traced (bvh_quality_for)
+  std::size_t degenerate_uv_triangles = 0, degenerate_3d_triangles = 0, corners_without_tangent = 0;
+  std::size_t uv_outside_triangles = 0;  // low-poly triangles with a UV outside [0,1]
+  std::size_t uv_outside_entirely_triangles = 0;  // of those, UV bounding box outside [0,1]^2: not baked
+  std::size_t high_faces_reoriented = 0;  // computed high-poly normals: faces turned to their piece's winding
+  // Float spacing at the largest (referenced) coordinate of the inputs, relative to the scene
+  // diagonal: the precision the meshes themselves carry. Above kCoordinateSpacingWarn the map
+  // degrades measurably (data/stability/README.md, case 5).
+  double coordinate_spacing = 0.0;
+  double largest_coordinate = 0.0;  // largest |x|, |y| or |z| of a position a face uses
+  // Tangent space: covered texels whose normal points into the low-poly surface (z < 0), e.g.
+  // from inverted high-poly normals or winding. 0 for object-space maps.
+  std::size_t texels_facing_away = 0;
+  bool high_normals_computed = false;
+  // The hit rule (BakeOptions::keep_backfaces): whether it was applied, and why not.
+  bool backfaces_skipped = false;
+  // Probes from the low-poly both ways along its normals: of those that hit, the share whose
+  // nearest hit is a back face. Near 0 on a sound high-poly; near 1 when its winding and normals
+  // are inverted (then the faces' fronts are taken the other way round, and computed normals are
+  // turned outwards); in between, when only some parts are inverted, back faces are kept.
+  double backface_probe_share = 0.0;
+  enum class HighFacing { sound, inverted, mixed } high_facing = HighFacing::sound;
+  // Rays whose first hit was a back face, passed over for the next hit.
+  std::uint64_t backface_skips = 0;
+  // Where rays start: a cage from a file, the automatic cage (no --cage, --front or --rear), or
+  // none (one fixed distance for the scene).
+  enum class CageSource { none, automatic, file } cage = CageSource::none;
+  // Per low-poly vertex (file vertex) distances, scene units: front with the automatic cage, rear
+  // with it and with a file's cage when --rear is not given (else all 0).
+  struct Range {
+    double min = 0.0, mean = 0.0, max = 0.0;
+  } vertex_front, vertex_rear;
+  // Welded vertices whose measured front or rear need was cut by the limit (half the distance to
+  // the next part of the low-poly along the normal).
+  std::size_t cage_front_limited = 0, cage_rear_limited = 0;
+  // The distances measured for the whole scene (1.25 x the 99.9th percentile of the probes' nearest
+  // facing hits, each side), which every vertex of the automatic cage gets at least; 0 when not measured.
+  double scene_front = 0.0, scene_rear = 0.0;
+  // Suspect texels: covered texels whose tangent-space normal tilts more than 85 degrees from the
+  // low-poly normal (z below cos 85 degrees: black patches where a ray took another part), or whose
+  // samples disagree strongly (their mean is shorter than kSuspectAgreement: one texel, two
+  // surfaces). suspect_share = suspect_texels / texels_covered. suspect_region: the cell of an 8 x 8
+  // grid over the UV square holding most of them (u0, v0, u1, v1), and the share of them it holds.
+  std::size_t suspect_texels = 0;
+  double suspect_share = 0.0;
+  double suspect_region[4] = {0, 0, 0, 0};
+  double suspect_region_share = 0.0;
+  // Samples whose hit has a normal pointing away from the low-poly's outside (no other hit was found).
+  std::uint64_t hits_facing_away = 0;
+  // Seconds per stage.
+  double seconds_prepare = 0, seconds_bvh = 0, seconds_distances = 0, seconds_trace = 0, seconds_padding = 0;
+  double cpu_seconds_trace = 0;  // process CPU time of the trace stage (all threads)
+  // Of the trace stage's thread time (all threads), the seconds spent inside Embree's intersection
+  // calls, and the seconds spent working on tiles in all (rasterizing, making rays, casting them,
+  // shading, writing texels): the rest of a tile's time is the bake's own arithmetic.
+  double thread_seconds_intersect = 0, thread_seconds_tiles = 0;
+};
+
+struct BakeResult {
+  Image map;                          // RGB, encoded c = n * 0.5 + 0.5
+  Image miss_mask;                    // 1 channel, share of missed samples (only with options.miss_mask)
+  Image suspect_mask;                 // 1 channel, 1 for suspect texels, else 0 (only with options.suspect_mask)
+  std::vector<std::uint8_t> coverage;  // per texel: 1 = covered by the UV layout
+  BakeStats stats;
+  // The automatic cage (BakeStats::CageSource::automatic): per low-poly position, object space as
+  // the low-poly's (a cage file with the low-poly's topology holds these); else empty.
+  std::vector<glm::vec3> cage_positions;
+  // Per low-poly position, the rear distance measured (with the automatic cage or a file's cage
+  // without --rear); else empty.
+  std::vector<float> vertex_rear;
+  // Per low-poly position, how far out rays search beyond a cage that a neighbouring part limits
+  // (LocalDistances::search); empty where vertex_rear is.
+  std::vector<float> vertex_search;
+};
+
+struct Cancelled : Error {
+  Cancelled() : Error(ExitCode::usage, "cancelled") {}
+};
+
+// Throws UsageError for absurd options, InputError for meshes that cannot be baked (no UVs, cage
+// topology mismatch), ResourceError when the buffers would not fit in memory, Cancelled.
+BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& options);
+
+// The BVH build quality a bake with these options picks for `triangles` high-poly triangles (after
+// culling), by measurement (bench, issue 6): with few rays per triangle the quick Morton build wins
+// end to end (1M triangles at 2048^2, 1 sample: 0.15 s build instead of 0.64 s, trace 20% slower);
+// with 16 or more, the high-quality build's faster trace wins (8-9% faster than medium).
+raycast::BuildQuality bvh_quality_for(const BakeOptions& options, std::size_t triangles);
+
+// Bytes the bake will allocate for its images at this size (for the memory check and reports).
+std::uint64_t estimate_bake_bytes(const BakeOptions& options);
+
+// The direction rays follow at each low-poly position (unit, re-centring aside exactly the bake's):
+// the mean of the normals of the corners at that position (positions compared by value), so split
+// normals (hard edges) open no gaps between the rays of neighbouring faces.
+std::vector<glm::vec3> low_ray_normals(const Mesh& low);
+
+// The sample offsets inside a texel for `samples` samples, in [0,1)^2: the centre for 1, a
+// regular grid for square counts, otherwise a stratified (Hammersley) set.
+std::vector<glm::dvec2> sample_offsets(int samples);
+
+// ---- Re-baking chosen texels (for the error estimate, error_estimate.h) ----
+// The unit values bake_normal_map gives texels `texels` (indices y * width + x) with `samples`
+// sample points each (sample_offsets), using the ray distances, cage and centre of a finished bake
+// (`baked`) and otherwise the same rays, shading and averaging as the bake (tangent space with
+// --green down applied, or object space), as n in [-1,1]^3 (not encoded, not snapped to 0).
+// A texel none of whose samples falls in the UV layout gets (0,0,0). Builds its own BVH.
+std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& options,
+                                          const BakeResult& baked, const std::vector<std::uint32_t>& texels, int samples);
+// ---- end of re-baking chosen texels ----
+
+}  // namespace nmbake

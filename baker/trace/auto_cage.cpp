@@ -1,0 +1,226 @@
+#include "trace/auto_cage.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <queue>
+#include <utility>
+
+#include "core/mesh_topology.h"
+#include "core/parallel.h"
+
+namespace nmbake {
+
+namespace {
+
+// A point the probes start from, the unit direction they go (out: +dir, in: -dir), and the welded
+// vertices its findings count for.
+struct Probe {
+  glm::dvec3 p, n;
+  std::uint32_t v[3];
+  int nv;
+};
+
+glm::dvec3 unit_or_face(const glm::dvec3& n, const glm::dvec3& p0, const glm::dvec3& p1, const glm::dvec3& p2) {
+  const double len = glm::length(n);
+  if (len > 1e-12) return n / len;
+  const glm::dvec3 f = glm::cross(p1 - p0, p2 - p0);
+  const double fl = glm::length(f);
+  return fl > 0.0 ? f / fl : glm::dvec3(0, 0, 1);
+}
+
+// Over the edges (a, b, length): raises values so that none is more than `length` below a
+// neighbour's (spread = true, from the largest down), or lowers them so that none is more than
+// `length` above a neighbour's (spread = false, from the smallest up). Exact, in one pass of a heap.
+void ease(std::vector<double>& value, const std::vector<std::vector<std::pair<std::uint32_t, double>>>& adjacent, double slope,
+          bool spread) {
+  using Item = std::pair<double, std::uint32_t>;
+  auto cmp = [spread](const Item& a, const Item& b) { return spread ? a.first < b.first : a.first > b.first; };
+  std::priority_queue<Item, std::vector<Item>, decltype(cmp)> heap(cmp);
+  for (std::uint32_t v = 0; v < value.size(); ++v) heap.push({value[v], v});
+  while (!heap.empty()) {
+    const auto [val, v] = heap.top();
+    heap.pop();
+    if (val != value[v]) continue;  // stale
+    for (const auto& [u, len] : adjacent[v]) {
+      const double bound = spread ? val - slope * len : val + slope * len;
+      if (spread ? bound > value[u] : bound < value[u]) {
+        value[u] = bound;
+        heap.push({bound, u});
+      }
+    }
+  }
+}
+
+}  // namespace
+
+LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& high, double reach, double floor, double front_base,
+                                       double rear_base, double need_slope, double limit_slope, int threads) {
+  const std::vector<glm::vec3>& pos = *low.positions;
+  const std::vector<std::uint32_t>& index = *low.index;
+  const std::vector<glm::vec3>& rn = *low.ray_normals;
+  const std::size_t tris = index.size() / 3;
+  LocalDistances out;
+  std::size_t nw = 0;
+  const std::vector<std::uint32_t> weld = weld_positions(pos, &nw);
+  out.vertices = nw;
+
+  // Probes: one at every welded vertex a face uses, and at the centre and near each corner of
+  // every triangle (all three corners hear of these: the cage between them must cover them).
+  std::vector<Probe> probes;
+  {
+    std::vector<std::uint8_t> seen(nw, 0);
+    for (std::uint32_t pi : index) {
+      const std::uint32_t w = weld[pi];
+      if (seen[w]) continue;
+      seen[w] = 1;
+      probes.push_back({glm::dvec3(pos[pi]), glm::normalize(glm::dvec3(rn[pi])), {w, w, w}, 1});
+    }
+  }
+  const std::size_t stride = std::max<std::size_t>(1, tris / 50000);
+  static const double bary[4][3] = {{1 / 3.0, 1 / 3.0, 1 / 3.0}, {4 / 6.0, 1 / 6.0, 1 / 6.0}, {1 / 6.0, 4 / 6.0, 1 / 6.0},
+                                    {1 / 6.0, 1 / 6.0, 4 / 6.0}};
+  for (std::size_t t = 0; t < tris; t += stride) {
+    const std::uint32_t* c = &index[3 * t];
+    const glm::dvec3 p0(pos[c[0]]), p1(pos[c[1]]), p2(pos[c[2]]);
+    for (const auto& b : bary) {
+      const glm::dvec3 p = b[0] * p0 + b[1] * p1 + b[2] * p2;
+      const glm::dvec3 n = b[0] * glm::dvec3(rn[c[0]]) + b[1] * glm::dvec3(rn[c[1]]) + b[2] * glm::dvec3(rn[c[2]]);
+      probes.push_back({p, unit_or_face(n, p0, p1, p2), {weld[c[0]], weld[c[1]], weld[c[2]]}, 3});
+    }
+  }
+  out.probes = probes.size();
+
+  // The low-poly itself, for the distance to its next part along the normal: only surfaces that
+  // face the probe's start count (the probe's own part, left through its far side, does not).
+  std::vector<glm::vec3> corner_normals(index.size());
+  for (std::size_t c = 0; c < index.size(); ++c) corner_normals[c] = rn[index[c]];
+  std::vector<std::int8_t> low_facing(tris, 1);
+  for (std::size_t t = 0; t < tris; ++t) {
+    const glm::dvec3 p0(pos[index[3 * t]]), p1(pos[index[3 * t + 1]]), p2(pos[index[3 * t + 2]]);
+    const glm::dvec3 n = glm::dvec3(corner_normals[3 * t]) + glm::dvec3(corner_normals[3 * t + 1]) + glm::dvec3(corner_normals[3 * t + 2]);
+    if (glm::dot(glm::cross(p1 - p0, p2 - p0), n) < 0.0) low_facing[t] = -1;
+  }
+  const raycast::Scene self(&pos[0].x, pos.size(), index.data(), tris, raycast::BuildQuality::low, threads);
+  raycast::HitRule facing_start;  // an "inward" ray under this rule takes surfaces facing its start
+  facing_start.facing = low_facing.data();
+  raycast::HitRule high_facing_start;
+  high_facing_start.facing = high.facing;
+
+  // Per probe: the distances found (infinity: none). Front/rear needs from the high-poly's first
+  // hits that face the low-poly's outside; limits from the low-poly.
+  const double inf = std::numeric_limits<double>::infinity();
+  // high_back_out: where a next part of the low-poly lies along the normal, the first high-poly
+  // surface before the half-way point that faces back at the probe (that part's, standing out).
+  std::vector<double> high_back_out(probes.size(), inf);
+  std::vector<double> need_out(probes.size(), inf), need_in(probes.size(), inf), gap_out(probes.size(), inf),
+      gap_in(probes.size(), inf);
+  const float tnear = float(1e-2 * floor);
+  parallel_chunks(threads, probes.size(), 1024, [&](std::size_t i0, std::size_t i1) {
+    std::vector<raycast::Ray> rays;
+    rays.reserve(2 * (i1 - i0));
+    for (std::size_t i = i0; i < i1; ++i) {
+      rays.push_back({glm::vec3(probes[i].p), 0.0f, glm::vec3(probes[i].n), float(reach)});
+      rays.push_back({glm::vec3(probes[i].p), 0.0f, glm::vec3(-probes[i].n), float(reach)});
+    }
+    std::vector<raycast::Hit> hits(rays.size());
+    high.scene->intersect(rays.data(), hits.data(), rays.size());
+    for (std::size_t i = i0; i < i1; ++i)
+      for (int k = 0; k < 2; ++k) {
+        const raycast::Hit& h = hits[2 * (i - i0) + k];
+        if (!h.hit()) continue;
+        // The low-poly's outside is +n: a front face there is the surface the probe looks for.
+        if (front_along(high, h.triangle, glm::vec3(probes[i].n)) > 0.0f) (k == 0 ? need_out : need_in)[i] = h.t;
+      }
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      // The surface around the probe is its own part, however it folds: triangles that share a
+      // vertex with the probe's (a concave crease's other side) are looked past.
+      const Probe& pr = probes[i0 + i / 2];
+      raycast::Ray r = rays[i];
+      r.tnear = tnear;
+      for (int tries = 0; tries < 8; ++tries) {
+        const raycast::Hit h = self.intersect(r, facing_start);
+        if (!h.hit()) break;
+        bool near = false;
+        for (int c = 0; c < 3 && !near; ++c)
+          for (int j = 0; j < pr.nv; ++j) near |= weld[index[3 * std::size_t(h.triangle) + c]] == pr.v[j];
+        if (!near) {
+          (i % 2 == 0 ? gap_out : gap_in)[i0 + i / 2] = h.t;
+          break;
+        }
+        r.tnear = std::nextafter(h.t, std::numeric_limits<float>::infinity());
+      }
+    }
+    // Towards a next part: its high-poly surface facing back at the probe, before half way (this
+    // part's own surface, met from inside, is passed over: an "inward" ray under the rule takes
+    // the surfaces that face its start).
+    for (std::size_t i = i0; i < i1; ++i) {
+      if (!(gap_out[i] < inf)) continue;
+      const raycast::Ray r{glm::vec3(probes[i].p), tnear, glm::vec3(probes[i].n), float(0.5 * gap_out[i])};
+      const raycast::Hit h = high.scene->intersect(r, high_facing_start);
+      if (h.hit()) high_back_out[i] = h.t;
+    }
+  });
+
+  // Per welded vertex: the largest need and the smallest limit its probes found.
+  std::vector<double> front(nw, std::max(floor, front_base)), rear(nw, std::max(floor, rear_base)), front_cap(nw, reach),
+      rear_cap(nw, reach);
+  for (std::size_t i = 0; i < probes.size(); ++i)
+    for (int j = 0; j < probes[i].nv; ++j) {
+      const std::uint32_t w = probes[i].v[j];
+      if (need_out[i] < inf) front[w] = std::max(front[w], 1.25 * need_out[i] + floor);
+      if (need_in[i] < inf) rear[w] = std::max(rear[w], 1.25 * need_in[i] + floor);
+      front_cap[w] = std::min(front_cap[w], 0.5 * gap_out[i]);
+      // Nor past the high-poly surface of that next part, where it stands out towards this one
+      // beyond the half-way point. (With no next part of the low-poly along the normal, a surface
+      // facing back is this part's own overhang, whose lip the cage must pass: not looked for.)
+      front_cap[w] = std::min(front_cap[w], 0.9 * high_back_out[i]);
+      rear_cap[w] = std::min(rear_cap[w], 0.5 * gap_in[i]);
+    }
+
+  // Neither spikes nor notches: along every edge a need falls by at most need_slope times the
+  // edge's length (it reaches as far around as it is tall), and a limit rises by at most
+  // limit_slope times it (a neighbouring part's limit fades out gently).
+  std::vector<std::vector<std::pair<std::uint32_t, double>>> adjacent(nw);
+  {
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
+    for (std::size_t t = 0; t < tris; ++t)
+      for (int c = 0; c < 3; ++c) {
+        std::uint32_t a = weld[index[3 * t + c]], b = weld[index[3 * t + (c + 1) % 3]];
+        if (a == b) continue;
+        if (a > b) std::swap(a, b);
+        edges.push_back({a, b});
+      }
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    std::vector<glm::dvec3> wpos(nw);
+    for (std::size_t p = 0; p < pos.size(); ++p) wpos[weld[p]] = glm::dvec3(pos[p]);
+    for (const auto& [a, b] : edges) {
+      const double len = glm::length(wpos[a] - wpos[b]);
+      adjacent[a].push_back({b, len});
+      adjacent[b].push_back({a, len});
+    }
+  }
+  ease(front, adjacent, need_slope, true);
+  ease(rear, adjacent, need_slope, true);
+  ease(front_cap, adjacent, limit_slope, false);
+  ease(rear_cap, adjacent, limit_slope, false);
+  const std::vector<double> search = front;
+  for (std::size_t w = 0; w < nw; ++w) {
+    out.front_limited += front_cap[w] < front[w];
+    out.rear_limited += rear_cap[w] < rear[w];
+    front[w] = std::max(floor, std::min(front[w], front_cap[w]));
+    rear[w] = std::max(floor, std::min(rear[w], rear_cap[w]));
+  }
+  out.front.resize(pos.size());
+  out.rear.resize(pos.size());
+  out.search.resize(pos.size());
+  for (std::size_t p = 0; p < pos.size(); ++p) {
+    out.search[p] = float(search[weld[p]]);
+    out.front[p] = float(front[weld[p]]);
+    out.rear[p] = float(rear[weld[p]]);
+  }
+  return out;
+}
+
+}  // namespace nmbake

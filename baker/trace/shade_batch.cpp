@@ -1,0 +1,160 @@
+#include "trace/shade_batch.h"
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstring>
+
+#include "core/lanes.h"
+#include "raycast.h"
+
+namespace nmbake {
+
+using namespace lanes;
+
+namespace {
+
+// Four samples from `i` on (a short last block repeats its last sample). `same_triangle`: all four
+// on one low-poly triangle, whose data is then loaded once and broadcast instead of gathered.
+template <bool same_triangle>
+[[gnu::always_inline]] inline void encode_block(const LowTriangle* low, const glm::vec3* high_corner_normals,
+                                                const ShadeSamples& in, std::size_t i, std::size_t count,
+                                                double* const value[3], std::uint8_t* degenerate) {
+  const V zero = {0.0, 0.0, 0.0, 0.0};
+  const bool full = i + kLanes <= count;
+  std::size_t at[kLanes];
+  for (int k = 0; k < kLanes; ++k) at[k] = std::min(i + std::size_t(k), count - 1);
+  const LowTriangle* lp[kLanes];
+  const glm::vec3* hp[kLanes];
+  unsigned miss = 0;
+#pragma GCC unroll 4
+  for (int k = 0; k < kLanes; ++k) {
+    lp[k] = &low[in.low_tri[same_triangle ? i : at[k]]];
+    const std::uint32_t ht = in.high_tri[at[k]];
+    miss |= unsigned(ht == raycast::no_hit) << k;
+    hp[k] = &high_corner_normals[3 * std::size_t(ht == raycast::no_hit ? 0 : ht)];  // a miss reads any triangle, and is flagged
+  }
+  V b[3], tw[3];
+  V3 n[3], t[3], hn[3];
+#pragma GCC unroll 3
+  for (int c = 0; c < 3; ++c) {
+    if (full)
+      std::memcpy(&b[c], &in.b[c][i], sizeof(V));
+    else
+      gather(b[c], [&](int k) { return in.b[c][at[k]]; });
+    gather(n[c].x, [&](int k) { return lp[k]->n[c].x; });
+    gather(n[c].y, [&](int k) { return lp[k]->n[c].y; });
+    gather(n[c].z, [&](int k) { return lp[k]->n[c].z; });
+    gather(t[c].x, [&](int k) { return lp[k]->t[c].x; });
+    gather(t[c].y, [&](int k) { return lp[k]->t[c].y; });
+    gather(t[c].z, [&](int k) { return lp[k]->t[c].z; });
+    gather(tw[c], [&](int k) { return lp[k]->t[c].w; });
+    gather(hn[c].x, [&](int k) { return double(hp[k][c].x); });
+    gather(hn[c].y, [&](int k) { return double(hp[k][c].y); });
+    gather(hn[c].z, [&](int k) { return double(hp[k][c].z); });
+  }
+  V u, v;
+  if (full) {
+    F uf, vf;
+    std::memcpy(&uf, &in.u[i], sizeof uf);
+    std::memcpy(&vf, &in.v[i], sizeof vf);
+    u = __builtin_convertvector(uf, V);
+    v = __builtin_convertvector(vf, V);
+  } else {
+    gather(u, [&](int k) { return double(in.u[at[k]]); });
+    gather(v, [&](int k) { return double(in.v[at[k]]); });
+  }
+  const V hw[3] = {1.0 - u - v, u, v};
+  // interpolate_frame, per-pixel bitangent: sums start from zero as there.
+  V3 fn{zero, zero, zero}, ft{zero, zero, zero};
+  V sign = zero;
+#pragma GCC unroll 3
+  for (int c = 0; c < 3; ++c) {
+    fn.x += b[c] * n[c].x;
+    fn.y += b[c] * n[c].y;
+    fn.z += b[c] * n[c].z;
+    ft.x += b[c] * t[c].x;
+    ft.y += b[c] * t[c].y;
+    ft.z += b[c] * t[c].z;
+    sign += b[c] * tw[c];
+  }
+  V3 nt;
+  cross(nt, fn, ft);
+  const V3 fb{sign * nt.x, sign * nt.y, sign * nt.z};
+  // The hit normal, interpolated with the hit's barycentrics and normalized.
+  V3 h{zero, zero, zero};
+#pragma GCC unroll 3
+  for (int c = 0; c < 3; ++c) {
+    h.x += hw[c] * hn[c].x;
+    h.y += hw[c] * hn[c].y;
+    h.z += hw[c] * hn[c].z;
+  }
+  // The encoding normalizes its result, so h goes in at its own length.
+  V hh;
+  dot(hh, h, h);
+  // encode_tangent_normal.
+  V3 bxn, nxt, txb;
+  cross(bxn, fb, fn);
+  cross(nxt, fn, ft);
+  cross(txb, ft, fb);
+  V det, tt, bb, nn;
+  dot(det, ft, bxn);
+  dot(tt, ft, ft);
+  dot(bb, fb, fb);
+  dot(nn, fn, fn);
+  const V scale2 = tt * bb * nn;
+  V3 x;
+  dot(x.x, h, bxn);
+  dot(x.y, h, nxt);
+  dot(x.z, h, txb);
+  V xx, len;
+  dot(xx, x, x);
+  vsqrt(len, xx);
+  const V inv = 1.0 / len;
+  // inv, negated where det is not positive (encode_tangent_normal's x * -inv): its sign bit flipped.
+  const M sign_bit = {INT64_MIN, INT64_MIN, INT64_MIN, INT64_MIN};
+  M inv_bits;
+  std::memcpy(&inv_bits, &inv, sizeof inv);
+  inv_bits ^= ~(det > zero) & sign_bit;
+  V s;
+  std::memcpy(&s, &inv_bits, sizeof s);
+  const V3 r{x.x * s, x.y * s, x.z * s};
+  // Degenerate: a miss, a short hit normal, a singular frame, a result not finite (NaN fails each
+  // comparison, and an infinite det or len is above DBL_MAX).
+  const M good = (hh > kShortHitNormal2) & (det * det > 1e-24 * scale2) & (det >= -DBL_MAX) & (det <= DBL_MAX) &
+                 (len > 0.0) & (len <= DBL_MAX);
+  const unsigned bad = (~bits(good) | miss) & 0xfu;
+  if (full) {
+    std::memcpy(&value[0][i], &r.x, sizeof(V));
+    std::memcpy(&value[1][i], &r.y, sizeof(V));
+    std::memcpy(&value[2][i], &r.z, sizeof(V));
+    store_flags(&degenerate[i], bad);
+  } else {
+    for (std::size_t k = 0; i + k < count; ++k) {
+      value[0][i + k] = r.x[k];
+      value[1][i + k] = r.y[k];
+      value[2][i + k] = r.z[k];
+      degenerate[i + k] = std::uint8_t(bad >> k & 1u);
+    }
+  }
+}
+
+}  // namespace
+
+// Two versions, chosen once at load time by the CPU: AVX2 (4 lanes per instruction) and the
+// baseline (2 lanes per SSE2 instruction). Neither uses FMA, so both give the scalar code's bits.
+__attribute__((target_clones("avx2", "default"))) void encode_hits_per_pixel(const LowTriangle* low,
+                                                                              const glm::vec3* high_corner_normals,
+                                                                              const ShadeSamples& samples,
+                                                                              std::size_t count, double* const value[3],
+                                                                              std::uint8_t* degenerate) {
+  for (std::size_t i = 0; i < count; i += kLanes) {
+    const std::int32_t* lt = samples.low_tri;
+    if (i + kLanes <= count && lt[i] == lt[i + 1] && lt[i] == lt[i + 2] && lt[i] == lt[i + 3])
+      encode_block<true>(low, high_corner_normals, samples, i, count, value, degenerate);
+    else
+      encode_block<false>(low, high_corner_normals, samples, i, count, value, degenerate);
+  }
+}
+
+}  // namespace nmbake

@@ -1,0 +1,300 @@
+#include "trace/tile_kernels.h"
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstring>
+
+#include "core/lanes.h"
+
+namespace nmbake {
+
+using namespace lanes;
+
+namespace {
+
+// P + front N and -N for one triangle at barycentrics w, as sample_rays does (low_point,
+// low_ray_normal: b0 * c0 + b1 * c1 + b2 * c2 summed left to right, N times 1 / |N|). `good`: lanes
+// whose squared normal length exceeds 1e-24 (the others take low_ray_normal's fallback).
+[[gnu::always_inline]] inline void default_ray(const LowTriangle& lt, double front, const V (&w)[3], V3& org, V3& dir,
+                                               unsigned& good) {
+  V3 p, n;
+  for (int c = 0; c < 3; ++c) {
+    const V3 pc = {w[c] * lt.p[c].x, w[c] * lt.p[c].y, w[c] * lt.p[c].z};
+    const V3 nc = {w[c] * lt.ray_n[c].x, w[c] * lt.ray_n[c].y, w[c] * lt.ray_n[c].z};
+    if (c == 0) {
+      p = pc;
+      n = nc;
+    } else {
+      p = {p.x + pc.x, p.y + pc.y, p.z + pc.z};
+      n = {n.x + nc.x, n.y + nc.y, n.z + nc.z};
+    }
+  }
+  V len2, len;
+  dot(len2, n, n);
+  vsqrt(len, len2);
+  const V inv = 1.0 / len;
+  n = {n.x * inv, n.y * inv, n.z * inv};
+  good = bits(len2 > 1e-24);
+  org = {p.x + front * n.x, p.y + front * n.y, p.z + front * n.z};
+  dir = {-n.x, -n.y, -n.z};
+}
+
+}  // namespace
+
+// Two versions, chosen once at load time by the CPU: AVX2 and the SSE2 baseline. Neither uses FMA,
+// so both give the scalar code's bits.
+__attribute__((target_clones("avx2", "default"))) std::size_t cover_rect(const TexelTriangle& tt, std::int32_t t, int x0,
+                                                                          int x1, int y0, int y1, double ox, double oy,
+                                                                          const DefaultRays& rays, const SampleSlots& slots,
+                                                                          std::size_t first, std::size_t row_stride) {
+  std::size_t taken = 0;
+  const V zero = {0.0, 0.0, 0.0, 0.0};
+  double inv_dy[3];  // for the rows' bounds, which need not be exact
+  for (int k = 0; k < 3; ++k) inv_dy[k] = tt.edge_d[k].y != 0.0 ? 1.0 / tt.edge_d[k].y : 0.0;
+  for (int y = y0; y <= y1; ++y) {
+    const double qy = y + oy;
+    // Edge k's value at q is d.x * (q.y - a.y) - d.y * (q.x - a.x); the first product is the row's.
+    double row_term[3];
+    for (int k = 0; k < 3; ++k) row_term[k] = tt.edge_d[k].x * (qy - tt.edge_a[k].y);
+    const std::size_t row = first + std::size_t(y - y0) * row_stride;
+    // The row's texels that can be covered, xa .. xb: each edge's value is linear in x, with one
+    // sign on one side of where it crosses 0 and the other on the other. The bounds have a margin
+    // far above the rounding of that crossing (relative to the terms it sums) and of the edge
+    // values near it; the test below decides every texel in them.
+    int xa = x0, xb = x1;
+    bool empty = false;
+    for (int k = 0; k < 3 && !empty; ++k) {
+      const double dy = tt.edge_d[k].y;
+      if (dy == 0.0) continue;  // the edge's value does not change along the row
+      const double along = row_term[k] * inv_dy[k];
+      const double cross = tt.edge_a[k].x + along - ox;
+      if (!(cross >= -DBL_MAX && cross <= DBL_MAX)) continue;  // not finite: no bound
+      const double slack = 1e-6 * (1.0 + std::fabs(tt.edge_a[k].x) + std::fabs(along) + std::fabs(ox));
+      if ((tt.edge_side[k] > 0.0) == (dy > 0.0)) {  // covered only up to the crossing
+        const double hi = std::floor(cross + slack);
+        if (hi < double(xa)) empty = true;
+        else if (hi < double(xb)) xb = int(hi);
+      } else {  // covered only from the crossing on
+        const double lo = std::ceil(cross - slack);
+        if (lo > double(xb)) empty = true;
+        else if (lo > double(xa)) xa = int(lo);
+      }
+    }
+    if (empty) continue;
+    for (int x = xa; x <= xb; x += kLanes) {
+      const V qx = V{double(x), double(x + 1), double(x + 2), double(x + 3)} + ox;
+      M in = {x <= xb ? -1 : 0, x + 1 <= xb ? -1 : 0, x + 2 <= xb ? -1 : 0, x + 3 <= xb ? -1 : 0};
+      V w[3];
+      for (int k = 0; k < 3; ++k) {
+        const V e = row_term[k] - tt.edge_d[k].y * (qx - tt.edge_a[k].x);
+        // covers() rejects e < 0 when the opposite corner is on the positive side, else e >= 0
+        // (a NaN passes both tests there; the sum test below rejects it).
+        in &= tt.edge_side[k] > 0.0 ? ~(e < zero) : ~(e >= zero);
+        w[(k + 2) % 3] = e * tt.edge_inv_side[k];
+      }
+      const V sum = w[0] + w[1] + w[2];
+      in &= (sum > zero) & (sum <= DBL_MAX);  // covers(): !(sum > 0) || !isfinite(sum) rejects
+      const unsigned m = bits(in);
+      if (!m) continue;
+      const V inv_sum = 1.0 / sum;
+      const V b[3] = {w[0] * inv_sum, w[1] * inv_sum, w[2] * inv_sum};
+      V3 org{zero, zero, zero}, dir{zero, zero, zero};
+      unsigned good = 0;
+      if (rays.low) default_ray(rays.low[t], double(rays.front), b, org, dir, good);
+      const F of[3] = {__builtin_convertvector(org.x, F), __builtin_convertvector(org.y, F),
+                       __builtin_convertvector(org.z, F)};
+      const F df[3] = {__builtin_convertvector(dir.x, F), __builtin_convertvector(dir.y, F),
+                       __builtin_convertvector(dir.z, F)};
+      const std::size_t slot0 = row + std::size_t(x - x0);
+      if (m == 0xfu) {
+        // The common case, four lanes at once: all four samples covered, their slots free, none
+        // near enough to an edge to be moved in (inset_from_edges leaves them as they are).
+        I held;
+        std::memcpy(&held, &slots.tri[slot0], sizeof held);
+        const M far_from_edges = (b[0] >= kEdgeInset) & (b[1] >= kEdgeInset) & (b[2] >= kEdgeInset);
+        if (bits(held < 0) == 0xfu && bits(far_from_edges) == 0xfu) {
+          const I tris = {t, t, t, t};
+          std::memcpy(&slots.tri[slot0], &tris, sizeof tris);
+          for (int c = 0; c < 3; ++c) std::memcpy(&slots.b[c][slot0], &b[c], sizeof(V));
+          if (!rays.low) continue;
+          for (int c = 0; c < 3; ++c) {
+            std::memcpy(&slots.org[c][slot0], &of[c], sizeof(F));
+            std::memcpy(&slots.dir[c][slot0], &df[c], sizeof(F));
+          }
+          store_flags(&slots.ray_fallback[slot0], ~good);
+          continue;
+        }
+      }
+      for (int k = 0; k < kLanes; ++k) {
+        if (!(m >> k & 1u)) continue;
+        const std::size_t slot = slot0 + std::size_t(k);
+        if (slots.tri[slot] >= 0) {
+          ++taken;
+          continue;
+        }
+        double bk[3] = {b[0][k], b[1][k], b[2][k]};
+        const bool moved = inset_from_edges(bk);
+        slots.tri[slot] = t;
+        for (int c = 0; c < 3; ++c) slots.b[c][slot] = bk[c];
+        if (!rays.low) continue;
+        // A sample moved in from an edge has other barycentrics than the ray was made with.
+        slots.ray_fallback[slot] = moved || !(good >> k & 1u);
+        for (int c = 0; c < 3; ++c) {
+          slots.org[c][slot] = of[c][k];
+          slots.dir[c][slot] = df[c][k];
+        }
+      }
+    }
+  }
+  return taken;
+}
+
+__attribute__((target_clones("avx2", "default"))) std::size_t compact_samples(const SampleSlots& slots,
+                                                                               std::size_t slot_count, std::size_t texels,
+                                                                               bool rays, const CoveredSamples& out) {
+  std::size_t n = 0;
+  // Entry i to entry n <= i, one value at a time (in place, n may equal i).
+  const auto copy_one = [&](std::size_t i) {
+    out.tri[n] = slots.tri[i];
+    for (int c = 0; c < 3; ++c) out.b[c][n] = slots.b[c][i];
+    out.texel[n] = std::uint16_t(i % texels);
+    if (rays) {
+      for (int c = 0; c < 3; ++c) {
+        out.org[c][n] = slots.org[c][i];
+        out.dir[c][n] = slots.dir[c][i];
+      }
+      out.ray_fallback[n] = slots.ray_fallback[i];
+    }
+    ++n;
+  };
+  std::size_t i = 0;
+  if (texels % kLanes == 0) {
+    // Four slots at a time (they are four consecutive texels); one by one where some are empty.
+    for (std::size_t texel = 0; i + kLanes <= slot_count; i += kLanes, texel = texel + kLanes == texels ? 0 : texel + kLanes) {
+      std::int32_t tri[kLanes];
+      std::memcpy(tri, &slots.tri[i], sizeof tri);
+      if ((tri[0] & tri[1] & tri[2] & tri[3]) < 0) continue;  // all empty
+      if ((tri[0] | tri[1] | tri[2] | tri[3]) < 0) {          // some empty
+        for (std::size_t k = 0; k < kLanes; ++k)
+          if (tri[k] >= 0) copy_one(i + k);
+        continue;
+      }
+      const std::uint16_t tex[kLanes] = {std::uint16_t(texel), std::uint16_t(texel + 1), std::uint16_t(texel + 2),
+                                         std::uint16_t(texel + 3)};
+      std::memcpy(&out.texel[n], tex, sizeof tex);
+      // Moved unless in place with no gap yet (then already where they belong); memmove, as in
+      // place the four entries from i can overlap the four from n.
+      if (out.tri + n != slots.tri + i) {
+        std::memcpy(&out.tri[n], tri, sizeof tri);
+        for (int c = 0; c < 3; ++c) std::memmove(&out.b[c][n], &slots.b[c][i], kLanes * sizeof(double));
+        if (rays) {
+          for (int c = 0; c < 3; ++c) {
+            std::memmove(&out.org[c][n], &slots.org[c][i], kLanes * sizeof(float));
+            std::memmove(&out.dir[c][n], &slots.dir[c][i], kLanes * sizeof(float));
+          }
+          std::memmove(&out.ray_fallback[n], &slots.ray_fallback[i], kLanes);
+        }
+      }
+      n += kLanes;
+    }
+  }
+  for (; i < slot_count; ++i)
+    if (slots.tri[i] >= 0) copy_one(i);
+  return n;
+}
+
+__attribute__((target_clones("avx2", "default"))) void accumulate_samples(const double* const value[3],
+                                                                           const std::uint16_t* texel, std::size_t count,
+                                                                           const TexelSums& sums) {
+  const auto add_one = [&](std::size_t i) {
+    const std::size_t t = texel[i];
+    for (int c = 0; c < 3; ++c) sums.sum[c][t] += value[c][i];
+    sums.count[t] += 1.0;
+  };
+  std::size_t i = 0;
+  for (; i + kLanes <= count; i += kLanes) {
+    // Four samples of four consecutive texels (the common case) are four different texels: their
+    // additions are independent, four at a time.
+    const std::size_t t = texel[i];
+    if (!(texel[i + 1] == t + 1 && texel[i + 2] == t + 2 && texel[i + 3] == t + 3)) {
+      for (std::size_t k = 0; k < kLanes; ++k) add_one(i + k);
+      continue;
+    }
+    for (int c = 0; c < 3; ++c) {
+      V sum, add;
+      std::memcpy(&sum, &sums.sum[c][t], sizeof sum);
+      std::memcpy(&add, &value[c][i], sizeof add);
+      sum += add;
+      std::memcpy(&sums.sum[c][t], &sum, sizeof sum);
+    }
+    V n;
+    std::memcpy(&n, &sums.count[t], sizeof n);
+    n += 1.0;
+    std::memcpy(&sums.count[t], &n, sizeof n);
+  }
+  for (; i < count; ++i) add_one(i);
+}
+
+__attribute__((target_clones("avx2", "default"))) void write_texel_row(const TexelSums& sums, std::size_t first,
+                                                                        int width, bool flip_y, double snap, float* rgb,
+                                                                        std::uint8_t* covered) {
+  const V zero = {0.0, 0.0, 0.0, 0.0};
+  for (int x = 0; x < width; x += kLanes) {
+    const int n = std::min(kLanes, width - x);
+    V3 v;
+    V count;
+    const std::size_t at = first + std::size_t(x);
+    if (n == kLanes) {
+      std::memcpy(&v.x, &sums.sum[0][at], sizeof(V));
+      std::memcpy(&v.y, &sums.sum[1][at], sizeof(V));
+      std::memcpy(&v.z, &sums.sum[2][at], sizeof(V));
+      std::memcpy(&count, &sums.count[at], sizeof(V));
+    } else {  // a short last block repeats its last texel
+      gather(v.x, [&](int k) { return sums.sum[0][at + std::size_t(std::min(k, n - 1))]; });
+      gather(v.y, [&](int k) { return sums.sum[1][at + std::size_t(std::min(k, n - 1))]; });
+      gather(v.z, [&](int k) { return sums.sum[2][at + std::size_t(std::min(k, n - 1))]; });
+      gather(count, [&](int k) { return sums.count[at + std::size_t(std::min(k, n - 1))]; });
+    }
+    const unsigned filled = bits(count > zero);
+    if (!filled) continue;
+    // glm::length, then v * (1 / length); a zero sum gives (0, 0, 1).
+    V len2, len;
+    dot(len2, v, v);
+    vsqrt(len, len2);
+    const V inv = 1.0 / len;
+    const M nonzero = len > zero;
+    v.x = nonzero ? v.x * inv : zero;
+    v.y = nonzero ? v.y * inv : zero;
+    v.z = nonzero ? v.z * inv : zero + 1.0;
+    if (flip_y) v.y = -v.y;
+    V* const comp[3] = {&v.x, &v.y, &v.z};
+    F out[3];
+    for (int c = 0; c < 3; ++c) {
+      V& u = *comp[c];
+      const V mag = u < zero ? -u : u;
+      u = mag < snap ? zero : u;
+      out[c] = __builtin_convertvector(u * 0.5 + 0.5, F);
+    }
+    if (filled == 0xfu && n == kLanes) {
+      // Four texels, all with samples (most blocks): interleaved to r g b per texel in registers,
+      // stored as three vectors.
+      const F rg_lo = __builtin_shufflevector(out[0], out[1], 0, 4, 1, 5);     // r0 g0 r1 g1
+      const F rg_mid = __builtin_shufflevector(out[0], out[1], 5, 2, 6, 2);    // g1 r2 g2 -
+      const F rg_hi = __builtin_shufflevector(out[0], out[1], 3, 7, 3, 7);     // r3 g3 - -
+      const F rgb4[3] = {__builtin_shufflevector(rg_lo, out[2], 0, 1, 4, 2),   // r0 g0 b0 r1
+                         __builtin_shufflevector(rg_mid, out[2], 0, 5, 1, 2),  // g1 b1 r2 g2
+                         __builtin_shufflevector(out[2], rg_hi, 2, 4, 5, 3)};  // b2 r3 g3 b3
+      std::memcpy(rgb + 3 * std::size_t(x), rgb4, sizeof rgb4);
+      store_flags(covered + x, 0xfu);
+      continue;
+    }
+    for (int k = 0; k < n; ++k) {
+      if (!(filled >> k & 1u)) continue;
+      for (int c = 0; c < 3; ++c) rgb[3 * std::size_t(x + k) + std::size_t(c)] = out[c][k];
+      covered[x + k] = 1;
+    }
+  }
+}
+
+}  // namespace nmbake
