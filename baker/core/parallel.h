@@ -1,3 +1,4 @@
+// worker(id) on `threads` threads, ids 0 .. threads - 1 (0: the caller's), joined before return.
 // A loop over [0, count) in chunks shared out to `threads` threads (the caller's among them):
 // fn(begin, end) for each chunk, in no particular order. threads <= 0: all cores.
 #pragma once
@@ -9,6 +10,14 @@
 #include <vector>
 
 namespace nmbake {
+
+template <typename Fn>
+void run_parallel(int threads, Fn&& worker) {
+  std::vector<std::thread> pool;
+  for (int i = 1; i < threads; ++i) pool.emplace_back(worker, i);
+  worker(0);
+  for (auto& t : pool) t.join();
+}
 
 template <typename Fn>
 void parallel_chunks(int threads, std::size_t count, std::size_t chunk, Fn&& fn) {

@@ -1,0 +1,47 @@
+#include "pipeline/bvh.h"
+
+namespace nmbake {
+
+void build_high_scene(HighScene& h, const Prepared& s, const Mesh& high, const std::vector<std::uint32_t>& kept,
+                      raycast::BuildQuality quality, int threads) {
+  h.positions = s.high_pos.data();
+  h.index = high.position_index.data();
+  h.normals = s.high_corner_normals.data();
+  h.facing = s.high_facing.data();
+  h.kept_index.clear();
+  h.kept_normals.clear();
+  h.kept_facing.clear();
+  if (!kept.empty()) {
+    std::vector<std::uint32_t> index(3 * kept.size());
+    std::vector<glm::vec3> normals(3 * kept.size());
+    std::vector<std::int8_t> facing(kept.size());
+    for (std::size_t i = 0; i < kept.size(); ++i) {
+      for (int c = 0; c < 3; ++c) {
+        index[3 * i + c] = high.position_index[3 * std::size_t(kept[i]) + c];
+        normals[3 * i + c] = s.high_corner_normals[3 * std::size_t(kept[i]) + c];
+      }
+      facing[i] = s.high_facing[kept[i]];
+    }
+    h.kept_index = std::move(index);
+    h.kept_normals = std::move(normals);
+    h.kept_facing = std::move(facing);
+    h.index = h.kept_index.data();
+    h.normals = h.kept_normals.data();
+    h.facing = h.kept_facing.data();
+  }
+  h.triangles = kept.empty() ? high.triangle_count() : kept.size();
+  h.quality = quality;
+  h.scene.reset();
+  h.scene.emplace(&s.high_pos[0].x, s.high_pos.size(), h.index, h.triangles, quality, threads);
+}
+
+void turn_inverted_high(Prepared& s, HighScene& h, bool normals_computed) {
+  // A file's normals now point against the fronts: how far they lean is then unknown (127).
+  for (auto* v : {&s.high_facing, &h.kept_facing})
+    for (std::int8_t& f : *v) f = normals_computed ? std::int8_t(-f) : raycast::facing_code(f < 0 ? 1 : -1, 2.0);
+  if (normals_computed)
+    for (auto* v : {&s.high_corner_normals, &h.kept_normals})
+      for (glm::vec3& n : *v) n = -n;
+}
+
+}  // namespace nmbake

@@ -1,0 +1,50 @@
+// Stage 4 of the bake, BVH: the high-poly triangles some ray can reach (select.h) in Embree's
+// BVH, with per-triangle arrays (vertex indices, corner normals, facing codes) in the BVH's own
+// order, so a hit's triangle index reads them without a mapping.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "core/mesh.h"
+#include "pipeline/prepare.h"
+#include "raycast.h"
+
+namespace nmbake {
+
+struct HighScene {
+  std::optional<raycast::Scene> scene;
+  const glm::vec3* positions = nullptr;  // re-centred, Prepared::high_pos
+  // 3 vertex indices, 3 corner normals and a facing code per BVH triangle. They point into the
+  // mesh and Prepared, or, when some triangles are left out, into the kept_ copies.
+  const std::uint32_t* index = nullptr;
+  const glm::vec3* normals = nullptr;
+  const std::int8_t* facing = nullptr;
+  std::size_t triangles = 0;
+  raycast::BuildQuality quality = raycast::BuildQuality::medium;
+  std::vector<std::uint32_t> kept_index;
+  std::vector<glm::vec3> kept_normals;
+  std::vector<std::int8_t> kept_facing;
+
+  // The rule the trace applies to hits (raycast::HitRule) over these triangles.
+  raycast::HitRule hit_rule() const {
+    raycast::HitRule rule;
+    rule.facing = facing;
+    rule.corner_normals = normals;
+    return rule;
+  }
+};
+
+// Builds (or rebuilds) `h` over the high-poly triangles `kept` (increasing; empty: all of them).
+void build_high_scene(HighScene& h, const Prepared& s, const Mesh& high, const std::vector<std::uint32_t>& kept,
+                      raycast::BuildQuality quality, int threads);
+
+// The high-poly found inverted (BakeStats::HighFacing): fronts are taken the other way round, and
+// normals nmbake computed itself are turned outwards with them (a file's normals are kept: the map
+// then is what it was without the rule). Applies to the BVH's copies too.
+void turn_inverted_high(Prepared& s, HighScene& h, bool normals_computed);
+
+}  // namespace nmbake

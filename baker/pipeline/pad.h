@@ -1,0 +1,16 @@
+// Stage 7 of the bake, pad: the background (never reached by padding) set to the flat normal, the
+// suspect texels found, and the islands' edges padded (core/padding.h).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "pipeline/bake.h"
+
+namespace nmbake {
+
+// `disagree`: per texel, whether its samples disagree (trace.h; empty with one sample). Fills in
+// result.stats: texels_facing_away, suspect_*, texels_padded; and result.suspect_mask when asked.
+void pad_map(const BakeOptions& opt, const std::vector<std::uint8_t>& disagree, int threads, BakeResult& result);
+
+}  // namespace nmbake

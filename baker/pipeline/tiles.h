@@ -1,0 +1,27 @@
+// Stage 5 of the bake, rasterize: the map in square tiles, each with the low-poly triangles whose
+// UV bounding box touches it, so a tile's samples are tested only against those.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/mesh.h"
+#include "core/rasterize.h"
+
+namespace nmbake {
+
+struct TileBins {
+  int side = 16;              // texels per tile side
+  int tiles_x = 0, tiles_y = 0;
+  std::vector<TexelTriangle> texel_tris;  // per low-poly triangle (setup_texel_triangle)
+  // The triangles of tile i (y * tiles_x + x) are tris[start[i]] .. tris[start[i + 1] - 1], in
+  // increasing order: of two covering one sample, the lower index wins.
+  std::vector<std::uint32_t> start, tris;
+
+  std::size_t count() const { return start.empty() ? 0 : start.size() - 1; }
+  std::size_t tile_of(int x, int y) const { return std::size_t(y / side) * std::size_t(tiles_x) + std::size_t(x / side); }
+};
+
+TileBins bin_triangles(const Mesh& low, int width, int height, int side);
+
+}  // namespace nmbake

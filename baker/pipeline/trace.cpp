@@ -1,0 +1,392 @@
+#include "pipeline/trace.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <limits>
+#include <mutex>
+#include <thread>
+
+#include "trace/shade_batch.h"
+#include "trace/tile_kernels.h"
+
+namespace nmbake {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+constexpr std::size_t kTilesPerGrab = 4;  // consecutive tiles a trace thread takes at once
+// Tangent components this close to zero are written as exactly 0: a flat result is then
+// (128,128,255) and not a coin flip between 127 and 128 decided by float noise.
+constexpr double kSnap = 1e-6;
+
+// One cache line each: the counters change per sample, and shared lines would serialize threads.
+struct alignas(64) ThreadStats {
+  std::uint64_t rays = 0, hits = 0, misses = 0, covered = 0, overlaps = 0, backface_skips = 0, facing_away = 0;
+  Clock::duration intersect{0}, tiles{0};
+  double dmin = std::numeric_limits<double>::infinity(), dmax = -std::numeric_limits<double>::infinity();
+};
+
+// What every thread of the trace reads, and the state they share.
+struct Shared {
+  Shared(const Prepared& s_, const HighScene& scene_, const TileBins& bins_, const RaySetup& setup_, const BakeOptions& opt_,
+         const TraceTargets& out_)
+      : s(s_), scene(scene_), bins(bins_), setup(setup_), opt(opt_), out(out_) {}
+  const Prepared& s;
+  const HighScene& scene;
+  const TileBins& bins;
+  const RaySetup& setup;
+  const BakeOptions& opt;
+  const TraceTargets& out;
+  std::vector<glm::dvec2> offsets;
+  int rays_per_sample = 1;
+  bool batched = false;  // tangent space, per-pixel bitangent: shade_batch.h shades most samples
+  const raycast::HitRule* hit_rule = nullptr;
+  std::vector<ThreadStats> stats;
+  // Hit distances summed per tile, then over tiles in order: the mean does not depend on which
+  // thread took which tile.
+  std::vector<double> tile_dsum;
+  std::atomic<std::size_t> next_tile{0}, tiles_done{0};
+  std::atomic<bool> cancel{false};
+  std::mutex record_mutex;
+};
+
+// One thread's buffers and its walk over the tiles it takes. Sample slots of a tile: sample k of
+// tile texel (x, y) is slot (k * side + y) * side + x, so a texel row is contiguous for the
+// coverage kernel. The covered samples are compacted in slot order, which puts each texel's samples
+// in sample order: that fixes how its values are summed. Rays and hits are arrays, the layout
+// Embree's packets take; sample r casts rays r * rays_per_sample onwards. The coverage fills slots
+// in these same arrays (with the default policy's one ray per sample, slot i's ray is ray i), and
+// the compaction closes the gaps in place: a fully covered stretch of slots stays where it is.
+class TileTracer {
+ public:
+  TileTracer(Shared& sh, int id)
+      : sh_(sh),
+        ts_(sh.stats[std::size_t(id)]),
+        side_(sh.bins.side),
+        tile_texels_(std::size_t(side_) * std::size_t(side_)),
+        slot_count_(tile_texels_ * sh.offsets.size()),
+        default_rays_(!sh.setup.cage && !sh.setup.closest),
+        rays_(slot_count_ * std::size_t(sh.rays_per_sample)),
+        hits_(rays_.hits()),
+        sample_tri_(slot_count_),
+        sample_b_(3 * slot_count_),
+        sample_texel_(slot_count_),
+        sample_fallback_(slot_count_, 1),
+        signed_base_(rays_.size(), double(sh.setup.front)),
+        chosen_(slot_count_),
+        chosen_tri_(slot_count_),
+        chosen_u_(slot_count_),
+        chosen_v_(slot_count_),
+        value_(3 * slot_count_),
+        one_at_a_time_(slot_count_, 1),
+        acc_(4 * tile_texels_),
+        miss_count_(tile_texels_) {
+    for (int c = 0; c < 3; ++c) {
+      sb_[c] = &sample_b_[std::size_t(c) * slot_count_];
+      value_c_[c] = &value_[std::size_t(c) * slot_count_];
+      sums_.sum[c] = &acc_[std::size_t(c) * tile_texels_];
+    }
+    sums_.count = &acc_[3 * tile_texels_];
+    // With two rays per sample (closest), the first leaves the low-poly outwards.
+    if (sh.rays_per_sample == 2) {
+      outward_.assign(rays_.size(), 0);
+      for (std::size_t i = 0; i < outward_.size(); i += 2) outward_[i] = 1;
+    }
+    batch_ = rays_.rays();
+    batch_.outward = outward_.empty() ? nullptr : outward_.data();
+    if (sh.setup.cage) {
+      prefer_lo_.assign(rays_.size(), 0.0f);
+      prefer_hi_.assign(rays_.size(), 0.0f);
+      batch_.prefer_lo = prefer_lo_.data();
+      batch_.prefer_hi = prefer_hi_.data();
+    }
+    // Every default-policy ray starts at 0 and reaches front + rear (sample_rays' too).
+    if (default_rays_) std::fill(rays_.tfar(), rays_.tfar() + rays_.size(), sh.setup.front + sh.setup.rear);
+  }
+
+  void run() {
+    const std::size_t tile_count = sh_.bins.count();
+    for (std::size_t tile = 0, grab_end = 0; !sh_.cancel.load(std::memory_order_relaxed); ++tile) {
+      if (tile == grab_end) {
+        // A few consecutive tiles at a time: they lie near each other on the model, and a thread
+        // that casts their rays one after another finds more of the BVH in its own caches.
+        tile = sh_.next_tile.fetch_add(kTilesPerGrab);
+        if (tile >= tile_count) break;
+        grab_end = std::min(tile + kTilesPerGrab, tile_count);
+      }
+      if (sh_.bins.start[tile] != sh_.bins.start[tile + 1]) trace_tile(tile);  // else no triangle touches it
+      ++sh_.tiles_done;
+    }
+  }
+
+ private:
+  void trace_tile(std::size_t tile) {
+    const auto tile_start = Clock::now();
+    const int W = sh_.opt.width, H = sh_.opt.height;
+    const int tx0 = int(tile % std::size_t(sh_.bins.tiles_x)) * side_, ty0 = int(tile / std::size_t(sh_.bins.tiles_x)) * side_;
+    const int tw = std::min(side_, W - tx0), th = std::min(side_, H - ty0);
+    const std::size_t sample_count = cover_tile(tile, tx0, ty0, tw, th);
+    const std::size_t ray_count = sample_count * std::size_t(sh_.rays_per_sample);
+    make_rays(sample_count);
+    if (ray_count) {
+      const auto cast_start = Clock::now();
+      sh_.scene.scene->intersect(batch_, hits_, ray_count, sh_.hit_rule);
+      ts_.intersect += Clock::now() - cast_start;
+      if (sh_.hit_rule)
+        for (std::size_t r = 0; r < ray_count; ++r) ts_.backface_skips += (hits_.flags[r] & raycast::hit_passed_backface) != 0;
+    }
+    if (sh_.opt.record_rays) {
+      std::lock_guard<std::mutex> lock(sh_.record_mutex);
+      for (std::size_t r = 0; r < ray_count; ++r) sh_.opt.record_rays->push_back(rays_.ray(r));
+    }
+    ts_.rays += ray_count;
+    sh_.tile_dsum[tile] = count_hits(sample_count);
+    shade(sample_count);
+    write_texels(tx0, ty0, tw, th);
+    ts_.tiles += Clock::now() - tile_start;
+  }
+
+  // Rasterize: the covered samples of the tile, compacted (and, for the default policy, their
+  // rays). The lowest triangle index wins a sample covered twice (overlapping islands).
+  std::size_t cover_tile(std::size_t tile, int tx0, int ty0, int tw, int th) {
+    const TileBins& bins = sh_.bins;
+    std::fill(sample_tri_.begin(), sample_tri_.end(), -1);
+    const SampleSlots slots{sample_tri_.data(), {sb_[0], sb_[1], sb_[2]}, {rays_.origin(0), rays_.origin(1), rays_.origin(2)},
+                            {rays_.direction(0), rays_.direction(1), rays_.direction(2)}, sample_fallback_.data()};
+    const DefaultRays default_ray_setup{default_rays_ ? sh_.s.low_tris.data() : nullptr, sh_.setup.front};
+    for (std::uint32_t bi = bins.start[tile]; bi < bins.start[tile + 1]; ++bi) {
+      const std::uint32_t t = bins.tris[bi];
+      const TexelTriangle& tt = bins.texel_tris[t];
+      const int x0 = std::max(tt.xmin, tx0), x1 = std::min(tt.xmax, tx0 + tw - 1);
+      const int y0 = std::max(tt.ymin, ty0), y1 = std::min(tt.ymax, ty0 + th - 1);
+      if (x1 < x0 || y1 < y0) continue;
+      for (std::size_t k = 0; k < sh_.offsets.size(); ++k)
+        ts_.overlaps += cover_rect(tt, std::int32_t(t), x0, x1, y0, y1, sh_.offsets[k].x, sh_.offsets[k].y, default_ray_setup, slots,
+                                   (k * std::size_t(side_) + std::size_t(y0 - ty0)) * std::size_t(side_) + std::size_t(x0 - tx0),
+                                   std::size_t(side_));
+    }
+    const CoveredSamples covered{sample_tri_.data(), {sb_[0], sb_[1], sb_[2]}, sample_texel_.data(), {slots.org[0], slots.org[1], slots.org[2]},
+                                 {slots.dir[0], slots.dir[1], slots.dir[2]}, sample_fallback_.data()};
+    return compact_samples(slots, slot_count_, tile_texels_, default_rays_, covered);
+  }
+
+  // The rays the coverage did not make: cage rays straight into the arrays, and one at a time the
+  // other policies' and the default policy's special cases.
+  void make_rays(std::size_t sample_count) {
+    const RaySetup& setup = sh_.setup;
+    if (setup.cage && !setup.closest) {
+      for (std::size_t r = 0; r < sample_count; ++r) {
+        const double b[3] = {sb_[0][r], sb_[1][r], sb_[2][r]};
+        const std::size_t tri = std::size_t(sample_tri_[r]);
+        rays_.set(r, inward_ray(cage_ray(sh_.s.low_tris[tri], sh_.s.cage_tris[tri], b, setup.diagonal), &signed_base_[r], &prefer_lo_[r]));
+        prefer_hi_[r] = std::numeric_limits<float>::infinity();
+      }
+      return;
+    }
+    const std::size_t per = std::size_t(sh_.rays_per_sample);
+    for (std::size_t r = 0; r < sample_count; ++r) {
+      if (!sample_fallback_[r]) continue;
+      raycast::Ray one[2];
+      const double b[3] = {sb_[0][r], sb_[1][r], sb_[2][r]};
+      float lo[2], hi[2];
+      const int n = sample_rays(sh_.s, std::size_t(sample_tri_[r]), b, setup, one, &signed_base_[r * per], lo, hi);
+      for (int j = 0; j < n; ++j) {
+        const std::size_t i = r * per + std::size_t(j);
+        rays_.set(i, one[j]);
+        if (setup.cage) prefer_lo_[i] = lo[j], prefer_hi_[i] = hi[j];
+      }
+    }
+  }
+
+  // In sample order, which ray's hit counts and the hit statistics. Returns the tile's sum of hit
+  // distances.
+  double count_hits(std::size_t sample_count) {
+    std::fill(miss_count_.begin(), miss_count_.end(), 0u);
+    std::size_t tile_hits = 0;
+    // In registers for the tile: the stores below could alias the thread's counters.
+    double dsum = 0.0, dmin = ts_.dmin, dmax = ts_.dmax;
+    const std::size_t per = std::size_t(sh_.rays_per_sample);
+    for (std::size_t r = 0; r < sample_count; ++r) {
+      double dist = 0.0;
+      const std::size_t h = chosen_hit(hits_, r * per, signed_base_.data(), sh_.setup.closest, &dist);
+      if (per != 1) {
+        chosen_[r] = std::uint32_t(h);
+        chosen_tri_[r] = hits_.triangle[h];
+        chosen_u_[r] = hits_.u[h];
+        chosen_v_[r] = hits_.v[h];
+      }
+      if (hits_.triangle[h] != raycast::no_hit) {
+        if (sh_.hit_rule) ts_.facing_away += (hits_.flags[h] & raycast::hit_normal_disagrees) != 0;
+        // The hit triangles' corner normals are scattered over the high-poly: ask for them all
+        // before shading needs the first, so the cache misses overlap.
+        const char* line = reinterpret_cast<const char*>(&sh_.scene.normals[3 * std::size_t(hits_.triangle[h])]);
+        __builtin_prefetch(line);
+        __builtin_prefetch(line + sizeof(glm::vec3) * 3 - 1);
+        ++tile_hits;
+        dmin = std::min(dmin, dist);
+        dmax = std::max(dmax, dist);
+        dsum += dist;
+      } else {
+        ++miss_count_[sample_texel_[r]];
+      }
+    }
+    ts_.covered += sample_count;
+    ts_.hits += tile_hits;
+    ts_.misses += sample_count - tile_hits;
+    ts_.dmin = dmin;
+    ts_.dmax = dmax;
+    return dsum;
+  }
+
+  // The high-poly normal at each hit in the low-poly's frame at P: the common case (tangent space,
+  // per-pixel bitangent) for all samples at once, then one at a time the misses and the cases the
+  // batch leaves out; each sample's value summed into its texel.
+  void shade(std::size_t sample_count) {
+    const bool one_ray = sh_.rays_per_sample == 1;
+    std::fill(acc_.begin(), acc_.end(), 0.0);
+    if (sh_.batched && sample_count) {
+      const ShadeSamples in{sample_tri_.data(), {sb_[0], sb_[1], sb_[2]}, one_ray ? hits_.triangle : chosen_tri_.data(),
+                            one_ray ? hits_.u : chosen_u_.data(), one_ray ? hits_.v : chosen_v_.data()};
+      encode_hits_per_pixel(sh_.s.low_tris.data(), sh_.scene.normals, in, sample_count, value_c_, one_at_a_time_.data());
+    }
+    for (std::size_t r = 0; r < sample_count; ++r) {
+      if (!one_at_a_time_[r]) continue;
+      const double b[3] = {sb_[0][r], sb_[1][r], sb_[2][r]};
+      const glm::dvec3 v = shade_sample(sh_.s, sh_.scene, std::size_t(sample_tri_[r]), b, rays_.hit(one_ray ? r : chosen_[r]), sh_.opt);
+      for (int c = 0; c < 3; ++c) value_c_[c][r] = v[c];
+    }
+    accumulate_samples(value_c_, sample_texel_.data(), sample_count, sums_);
+  }
+
+  // Texels: renormalized mean of their covered samples; with several samples, whether they
+  // disagree; the miss mask.
+  void write_texels(int tx0, int ty0, int tw, int th) {
+    const int W = sh_.opt.width;
+    const TraceTargets& out = sh_.out;
+    if (!out.disagree.empty())
+      for (int y = 0; y < th; ++y)
+        for (int x = 0; x < tw; ++x) {
+          const std::size_t i = std::size_t(y) * std::size_t(side_) + std::size_t(x);
+          const double n = sums_.count[i];
+          const double len2 = sums_.sum[0][i] * sums_.sum[0][i] + sums_.sum[1][i] * sums_.sum[1][i] + sums_.sum[2][i] * sums_.sum[2][i];
+          if (n > 1.0 && len2 < kSuspectAgreement * kSuspectAgreement * n * n)
+            out.disagree[std::size_t(ty0 + y) * std::size_t(W) + std::size_t(tx0 + x)] = 1;
+        }
+    const bool flip_y = sh_.opt.space == NormalSpace::tangent && sh_.opt.green_down;
+    for (int y = 0; y < th; ++y) {
+      const std::size_t first = std::size_t(y) * std::size_t(side_), gi = std::size_t(ty0 + y) * std::size_t(W) + std::size_t(tx0);
+      write_texel_row(sums_, first, tw, flip_y, kSnap, out.map.at(tx0, ty0 + y), &out.coverage[gi]);
+      if (sh_.opt.miss_mask)
+        for (int x = 0; x < tw; ++x)
+          if (sums_.count[first + std::size_t(x)] > 0.0)
+            out.miss_mask.pixels[gi + std::size_t(x)] = float(miss_count_[first + std::size_t(x)]) / float(sums_.count[first + std::size_t(x)]);
+    }
+  }
+
+  Shared& sh_;
+  ThreadStats& ts_;
+  const int side_;
+  const std::size_t tile_texels_, slot_count_;
+  const bool default_rays_;
+  raycast::RayArrays rays_;
+  const raycast::HitBatch hits_;
+  raycast::RayBatch batch_;
+  std::vector<std::uint8_t> outward_;
+  std::vector<float> prefer_lo_, prefer_hi_;
+  std::vector<std::int32_t> sample_tri_;
+  std::vector<double> sample_b_;
+  double* sb_[3];
+  std::vector<std::uint16_t> sample_texel_;
+  std::vector<std::uint8_t> sample_fallback_;  // per covered sample: its ray is made one at a time
+  std::vector<double> signed_base_;            // per ray: distance from P to its origin along it
+  // The hit that counts, per covered sample: with one ray per sample its own, read in place; with
+  // two (closest), picked into these.
+  std::vector<std::uint32_t> chosen_, chosen_tri_;
+  std::vector<float> chosen_u_, chosen_v_;
+  std::vector<double> value_;
+  double* value_c_[3];
+  std::vector<std::uint8_t> one_at_a_time_;  // per covered sample: shaded by shade_sample
+  std::vector<double> acc_;  // per texel of the tile: x, y, z sums and covered samples, as arrays
+  TexelSums sums_;
+  std::vector<std::uint32_t> miss_count_;
+};
+
+// Runs `threads` tracers; the calling thread reports progress every 100 ms. The last worker to
+// finish wakes the wait at once, so the stage does not end up to 100 ms after its work.
+void run_tracers(Shared& sh, int threads) {
+  std::mutex done_mutex;
+  std::condition_variable done_cv;
+  int running = threads;
+  std::vector<std::thread> pool;
+  for (int i = 0; i < threads; ++i)
+    pool.emplace_back([&, i] {
+      TileTracer(sh, i).run();
+      std::lock_guard<std::mutex> lock(done_mutex);
+      if (--running == 0) done_cv.notify_all();
+    });
+  if (sh.opt.progress) {
+    const double tile_count = double(sh.bins.count());
+    std::unique_lock<std::mutex> lock(done_mutex);
+    while (running > 0 && !sh.cancel.load()) {
+      lock.unlock();
+      if (!sh.opt.progress(double(sh.tiles_done.load()) / tile_count)) sh.cancel = true;
+      lock.lock();
+      done_cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return running == 0; });
+    }
+  }
+  for (auto& t : pool) t.join();
+  if (sh.cancel) throw Cancelled();
+  if (sh.opt.progress) sh.opt.progress(1.0);
+}
+
+}  // namespace
+
+void trace_and_shade(const Prepared& s, const HighScene& scene, const TileBins& bins, const RaySetup& rays,
+                     const BakeOptions& opt, int threads, const TraceTargets& out, BakeStats& st) {
+  Shared sh(s, scene, bins, rays, opt, out);
+  sh.offsets = sample_offsets(opt.samples);
+  sh.rays_per_sample = rays.closest ? 2 : 1;
+  sh.batched = opt.space == NormalSpace::tangent && opt.bitangent == BitangentMode::per_pixel;
+  const raycast::HitRule rule = scene.hit_rule();
+  sh.hit_rule = st.backfaces_skipped ? &rule : nullptr;
+  sh.stats.resize(std::size_t(threads));
+  sh.tile_dsum.assign(bins.count(), 0.0);
+  run_tracers(sh, threads);
+
+  ThreadStats total;
+  for (const ThreadStats& ts : sh.stats) {
+    total.rays += ts.rays;
+    total.hits += ts.hits;
+    total.misses += ts.misses;
+    total.covered += ts.covered;
+    total.overlaps += ts.overlaps;
+    total.backface_skips += ts.backface_skips;
+    total.facing_away += ts.facing_away;
+    st.thread_seconds_intersect += std::chrono::duration<double>(ts.intersect).count();
+    st.thread_seconds_tiles += std::chrono::duration<double>(ts.tiles).count();
+    total.dmin = std::min(total.dmin, ts.dmin);
+    total.dmax = std::max(total.dmax, ts.dmax);
+  }
+  st.rays = total.rays;
+  st.hits = total.hits;
+  st.misses = total.misses;
+  st.samples_covered = total.covered;
+  st.overlapping_samples = total.overlaps;
+  st.backface_skips = total.backface_skips;
+  st.hits_facing_away = total.facing_away;
+  if (total.hits) {
+    st.hit_distance_min = total.dmin;
+    st.hit_distance_max = total.dmax;
+    double dsum = 0.0;
+    for (double d : sh.tile_dsum) dsum += d;
+    st.hit_distance_mean = dsum / double(total.hits);
+  }
+  st.texels_total = std::size_t(opt.width) * std::size_t(opt.height);
+  for (std::uint8_t c : out.coverage) st.texels_covered += c;
+  st.coverage = double(st.texels_covered) / double(st.texels_total);
+}
+
+}  // namespace nmbake
