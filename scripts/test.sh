@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Command 2: install what is missing, then run every test configuration:
-#   unit     the normal Release build (build/) and its whole test suite with ctest
+#   unit     the normal Release build (build/, with the bench programs) and its whole test suite with ctest
 #   threads  maps byte-identical with --threads 1 and 2 (scripts/test-threads.sh)
 #   asan     an ASan+UBSan build (build-asan/) and the whole test suite again (scripts/test-sanitize.sh)
 #   fuzz     the mesh-loading fuzz target for 60 s (build-fuzz/, scripts/fuzz.sh)
@@ -17,7 +17,8 @@ for part in $parts; do
   echo "=== test.sh: $part"
   case "$part" in
     unit)
-      bash "$root/scripts/build.sh"
+      # The bench programs too (compiled, not run), so a change that breaks them fails here.
+      bash "$root/scripts/build.sh" -DNMBAKE_BENCH=ON
       (cd "$build" && ctest --output-on-failure -j "$(nproc 2>/dev/null || echo 2)" --timeout 900) ;;
     threads) bash "$root/scripts/test-threads.sh" ;;
     asan) bash "$root/scripts/test-sanitize.sh" ;;

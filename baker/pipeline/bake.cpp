@@ -134,21 +134,24 @@ std::uint64_t estimate_bake_bytes(const BakeOptions& o) {
   return texels * per_texel;
 }
 
-// The stages in order (README "Layout"): prepare, select, BVH, distances (and a narrower
-// selection once they are known), rasterize, trace and shade, pad. Loading and writing are the
-// caller's (io/).
-BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt) {
-  check_bake_inputs(low, high, cage, opt);
-  const int threads = opt.threads > 0 ? opt.threads : std::max(1, int(std::thread::hardware_concurrency()));
-  BakeResult result;
+namespace {
+
+// The stages up to the trace's (prepare, select, BVH, distances and a narrower selection once they
+// are known): what the trace reads, but the tiles.
+struct TraceInputs {
+  Prepared s;
+  HighScene scene;
+  RaySetup rays;
+};
+
+void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt, int threads, TraceInputs& in,
+                   BakeResult& result) {
   BakeStats& st = result.stats;
   st.low_triangles = low.triangle_count();
   st.high_triangles = high.triangle_count();
-  std::vector<std::uint8_t> disagree;  // per texel: its samples disagree (suspect), with several samples
-  OutputAllocation outputs(opt, result, disagree);
-
   auto t0 = Clock::now();
-  Prepared s = prepare(low, high, cage, st);
+  Prepared& s = in.s;
+  s = prepare(low, high, cage, st);
   const ReachMode mode = ReachMode::of(opt, cage, s);
   st.seconds_prepare = seconds_since(t0);
 
@@ -158,7 +161,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   std::vector<std::uint32_t> kept;  // increasing; empty: all
   if (opt.cull_far)
     kept = select_reachable(s, high, mode.probing ? mode.reach * 1.01 + 1e-6 * s.diagonal : ray_margin(s, mode.any_cage, opt.front, opt.rear));
-  HighScene scene;
+  HighScene& scene = in.scene;
   build_high_scene(scene, s, high, kept, bvh_quality_for(opt, kept.empty() ? high.triangle_count() : kept.size()), opt.threads);
   st.seconds_bvh = seconds_since(t0);
 
@@ -178,21 +181,40 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   }
   st.bvh_quality = scene.quality;
   st.high_triangles_culled = high.triangle_count() - scene.triangles;
+  in.rays.front = st.front;
+  in.rays.rear = st.rear;
+  in.rays.cage = mode.any_cage;
+  in.rays.closest = opt.policy == RayPolicy::closest;
+  in.rays.diagonal = s.diagonal;
+}
 
-  t0 = Clock::now();
+// Tiles of 32 x 32 texels up to 4 samples, else 16 x 16: a triangle's rows within a tile are
+// longer with the larger ones (less set-up per texel), and a tile's samples stay within the cache
+// with the smaller.
+int tile_side(const BakeOptions& opt) { return opt.samples <= 4 ? 2 * kTile : kTile; }
+
+int thread_count(const BakeOptions& opt) { return opt.threads > 0 ? opt.threads : std::max(1, int(std::thread::hardware_concurrency())); }
+
+}  // namespace
+
+// The stages in order (README "Layout"): prepare, select, BVH, distances (and a narrower
+// selection once they are known), rasterize, trace and shade, pad. Loading and writing are the
+// caller's (io/).
+BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt) {
+  check_bake_inputs(low, high, cage, opt);
+  const int threads = thread_count(opt);
+  BakeResult result;
+  BakeStats& st = result.stats;
+  std::vector<std::uint8_t> disagree;  // per texel: its samples disagree (suspect), with several samples
+  OutputAllocation outputs(opt, result, disagree);
+  TraceInputs in;
+  prepare_trace(low, high, cage, opt, threads, in, result);
+
+  auto t0 = Clock::now();
   const double cpu0 = process_cpu_seconds();
-  // Tiles of 32 x 32 texels up to 4 samples, else 16 x 16: a triangle's rows within a tile are
-  // longer with the larger ones (less set-up per texel), and a tile's samples stay within the
-  // cache with the smaller.
-  const TileBins bins = bin_triangles(low, opt.width, opt.height, opt.samples <= 4 ? 2 * kTile : kTile);
+  const TileBins bins = bin_triangles(low, opt.width, opt.height, tile_side(opt));
   outputs.wait();
-  RaySetup rays;
-  rays.front = st.front;
-  rays.rear = st.rear;
-  rays.cage = mode.any_cage;
-  rays.closest = opt.policy == RayPolicy::closest;
-  rays.diagonal = s.diagonal;
-  trace_and_shade(s, scene, bins, rays, opt, threads, {result.map, result.coverage, result.miss_mask, disagree}, st);
+  trace_and_shade(in.s, in.scene, bins, in.rays, opt, threads, {result.map, result.coverage, result.miss_mask, disagree}, st);
   st.seconds_trace = seconds_since(t0);
   st.cpu_seconds_trace = process_cpu_seconds() - cpu0;
 
@@ -200,6 +222,15 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   pad_map(opt, disagree, threads, result);
   st.seconds_padding = seconds_since(t0);
   return result;
+}
+
+BakeRays bake_rays(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt) {
+  check_bake_inputs(low, high, cage, opt);
+  BakeResult result;
+  TraceInputs in;
+  prepare_trace(low, high, cage, opt, thread_count(opt), in, result);
+  const TileBins bins = bin_triangles(low, opt.width, opt.height, tile_side(opt));
+  return {trace_rays(in.s, in.scene, bins, in.rays, opt), result.stats};
 }
 
 }  // namespace nmbake

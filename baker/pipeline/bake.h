@@ -68,9 +68,6 @@ struct BakeOptions {
   // Bytes the bake's buffers may take (estimate_bake_bytes); 0 = what the machine has
   // (memory_budget_bytes: MemAvailable, cgroup limit, ulimit -v). Larger bakes are refused.
   std::uint64_t memory_limit = 0;
-  // For the bench: when set, receives a copy of every ray the trace stage cast (order unspecified),
-  // in coordinates re-centred on BakeStats::centre.
-  std::vector<raycast::Ray>* record_rays = nullptr;
   // Called from the calling thread with the fraction done in [0,1]; return false to cancel
   // (bake_normal_map then throws Cancelled).
   std::function<bool(double)> progress;
@@ -143,10 +140,6 @@ struct BakeStats {
   // Seconds per stage.
   double seconds_prepare = 0, seconds_bvh = 0, seconds_distances = 0, seconds_trace = 0, seconds_padding = 0;
   double cpu_seconds_trace = 0;  // process CPU time of the trace stage (all threads)
-  // Of the trace stage's thread time (all threads), the seconds spent inside Embree's intersection
-  // calls, and the seconds spent working on tiles in all (rasterizing, making rays, casting them,
-  // shading, writing texels): the rest of a tile's time is the bake's own arithmetic.
-  double thread_seconds_intersect = 0, thread_seconds_tiles = 0;
 };
 
 struct BakeResult {
@@ -173,6 +166,15 @@ struct Cancelled : Error {
 // Throws UsageError for absurd options, InputError for meshes that cannot be baked (no UVs, cage
 // topology mismatch), ResourceError when the buffers would not fit in memory, Cancelled.
 BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& options);
+
+// The rays bake_normal_map would cast with these options, in coordinates re-centred on
+// stats.centre, tile by tile, and the stats of the stages before the trace (distances, culling,
+// BVH quality). The bench traces them with a bare Embree loop.
+struct BakeRays {
+  std::vector<raycast::Ray> rays;
+  BakeStats stats;
+};
+BakeRays bake_rays(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& options);
 
 // The BVH build quality a bake with these options picks for `triangles` high-poly triangles (after
 // culling), by measurement (bench, issue 6): with few rays per triangle the quick Morton build wins

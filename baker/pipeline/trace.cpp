@@ -15,7 +15,6 @@ namespace nmbake {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
 
 constexpr std::size_t kTilesPerGrab = 4;  // consecutive tiles a trace thread takes at once
 // Tangent components this close to zero are written as exactly 0: a flat result is then
@@ -25,15 +24,23 @@ constexpr double kSnap = 1e-6;
 // One cache line each: the counters change per sample, and shared lines would serialize threads.
 struct alignas(64) ThreadStats {
   std::uint64_t rays = 0, hits = 0, misses = 0, covered = 0, overlaps = 0, backface_skips = 0, facing_away = 0;
-  Clock::duration intersect{0}, tiles{0};
   double dmin = std::numeric_limits<double>::infinity(), dmax = -std::numeric_limits<double>::infinity();
 };
 
 // What every thread of the trace reads, and the state they share.
 struct Shared {
   Shared(const Prepared& s_, const HighScene& scene_, const TileBins& bins_, const RaySetup& setup_, const BakeOptions& opt_,
-         const TraceTargets& out_)
-      : s(s_), scene(scene_), bins(bins_), setup(setup_), opt(opt_), out(out_) {}
+         const TraceTargets& out_, int threads)
+      : s(s_),
+        scene(scene_),
+        bins(bins_),
+        setup(setup_),
+        opt(opt_),
+        out(out_),
+        offsets(sample_offsets(opt_.samples)),
+        rays_per_sample(setup_.closest ? 2 : 1),
+        batched(opt_.space == NormalSpace::tangent && opt_.bitangent == BitangentMode::per_pixel),
+        stats(std::size_t(threads)) {}
   const Prepared& s;
   const HighScene& scene;
   const TileBins& bins;
@@ -50,7 +57,6 @@ struct Shared {
   std::vector<double> tile_dsum;
   std::atomic<std::size_t> next_tile{0}, tiles_done{0};
   std::atomic<bool> cancel{false};
-  std::mutex record_mutex;
 };
 
 // One thread's buffers and its walk over the tiles it takes. Sample slots of a tile: sample k of
@@ -107,6 +113,16 @@ class TileTracer {
     if (default_rays_) std::fill(rays_.tfar(), rays_.tfar() + rays_.size(), sh.setup.front + sh.setup.rear);
   }
 
+  // Appends the rays of every tile to `out`, in tile order, and casts none.
+  void collect_rays(std::vector<raycast::Ray>& out) {
+    for (std::size_t tile = 0; tile < sh_.bins.count(); ++tile) {
+      if (sh_.bins.start[tile] == sh_.bins.start[tile + 1]) continue;
+      const std::size_t sample_count = cover_tile(tile, rect_of(tile));
+      make_rays(sample_count);
+      for (std::size_t r = 0; r < sample_count * std::size_t(sh_.rays_per_sample); ++r) out.push_back(rays_.ray(r));
+    }
+  }
+
   void run() {
     const std::size_t tile_count = sh_.bins.count();
     for (std::size_t tile = 0, grab_end = 0; !sh_.cancel.load(std::memory_order_relaxed); ++tile) {
@@ -123,36 +139,35 @@ class TileTracer {
   }
 
  private:
+  struct TileRect {
+    int x0, y0, w, h;  // first texel, and size (tiles at the map's right and bottom edges are cut)
+  };
+  TileRect rect_of(std::size_t tile) const {
+    const int x0 = int(tile % std::size_t(sh_.bins.tiles_x)) * side_, y0 = int(tile / std::size_t(sh_.bins.tiles_x)) * side_;
+    return {x0, y0, std::min(side_, sh_.opt.width - x0), std::min(side_, sh_.opt.height - y0)};
+  }
+
   void trace_tile(std::size_t tile) {
-    const auto tile_start = Clock::now();
-    const int W = sh_.opt.width, H = sh_.opt.height;
-    const int tx0 = int(tile % std::size_t(sh_.bins.tiles_x)) * side_, ty0 = int(tile / std::size_t(sh_.bins.tiles_x)) * side_;
-    const int tw = std::min(side_, W - tx0), th = std::min(side_, H - ty0);
-    const std::size_t sample_count = cover_tile(tile, tx0, ty0, tw, th);
+    const TileRect rect = rect_of(tile);
+    const std::size_t sample_count = cover_tile(tile, rect);
     const std::size_t ray_count = sample_count * std::size_t(sh_.rays_per_sample);
     make_rays(sample_count);
     if (ray_count) {
-      const auto cast_start = Clock::now();
       sh_.scene.scene->intersect(batch_, hits_, ray_count, sh_.hit_rule);
-      ts_.intersect += Clock::now() - cast_start;
       if (sh_.hit_rule)
         for (std::size_t r = 0; r < ray_count; ++r) ts_.backface_skips += (hits_.flags[r] & raycast::hit_passed_backface) != 0;
-    }
-    if (sh_.opt.record_rays) {
-      std::lock_guard<std::mutex> lock(sh_.record_mutex);
-      for (std::size_t r = 0; r < ray_count; ++r) sh_.opt.record_rays->push_back(rays_.ray(r));
     }
     ts_.rays += ray_count;
     sh_.tile_dsum[tile] = count_hits(sample_count);
     shade(sample_count);
-    write_texels(tx0, ty0, tw, th);
-    ts_.tiles += Clock::now() - tile_start;
+    write_texels(rect);
   }
 
   // Rasterize: the covered samples of the tile, compacted (and, for the default policy, their
   // rays). The lowest triangle index wins a sample covered twice (overlapping islands).
-  std::size_t cover_tile(std::size_t tile, int tx0, int ty0, int tw, int th) {
+  std::size_t cover_tile(std::size_t tile, const TileRect& rect) {
     const TileBins& bins = sh_.bins;
+    const int tx0 = rect.x0, ty0 = rect.y0, tw = rect.w, th = rect.h;
     std::fill(sample_tri_.begin(), sample_tri_.end(), -1);
     const SampleSlots slots{sample_tri_.data(), {sb_[0], sb_[1], sb_[2]}, {rays_.origin(0), rays_.origin(1), rays_.origin(2)},
                             {rays_.direction(0), rays_.direction(1), rays_.direction(2)}, sample_fallback_.data()};
@@ -263,8 +278,8 @@ class TileTracer {
 
   // Texels: renormalized mean of their covered samples; with several samples, whether they
   // disagree; the miss mask.
-  void write_texels(int tx0, int ty0, int tw, int th) {
-    const int W = sh_.opt.width;
+  void write_texels(const TileRect& rect) {
+    const int W = sh_.opt.width, tx0 = rect.x0, ty0 = rect.y0, tw = rect.w, th = rect.h;
     const TraceTargets& out = sh_.out;
     if (!out.disagree.empty())
       for (int y = 0; y < th; ++y)
@@ -344,15 +359,22 @@ void run_tracers(Shared& sh, int threads) {
 
 }  // namespace
 
+std::vector<raycast::Ray> trace_rays(const Prepared& s, const HighScene& scene, const TileBins& bins, const RaySetup& rays,
+                                     const BakeOptions& opt) {
+  Image map;
+  std::vector<std::uint8_t> coverage, disagree;
+  const TraceTargets out{map, coverage, map, disagree};
+  Shared sh(s, scene, bins, rays, opt, out, 1);
+  std::vector<raycast::Ray> all;
+  TileTracer(sh, 0).collect_rays(all);
+  return all;
+}
+
 void trace_and_shade(const Prepared& s, const HighScene& scene, const TileBins& bins, const RaySetup& rays,
                      const BakeOptions& opt, int threads, const TraceTargets& out, BakeStats& st) {
-  Shared sh(s, scene, bins, rays, opt, out);
-  sh.offsets = sample_offsets(opt.samples);
-  sh.rays_per_sample = rays.closest ? 2 : 1;
-  sh.batched = opt.space == NormalSpace::tangent && opt.bitangent == BitangentMode::per_pixel;
+  Shared sh(s, scene, bins, rays, opt, out, threads);
   const raycast::HitRule rule = scene.hit_rule();
   sh.hit_rule = st.backfaces_skipped ? &rule : nullptr;
-  sh.stats.resize(std::size_t(threads));
   sh.tile_dsum.assign(bins.count(), 0.0);
   run_tracers(sh, threads);
 
@@ -365,8 +387,6 @@ void trace_and_shade(const Prepared& s, const HighScene& scene, const TileBins& 
     total.overlaps += ts.overlaps;
     total.backface_skips += ts.backface_skips;
     total.facing_away += ts.facing_away;
-    st.thread_seconds_intersect += std::chrono::duration<double>(ts.intersect).count();
-    st.thread_seconds_tiles += std::chrono::duration<double>(ts.tiles).count();
     total.dmin = std::min(total.dmin, ts.dmin);
     total.dmax = std::max(total.dmax, ts.dmax);
   }

@@ -26,9 +26,13 @@ struct TraceTargets {
   std::vector<std::uint8_t>& disagree;
 };
 
+// The rays trace_and_shade casts, tile by tile (no map is made).
+std::vector<raycast::Ray> trace_rays(const Prepared& s, const HighScene& scene, const TileBins& bins, const RaySetup& rays,
+                                     const BakeOptions& opt);
+
 // Traces every tile of `bins`, applying the hit rule of `scene` unless stats.backfaces_skipped is
 // false. Fills in `st`: rays, hits, misses, samples_covered, overlapping_samples, backface_skips,
-// hits_facing_away, hit_distance_*, texels_total, texels_covered, coverage, thread_seconds_*.
+// hits_facing_away, hit_distance_*, texels_total, texels_covered, coverage.
 // Calls options.progress from the calling thread; throws Cancelled when it returns false.
 void trace_and_shade(const Prepared& s, const HighScene& scene, const TileBins& bins, const RaySetup& rays,
                      const BakeOptions& opt, int threads, const TraceTargets& out, BakeStats& st);
