@@ -6,6 +6,7 @@
 #include <fstream>
 #include <iostream>
 #include <new>
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -18,7 +19,8 @@
 
 namespace {
 
-using nmbake::diff::DiffStats;
+namespace diff = nmbake::diff;
+using diff::DiffStats;
 
 // Exit status, as documented in --help.
 constexpr int kWithin = 0, kOutside = 1, kError = 2;
@@ -95,20 +97,20 @@ void write_text(const std::string& path, const std::string& text) {
   if (!f) throw nmbake::OutputError(path + ": cannot write: " + std::strerror(errno));
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  namespace diff = nmbake::diff;
+// The command line as given, and the comparison options it sets.
+struct CommandLine {
   diff::DiffOptions options;
   std::string path_a, path_b, heatmap_path, json_path, mask_path;
   std::string green_a = "up", green_b = "up", resample = "none";
-  double heatmap_scale = 0.0;
+  double heatmap_scale = 0.0;  // 0 = automatic
   bool ignore_alpha = false;
+};
 
-  CLI::App app{"nmdiff: compare two tangent-space normal maps by the angle between their normals.\n"
-               "Texels decode as n = normalize(rgb * 2 - 1); the angle is reported in degrees."};
-  app.add_option("A", path_a, "Map to check (e.g. a fresh bake); any format OpenImageIO reads")->required();
-  app.add_option("B", path_b, "Reference map (e.g. the golden map)")->required();
+// nmdiff's arguments, bound to the fields of `cl`, and the text of --help.
+void add_arguments(CLI::App& app, CommandLine& cl) {
+  diff::DiffOptions& options = cl.options;
+  app.add_option("A", cl.path_a, "Map to check (e.g. a fresh bake); any format OpenImageIO reads")->required();
+  app.add_option("B", cl.path_b, "Reference map (e.g. the golden map)")->required();
   app.add_option("--max-mean", options.tolerances.max_mean_deg, "Tolerance on the mean difference, degrees")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
@@ -118,31 +120,31 @@ int main(int argc, char** argv) {
   app.add_option("--max-deg", options.tolerances.max_deg, "Tolerance on the largest difference, degrees")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--mask", mask_path,
+  app.add_option("--mask", cl.mask_path,
                  "Low-poly mesh (OBJ, PLY, OFF, STL with UVs): compare only texels inside its UV layout, "
                  "rasterized as the baker does, so padding is ignored");
   app.add_flag("--include-padding", options.include_padding,
                "Also compare texels outside the --mask layout and outside alpha coverage");
-  app.add_flag("--ignore-alpha", ignore_alpha, "Do not treat a 4th channel as coverage");
-  app.add_option("--green-a", green_a, "Green convention of A: up (OpenGL Y+) or down (DirectX Y-)")
+  app.add_flag("--ignore-alpha", cl.ignore_alpha, "Do not treat a 4th channel as coverage");
+  app.add_option("--green-a", cl.green_a, "Green convention of A: up (OpenGL Y+) or down (DirectX Y-)")
       ->capture_default_str()
       ->check(CLI::IsMember({"up", "down"}));
-  app.add_option("--green-b", green_b, "Green convention of B: up or down")
+  app.add_option("--green-b", cl.green_b, "Green convention of B: up or down")
       ->capture_default_str()
       ->check(CLI::IsMember({"up", "down"}));
-  app.add_option("--resample", resample,
+  app.add_option("--resample", cl.resample,
                  "When sizes differ, bring B onto A's grid: nearest, bilinear or box (mean of the texels "
                  "inside); none = sizes must match")
       ->capture_default_str()
       ->check(CLI::IsMember({"none", "nearest", "bilinear", "box"}));
-  app.add_option("--heatmap", heatmap_path,
+  app.add_option("--heatmap", cl.heatmap_path,
                  "Write a colour picture of the difference (.png, .tif, .exr): dark violet 0 deg to yellow at "
                  "the scale; dark grey = not compared; legend bar below, its range also in metadata");
-  app.add_option("--heatmap-scale", heatmap_scale,
+  app.add_option("--heatmap-scale", cl.heatmap_scale,
                  "Difference shown as full yellow, degrees; 0 = max(--max-deg, observed p99)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--json", json_path, "Write the statistics as JSON");
+  app.add_option("--json", cl.json_path, "Write the statistics as JSON");
   app.footer(
       "Defaults accept 8-bit rounding: a float map against its own 8-bit quantisation differs by at most\n"
       "0.39 deg (mean 0.17 deg on random normals, 0.32 deg everywhere on a flat map); two 8-bit roundings\n"
@@ -151,6 +153,27 @@ int main(int argc, char** argv) {
       "The last line of output is: mean=<deg> p99=<deg> max=<deg> texels=<n> within=<0|1>\n"
       "Exit status: 0 within tolerance, 1 outside tolerance (or nothing compared),\n"
       "             2 unreadable or invalid input, unwritable output, or a bad command line.");
+}
+
+// Sets cl.options from the words given for the green conventions, the resampling and alpha.
+void apply_choices(CommandLine& cl) {
+  diff::DiffOptions& options = cl.options;
+  const std::string &green_a = cl.green_a, &green_b = cl.green_b, &resample = cl.resample;
+  options.green_a = green_a == "down" ? diff::GreenAxis::down : diff::GreenAxis::up;
+  options.green_b = green_b == "down" ? diff::GreenAxis::down : diff::GreenAxis::up;
+  options.resample = resample == "nearest"    ? diff::Resample::nearest
+                     : resample == "bilinear" ? diff::Resample::bilinear
+                     : resample == "box"      ? diff::Resample::box
+                                              : diff::Resample::none;
+  options.use_alpha = !cl.ignore_alpha;
+}
+
+// Parses the command line into `cl`. Returns the exit status when nmdiff is to stop there (after
+// --help, or with the error printed), nothing when it is to go on.
+std::optional<int> parse_command_line(int argc, char** argv, CommandLine& cl) {
+  CLI::App app{"nmdiff: compare two tangent-space normal maps by the angle between their normals.\n"
+               "Texels decode as n = normalize(rgb * 2 - 1); the angle is reported in degrees."};
+  add_arguments(app, cl);
 
   try {
     app.parse(argc, argv);
@@ -160,56 +183,77 @@ int main(int argc, char** argv) {
     std::cerr << "error: " << one_line(e.what()) << " (see nmdiff --help)\n";
     return kError;
   }
+  apply_choices(cl);
+  return std::nullopt;
+}
 
-  options.green_a = green_a == "down" ? diff::GreenAxis::down : diff::GreenAxis::up;
-  options.green_b = green_b == "down" ? diff::GreenAxis::down : diff::GreenAxis::up;
-  options.resample = resample == "nearest"    ? diff::Resample::nearest
-                     : resample == "bilinear" ? diff::Resample::bilinear
-                     : resample == "box"      ? diff::Resample::box
-                                              : diff::Resample::none;
-  options.use_alpha = !ignore_alpha;
+// Map A and map B compared.
+struct Comparison {
+  DiffStats stats;
+  diff::AngleField field;  // filled only when a heatmap is asked for
+  bool resized = false;    // B was resampled onto A's grid
+};
+
+// Reads both maps and the --mask mesh (setting cl.options.mask) and compares the maps.
+Comparison compare_files(CommandLine& cl) {
+  const std::string &path_a = cl.path_a, &path_b = cl.path_b;
+  diff::DiffOptions& options = cl.options;
+  Comparison c;
+  const nmbake::Image a = nmbake::read_image(path_a);
+  const nmbake::Image b = nmbake::read_image(path_b);
+  diff::check_normal_map(a, path_a);
+  diff::check_normal_map(b, path_b);
+  c.resized = a.width != b.width || a.height != b.height;
+  if (c.resized && options.resample == diff::Resample::none)
+    throw nmbake::InputError("sizes differ: " + path_a + " is " + std::to_string(a.width) + "x" +
+                             std::to_string(a.height) + ", " + path_b + " is " + std::to_string(b.width) +
+                             "x" + std::to_string(b.height) + " (use --resample nearest|bilinear|box)");
+  if (!cl.mask_path.empty()) {
+    nmbake::LoadOptions load;
+    load.require_uvs = true;
+    options.mask = diff::uv_layout_mask(nmbake::load_mesh(cl.mask_path, load), a.width, a.height);
+  }
+
+  c.stats = diff::compare_normal_maps(a, b, options, cl.heatmap_path.empty() ? nullptr : &c.field);
+  return c;
+}
+
+// The heatmap of the angles, with its scale in the metadata; prints where it went.
+void write_heatmap(const CommandLine& cl, const Comparison& c) {
+  const double scale = cl.heatmap_scale > 0 ? cl.heatmap_scale : diff::auto_heatmap_scale(c.stats, cl.options.tolerances);
+  nmbake::WriteOptions out;
+  out.metadata = {{"nmdiff:scale_min_deg", "0"},
+                  {"nmdiff:scale_max_deg", fmt("%.6g", scale)},
+                  {"nmdiff:legend", "bar under the map: 0 deg at the left, scale_max_deg at the right; "
+                                    "dark grey texels were not compared"},
+                  {"nmdiff:a", cl.path_a},
+                  {"nmdiff:b", cl.path_b}};
+  nmbake::write_image(cl.heatmap_path, diff::render_heatmap(c.field, scale), out);
+  std::cout << "heatmap: " << cl.heatmap_path << " (0 to " << fmt("%.3g", scale) << " deg)\n";
+}
+
+// Everything nmdiff prints and writes after the comparison, in order: the summary, warnings, the
+// heatmap, the JSON, and the last line.
+void report(const CommandLine& cl, const Comparison& c) {
+  print_summary(cl.path_a, cl.path_b, c.stats, cl.options, c.resized, cl.resample);
+  for (const std::string& w : c.stats.warnings) std::cerr << "warning: " << w << "\n";
+  if (!cl.heatmap_path.empty()) write_heatmap(cl, c);
+  if (!cl.json_path.empty())
+    write_text(cl.json_path, to_json(cl.path_a, cl.path_b, c.stats, cl.options, cl.mask_path, cl.resample).dump(2) + "\n");
+  std::cout << diff::summary_line(c.stats) << std::endl;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CommandLine cl;
+  if (const std::optional<int> status = parse_command_line(argc, argv, cl)) return *status;
 
   try {
-    if (!heatmap_path.empty()) nmbake::check_output_format(heatmap_path, 0);
-
-    const nmbake::Image a = nmbake::read_image(path_a);
-    const nmbake::Image b = nmbake::read_image(path_b);
-    diff::check_normal_map(a, path_a);
-    diff::check_normal_map(b, path_b);
-    const bool resized = a.width != b.width || a.height != b.height;
-    if (resized && options.resample == diff::Resample::none)
-      throw nmbake::InputError("sizes differ: " + path_a + " is " + std::to_string(a.width) + "x" +
-                               std::to_string(a.height) + ", " + path_b + " is " + std::to_string(b.width) +
-                               "x" + std::to_string(b.height) + " (use --resample nearest|bilinear|box)");
-    if (!mask_path.empty()) {
-      nmbake::LoadOptions load;
-      load.require_uvs = true;
-      options.mask = diff::uv_layout_mask(nmbake::load_mesh(mask_path, load), a.width, a.height);
-    }
-
-    diff::AngleField field;
-    const DiffStats stats = diff::compare_normal_maps(a, b, options, heatmap_path.empty() ? nullptr : &field);
-
-    print_summary(path_a, path_b, stats, options, resized, resample);
-    for (const std::string& w : stats.warnings) std::cerr << "warning: " << w << "\n";
-
-    if (!heatmap_path.empty()) {
-      const double scale = heatmap_scale > 0 ? heatmap_scale : diff::auto_heatmap_scale(stats, options.tolerances);
-      nmbake::WriteOptions out;
-      out.metadata = {{"nmdiff:scale_min_deg", "0"},
-                      {"nmdiff:scale_max_deg", fmt("%.6g", scale)},
-                      {"nmdiff:legend", "bar under the map: 0 deg at the left, scale_max_deg at the right; "
-                                        "dark grey texels were not compared"},
-                      {"nmdiff:a", path_a},
-                      {"nmdiff:b", path_b}};
-      nmbake::write_image(heatmap_path, diff::render_heatmap(field, scale), out);
-      std::cout << "heatmap: " << heatmap_path << " (0 to " << fmt("%.3g", scale) << " deg)\n";
-    }
-    if (!json_path.empty())
-      write_text(json_path, to_json(path_a, path_b, stats, options, mask_path, resample).dump(2) + "\n");
-
-    std::cout << diff::summary_line(stats) << std::endl;
-    return stats.within ? kWithin : kOutside;
+    if (!cl.heatmap_path.empty()) nmbake::check_output_format(cl.heatmap_path, 0);
+    const Comparison c = compare_files(cl);
+    report(cl, c);
+    return c.stats.within ? kWithin : kOutside;
   } catch (const nmbake::Error& e) {
     std::cerr << "error: " << one_line(e.what()) << "\n";
   } catch (const std::bad_alloc&) {

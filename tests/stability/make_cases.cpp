@@ -83,6 +83,8 @@ ObjMesh height_field(int nx, int ny, double x0, double x1, double y0, double y1,
   return m;
 }
 
+const Normal no_normal;  // empty: a mesh without normals
+
 double zero(double, double) { return 0.0; }
 glm::dvec3 up(double, double) { return {0, 0, 1}; }
 
@@ -150,43 +152,49 @@ void transform(ObjMesh& m, double scale, glm::dvec3 offset) {
   for (auto& p : m.v) p = p * scale + offset;
 }
 
-void make_all() {
-  const auto no_normal = Normal();
-  // Shared high-polys.
-  {
-    ObjMesh m = height_field(32, 32, -1.2, 1.2, -1.2, 1.2, bumps, bumps_normal, false);
-    m.comment = "bump field z = 0.03 sin(2 pi x) sin(3 pi y) over [-1.2,1.2]^2 with analytic normals";
-    write_obj("bumps_high.obj", m);
-    m = height_field(32, 32, -1.2, 1.2, -1.2, 1.2, dome_bumps, dome_bumps_normal, false);
-    m.comment = "dome z = 0.15 - 0.075 (x^2+y^2) plus the bump field, analytic normals";
-    write_obj("dome_bumps_high.obj", m);
-    m = height_field(1, 1, -2, 2, -2, 2, [](double x, double y) { return 0.2 * x + 0.1 * y + 0.05; },
-                     [](double, double) { return glm::dvec3(-0.2, -0.1, 1.0); }, false);
-    m.comment = "tilted plane z = 0.2 x + 0.1 y + 0.05, normal (-0.2,-0.1,1)/|.|";
-    write_obj("tilted_plane_high.obj", m);
-  }
-  // Flat 4x4 low-poly over [-1,1]^2 (the reference of several cases).
+// Shared high-polys.
+void write_shared_high_polys() {
+  ObjMesh m = height_field(32, 32, -1.2, 1.2, -1.2, 1.2, bumps, bumps_normal, false);
+  m.comment = "bump field z = 0.03 sin(2 pi x) sin(3 pi y) over [-1.2,1.2]^2 with analytic normals";
+  write_obj("bumps_high.obj", m);
+  m = height_field(32, 32, -1.2, 1.2, -1.2, 1.2, dome_bumps, dome_bumps_normal, false);
+  m.comment = "dome z = 0.15 - 0.075 (x^2+y^2) plus the bump field, analytic normals";
+  write_obj("dome_bumps_high.obj", m);
+  m = height_field(1, 1, -2, 2, -2, 2, [](double x, double y) { return 0.2 * x + 0.1 * y + 0.05; },
+                   [](double, double) { return glm::dvec3(-0.2, -0.1, 1.0); }, false);
+  m.comment = "tilted plane z = 0.2 x + 0.1 y + 0.05, normal (-0.2,-0.1,1)/|.|";
+  write_obj("tilted_plane_high.obj", m);
+}
+
+// Flat 4x4 low-poly over [-1,1]^2 (the reference of several cases).
+ObjMesh write_flat_grid() {
   ObjMesh grid = height_field(4, 4, -1, 1, -1, 1, zero, up);
   grid.comment = "flat 4x4 grid over [-1,1]^2, normal +Z, UVs [0,1]^2";
   write_obj("flat_grid_low.obj", grid);
+  return grid;
+}
 
-  // 1. Degenerate UV triangles next to good ones: three real 3D triangles reusing grid vertices,
-  // UVs with two corners equal, three collinear corners, all three equal.
-  {
-    ObjMesh m = grid;
-    auto id = [](int i, int j) { return j * 5 + i; };
-    auto add = [&](std::array<int, 3> v, std::array<int, 3> t) {
-      std::array<ObjMesh::Corner, 3> f;
-      for (int k = 0; k < 3; ++k) f[k] = {v[k], t[k], v[k]};
-      m.f.push_back(f);
-    };
-    add({id(0, 0), id(2, 0), id(2, 2)}, {id(0, 0), id(0, 0), id(2, 2)});  // two UVs equal
-    add({id(1, 1), id(3, 1), id(3, 3)}, {id(1, 1), id(2, 2), id(3, 3)});  // collinear UVs
-    add({id(2, 2), id(4, 2), id(4, 4)}, {id(3, 2), id(3, 2), id(3, 2)});  // all three equal
-    m.comment = "case 1: flat_grid_low plus 3 triangles with zero UV area (two equal, collinear, all equal)";
-    write_obj("degenerate_uv_low.obj", m);
-  }
-  // 2. Zero-area 3D triangles with good UVs: the grid squeezed into u < 0.8, plus a triangle whose
+// 1. Degenerate UV triangles next to good ones: three real 3D triangles reusing grid vertices,
+// UVs with two corners equal, three collinear corners, all three equal.
+void write_degenerate_uv_case(const ObjMesh& grid) {
+  ObjMesh m = grid;
+  auto id = [](int i, int j) { return j * 5 + i; };
+  auto add = [&](std::array<int, 3> v, std::array<int, 3> t) {
+    std::array<ObjMesh::Corner, 3> f;
+    for (int k = 0; k < 3; ++k) f[k] = {v[k], t[k], v[k]};
+    m.f.push_back(f);
+  };
+  add({id(0, 0), id(2, 0), id(2, 2)}, {id(0, 0), id(0, 0), id(2, 2)});  // two UVs equal
+  add({id(1, 1), id(3, 1), id(3, 3)}, {id(1, 1), id(2, 2), id(3, 3)});  // collinear UVs
+  add({id(2, 2), id(4, 2), id(4, 4)}, {id(3, 2), id(3, 2), id(3, 2)});  // all three equal
+  m.comment = "case 1: flat_grid_low plus 3 triangles with zero UV area (two equal, collinear, all equal)";
+  write_obj("degenerate_uv_low.obj", m);
+}
+
+// 2. Zero-area 3D triangles with good UVs; duplicated vertices and faces on the low-poly and on a
+// high-poly without normals.
+void write_zero_area_and_duplicate_cases(const ObjMesh& grid) {
+  // Zero-area 3D triangles with good UVs: the grid squeezed into u < 0.8, plus a triangle whose
   // three corners are one point and one whose corners are collinear, each with a proper UV triangle.
   {
     ObjMesh m = height_field(4, 4, -1, 1, -1, 1, zero, up, true, {0, 0.8, 0, 1});
@@ -206,7 +214,7 @@ void make_all() {
     m.comment = "case 2: grid in u < 0.8 plus a point triangle and a collinear triangle with proper UVs";
     write_obj("degenerate_3d_low.obj", m);
   }
-  // 2. Duplicated vertices and a duplicated face on the low-poly: the right half of the grid uses
+  // Duplicated vertices and a duplicated face on the low-poly: the right half of the grid uses
   // copies of the middle column's vertices; the first face is written twice.
   {
     ObjMesh m = grid;
@@ -223,7 +231,7 @@ void make_all() {
     m.comment = "case 2: flat_grid_low with the middle column's vertices duplicated and face 1 duplicated";
     write_obj("duplicates_low.obj", m);
   }
-  // 2. The same on a high-poly without normals (normals are computed).
+  // The same on a high-poly without normals (normals are computed).
   {
     ObjMesh m = height_field(32, 32, -1.2, 1.2, -1.2, 1.2, bumps, no_normal, false);
     m.comment = "bump field without normals (normals computed)";
@@ -243,98 +251,106 @@ void make_all() {
     m.comment = "case 2: bumps_nonormals_high with the x = 0 column duplicated and every 7th face duplicated";
     write_obj("duplicates_high.obj", m);
   }
-  // 3. Slivers of aspect ratio 1e6. The square [-1,1]^2 fanned around an apex M 1e-6 from the
-  // diagonal through (-1,-1) and (1,1) (the sliver lies across the middle, at 45 degrees).
+}
+
+// 3. Slivers of aspect ratio 1e6. The square [-1,1]^2 fanned around an apex M 1e-6 from the
+// diagonal through (-1,-1) and (1,1) (the sliver lies across the middle, at 45 degrees).
+void write_sliver_cases() {
+  const double e = 2.0e-6;  // apex distance from the diagonal; diagonal length 2.83 -> aspect ~1e6
+  const glm::dvec2 c0(-1, -1), c1(1, -1), c2(1, 1), c3(-1, 1);
+  const glm::dvec2 m3 = glm::dvec2(0.1, 0.1) + e * glm::normalize(glm::dvec2(1, -1));
+  auto uv = [](glm::dvec2 p) { return 0.5 * (p + glm::dvec2(1.0)); };
+  // Triangles: (c0,c1,M) (c1,c2,M) (c2,c0,M) is the sliver along the diagonal, (c2,c3,c0).
+  const std::vector<std::array<int, 3>> tris = {{0, 1, 4}, {1, 2, 4}, {2, 0, 4}, {2, 3, 0}};
   {
-    const double e = 2.0e-6;  // apex distance from the diagonal; diagonal length 2.83 -> aspect ~1e6
-    const glm::dvec2 c0(-1, -1), c1(1, -1), c2(1, 1), c3(-1, 1);
-    const glm::dvec2 m3 = glm::dvec2(0.1, 0.1) + e * glm::normalize(glm::dvec2(1, -1));
-    auto uv = [](glm::dvec2 p) { return 0.5 * (p + glm::dvec2(1.0)); };
-    // Triangles: (c0,c1,M) (c1,c2,M) (c2,c0,M) is the sliver along the diagonal, (c2,c3,c0).
-    const std::vector<std::array<int, 3>> tris = {{0, 1, 4}, {1, 2, 4}, {2, 0, 4}, {2, 3, 0}};
-    {
-      ObjMesh m = flat_mesh({c0, c1, c2, c3, m3}, {uv(c0), uv(c1), uv(c2), uv(c3), uv(m3)}, tris, tris);
-      m.comment = "case 3: sliver (aspect 1e6) in 3D and in UV (UVs an affine image of the positions)";
-      write_obj("sliver_both_low.obj", m);
-    }
-    {
-      // 3D sliver, UV apex at the centre of the lower-right half: the UV triangle is fat.
-      ObjMesh m = flat_mesh({c0, c1, c2, c3, m3}, {uv(c0), uv(c1), uv(c2), uv(c3), glm::dvec2(0.75, 0.3)}, tris, tris);
-      m.comment = "case 3: sliver (aspect 1e6) in 3D only; its UV triangle is fat";
-      write_obj("sliver_3d_low.obj", m);
-    }
-    {
-      // UV sliver, 3D apex at (0.5,-0.4): the 3D triangle is fat.
-      ObjMesh m = flat_mesh({c0, c1, c2, c3, glm::dvec2(0.5, -0.4)}, {uv(c0), uv(c1), uv(c2), uv(c3), uv(m3)}, tris, tris);
-      m.comment = "case 3: sliver (aspect 1e6) in UV only; its 3D triangle is fat";
-      write_obj("sliver_uv_low.obj", m);
-    }
+    ObjMesh m = flat_mesh({c0, c1, c2, c3, m3}, {uv(c0), uv(c1), uv(c2), uv(c3), uv(m3)}, tris, tris);
+    m.comment = "case 3: sliver (aspect 1e6) in 3D and in UV (UVs an affine image of the positions)";
+    write_obj("sliver_both_low.obj", m);
   }
-  // 4. A curved island with its UVs as is, mirrored in u, rotated by 90 and by 180 degrees.
   {
-    auto island = [&](const char* name, const char* what, std::function<glm::dvec2(glm::dvec2)> f) {
-      ObjMesh m = height_field(8, 8, -1, 1, -1, 1, dome, dome_normal);
-      for (auto& t : m.vt) t = f(t);
-      m.comment = std::string("case 4: dome island, UVs ") + what;
-      write_obj(name, m);
-    };
-    island("island_low.obj", "as is", [](glm::dvec2 t) { return t; });
-    island("island_mirrored_low.obj", "mirrored (u -> 1 - u)", [](glm::dvec2 t) { return glm::dvec2(1 - t.x, t.y); });
-    island("island_rot90_low.obj", "rotated 90 degrees ((u,v) -> (1 - v, u))", [](glm::dvec2 t) { return glm::dvec2(1 - t.y, t.x); });
-    island("island_rot180_low.obj", "rotated 180 degrees", [](glm::dvec2 t) { return glm::dvec2(1 - t.x, 1 - t.y); });
+    // 3D sliver, UV apex at the centre of the lower-right half: the UV triangle is fat.
+    ObjMesh m = flat_mesh({c0, c1, c2, c3, m3}, {uv(c0), uv(c1), uv(c2), uv(c3), glm::dvec2(0.75, 0.3)}, tris, tris);
+    m.comment = "case 3: sliver (aspect 1e6) in 3D only; its UV triangle is fat";
+    write_obj("sliver_3d_low.obj", m);
   }
-  // 5. Both meshes translated and scaled. The base pair is 100 units across (an object in cm).
   {
-    struct T {
-      const char* name;
-      double scale;
-      glm::dvec3 offset;
-    };
-    for (const T& t : {T{"far_base", 50.0, {0, 0, 0}}, T{"far_1e5", 50.0, {1e5, 1e5, 1e5}}, T{"far_1e7", 50.0, {1e7, 1e7, 1e7}},
-                       T{"scaled_1e-5", 50.0 * 1e-5, {0, 0, 0}}, T{"scaled_1e5", 50.0 * 1e5, {0, 0, 0}}}) {
-      ObjMesh low = height_field(8, 8, -1, 1, -1, 1, dome, dome_normal);
-      ObjMesh high = height_field(32, 32, -1.2, 1.2, -1.2, 1.2, dome_bumps, dome_bumps_normal, false);
-      transform(low, t.scale, t.offset);
-      transform(high, t.scale, t.offset);
-      char what[160];
-      std::snprintf(what, sizeof what, "case 5: dome pair scaled by %g and translated by (%g,%g,%g)", t.scale, t.offset.x, t.offset.y,
-                    t.offset.z);
-      low.comment = high.comment = what;
-      write_obj(std::string(t.name) + "_low.obj", low);
-      write_obj(std::string(t.name) + "_high.obj", high);
-    }
+    // UV sliver, 3D apex at (0.5,-0.4): the 3D triangle is fat.
+    ObjMesh m = flat_mesh({c0, c1, c2, c3, glm::dvec2(0.5, -0.4)}, {uv(c0), uv(c1), uv(c2), uv(c3), uv(m3)}, tris, tris);
+    m.comment = "case 3: sliver (aspect 1e6) in UV only; its 3D triangle is fat";
+    write_obj("sliver_uv_low.obj", m);
   }
-  // 6. Coincident: a curved low-poly and a hard-edged cube, each baked onto itself (see the test).
-  {
+}
+
+// 4. A curved island with its UVs as is, mirrored in u, rotated by 90 and by 180 degrees.
+void write_island_cases() {
+  auto island = [&](const char* name, const char* what, std::function<glm::dvec2(glm::dvec2)> f) {
     ObjMesh m = height_field(8, 8, -1, 1, -1, 1, dome, dome_normal);
-    m.comment = "case 6: dome island baked onto itself";
-    write_obj("coincident_dome.obj", m);
-    // A cube with split normals; each face an island whose borders lie on texel centres of a 64^2
-    // map (u, v multiples of 1/128 at odd numerators), the hardest case for ties.
-    ObjMesh c;
-    c.comment = "case 6: cube with hard edges (split normals), islands bordered on texel centres of a 64^2 map";
-    const glm::dvec3 nrm[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-    for (int fi = 0; fi < 6; ++fi) {
-      const glm::dvec3 n = nrm[fi];
-      const glm::dvec3 a = std::abs(n.x) > 0 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0);
-      const glm::dvec3 b = glm::cross(n, a);
-      const int base = int(c.v.size());
-      c.vn.push_back(n);
-      const double u0 = (1 + 2 * 20 * (fi % 3)) / 128.0, v0 = (1 + 2 * 20 * (fi / 3)) / 128.0, w = 2 * 19 / 128.0;
-      const double s[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
-      for (int k = 0; k < 4; ++k) {
-        c.v.push_back(n + s[k][0] * a + s[k][1] * b);
-        c.vt.push_back({u0 + (s[k][0] + 1) / 2 * w, v0 + (s[k][1] + 1) / 2 * w});
-      }
-      for (auto tri : {std::array<int, 3>{0, 1, 2}, std::array<int, 3>{0, 2, 3}}) {
-        std::array<ObjMesh::Corner, 3> f;
-        for (int k = 0; k < 3; ++k) f[k] = {base + tri[k], base + tri[k], fi};
-        c.f.push_back(f);
-      }
-    }
-    write_obj("coincident_cube.obj", c);
+    for (auto& t : m.vt) t = f(t);
+    m.comment = std::string("case 4: dome island, UVs ") + what;
+    write_obj(name, m);
+  };
+  island("island_low.obj", "as is", [](glm::dvec2 t) { return t; });
+  island("island_mirrored_low.obj", "mirrored (u -> 1 - u)", [](glm::dvec2 t) { return glm::dvec2(1 - t.x, t.y); });
+  island("island_rot90_low.obj", "rotated 90 degrees ((u,v) -> (1 - v, u))", [](glm::dvec2 t) { return glm::dvec2(1 - t.y, t.x); });
+  island("island_rot180_low.obj", "rotated 180 degrees", [](glm::dvec2 t) { return glm::dvec2(1 - t.x, 1 - t.y); });
+}
+
+// 5. Both meshes translated and scaled. The base pair is 100 units across (an object in cm).
+void write_far_and_scaled_cases() {
+  struct T {
+    const char* name;
+    double scale;
+    glm::dvec3 offset;
+  };
+  for (const T& t : {T{"far_base", 50.0, {0, 0, 0}}, T{"far_1e5", 50.0, {1e5, 1e5, 1e5}}, T{"far_1e7", 50.0, {1e7, 1e7, 1e7}},
+                     T{"scaled_1e-5", 50.0 * 1e-5, {0, 0, 0}}, T{"scaled_1e5", 50.0 * 1e5, {0, 0, 0}}}) {
+    ObjMesh low = height_field(8, 8, -1, 1, -1, 1, dome, dome_normal);
+    ObjMesh high = height_field(32, 32, -1.2, 1.2, -1.2, 1.2, dome_bumps, dome_bumps_normal, false);
+    transform(low, t.scale, t.offset);
+    transform(high, t.scale, t.offset);
+    char what[160];
+    std::snprintf(what, sizeof what, "case 5: dome pair scaled by %g and translated by (%g,%g,%g)", t.scale, t.offset.x, t.offset.y,
+                  t.offset.z);
+    low.comment = high.comment = what;
+    write_obj(std::string(t.name) + "_low.obj", low);
+    write_obj(std::string(t.name) + "_high.obj", high);
   }
-  // 7. Grazing rays: a zigzag in x with slopes +-50 (faces 1.15 degrees from the ray direction).
+}
+
+// 6. Coincident: a curved low-poly and a hard-edged cube, each baked onto itself (see the test).
+void write_coincident_cases() {
+  ObjMesh m = height_field(8, 8, -1, 1, -1, 1, dome, dome_normal);
+  m.comment = "case 6: dome island baked onto itself";
+  write_obj("coincident_dome.obj", m);
+  // A cube with split normals; each face an island whose borders lie on texel centres of a 64^2
+  // map (u, v multiples of 1/128 at odd numerators), the hardest case for ties.
+  ObjMesh c;
+  c.comment = "case 6: cube with hard edges (split normals), islands bordered on texel centres of a 64^2 map";
+  const glm::dvec3 nrm[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  for (int fi = 0; fi < 6; ++fi) {
+    const glm::dvec3 n = nrm[fi];
+    const glm::dvec3 a = std::abs(n.x) > 0 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0);
+    const glm::dvec3 b = glm::cross(n, a);
+    const int base = int(c.v.size());
+    c.vn.push_back(n);
+    const double u0 = (1 + 2 * 20 * (fi % 3)) / 128.0, v0 = (1 + 2 * 20 * (fi / 3)) / 128.0, w = 2 * 19 / 128.0;
+    const double s[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+    for (int k = 0; k < 4; ++k) {
+      c.v.push_back(n + s[k][0] * a + s[k][1] * b);
+      c.vt.push_back({u0 + (s[k][0] + 1) / 2 * w, v0 + (s[k][1] + 1) / 2 * w});
+    }
+    for (auto tri : {std::array<int, 3>{0, 1, 2}, std::array<int, 3>{0, 2, 3}}) {
+      std::array<ObjMesh::Corner, 3> f;
+      for (int k = 0; k < 3; ++k) f[k] = {base + tri[k], base + tri[k], fi};
+      c.f.push_back(f);
+    }
+  }
+  write_obj("coincident_cube.obj", c);
+}
+
+// 7. Grazing rays, holes, a high-poly inside or outside the low-poly, two layers.
+void write_ray_cases() {
+  // Grazing rays: a zigzag in x with slopes +-50 (faces 1.15 degrees from the ray direction).
   {
     ObjMesh m;
     const double w = 0.004, amp = 0.05;  // period and amplitude: slope 4 amp / w = 50
@@ -353,7 +369,7 @@ void make_all() {
     m.comment = "case 7: zigzag in x, period 0.004, amplitude 0.05 (slope 50): rays along -Z graze its faces";
     write_obj("grazing_high.obj", m);
   }
-  // 7. Holes: a 12x12 grid at z = 0.02 with tilted normals and three cells removed.
+  // Holes: a 12x12 grid at z = 0.02 with tilted normals and three cells removed.
   {
     ObjMesh m = height_field(12, 12, -1.2, 1.2, -1.2, 1.2, [](double, double) { return 0.02; },
                              [](double, double) { return glm::dvec3(0.1, 0.2, 1.0); }, false);
@@ -367,7 +383,7 @@ void make_all() {
     m.comment = "case 7: plane z = 0.02 with normal (0.1,0.2,1)/|.| and holes [-0.6,-0.4]x[-0.6,-0.2], [0.4,0.6]x[0.2,0.4]";
     write_obj("holes_high.obj", m);
   }
-  // 7. A unit sphere low-poly and high-polys entirely inside (r 0.6) and outside (r 1.6).
+  // A unit sphere low-poly and high-polys entirely inside (r 0.6) and outside (r 1.6).
   {
     ObjMesh m = sphere(24, 12, 1.0, true);
     m.comment = "case 7: unit sphere low-poly";
@@ -379,7 +395,7 @@ void make_all() {
     m.comment = "case 7: sphere r = 1.6, entirely outside sphere_low";
     write_obj("outside_high.obj", m);
   }
-  // 7. Two layers: z = +0.05 (normal tilted +x) and z = -0.03 (normal tilted +y); and a tie pair at +-0.05.
+  // Two layers: z = +0.05 (normal tilted +x) and z = -0.03 (normal tilted +y); and a tie pair at +-0.05.
   for (double lower : {-0.03, -0.05}) {
     ObjMesh m = height_field(1, 1, -1.5, 1.5, -1.5, 1.5, [](double, double) { return 0.05; },
                              [](double, double) { return glm::dvec3(0.3, 0, 1); }, false);
@@ -396,36 +412,40 @@ void make_all() {
                                : "case 7: two layers at equal distance, z = +0.05 (normal (0.3,0,1)) and z = -0.05 (normal (0,0.3,1))";
     write_obj(lower == -0.03 ? "two_layers_high.obj" : "two_layers_tie_high.obj", m);
   }
-  // 8. UVs outside [0,1]: island A inside, island B in the next tile (u in [1.05,1.45]), island C
-  // straddling u = 1. Overlap: two islands sharing UV square [0.4,0.6]^2.
-  {
-    auto quad = [](ObjMesh& m, double x0, double x1, double y0, double y1, glm::dvec4 uv) {
-      ObjMesh q = height_field(1, 1, x0, x1, y0, y1, zero, up, true, uv);
-      const int nv = int(m.v.size()), nt = int(m.vt.size()), nn = int(m.vn.size());
-      m.v.insert(m.v.end(), q.v.begin(), q.v.end());
-      m.vt.insert(m.vt.end(), q.vt.begin(), q.vt.end());
-      m.vn.insert(m.vn.end(), q.vn.begin(), q.vn.end());
-      for (auto f : q.f) {
-        for (auto& c : f) c.v += nv, c.vt += nt, c.vn += nn;
-        m.f.push_back(f);
-      }
-    };
-    ObjMesh m;
-    quad(m, -1.5, -0.5, -0.5, 0.5, {0.05, 0.45, 0.05, 0.45});
-    quad(m, -0.5, 0.5, -0.5, 0.5, {1.05, 1.45, 0.05, 0.45});
-    quad(m, 0.5, 1.5, -0.5, 0.5, {0.8, 1.2, 0.5, 0.9});
-    m.comment = "case 8: island A in [0,1]^2, island B in the tile u in [1,2], island C straddling u = 1";
-    write_obj("uv_tiles_low.obj", m);
-    ObjMesh o;
-    quad(o, -1.5, 0.0, -0.75, 0.75, {0.1, 0.6, 0.1, 0.6});
-    quad(o, 0.0, 1.5, -0.75, 0.75, {0.4, 0.9, 0.4, 0.9});
-    o.comment = "case 8: two islands overlapping in UV square [0.4,0.6]^2";
-    write_obj("uv_overlap_low.obj", o);
-  }
-  // 9. Hard edges: the four sides of a square prism (half-width 1, z in [-1,1]) with split normals,
-  // laid out as one strip (each side a quarter of u); a cylinder of radius 1.2 as the high-poly.
-  // OBJ style (positions shared by the sides, one normal per side) and glTF style (every side has
-  // its own copies of the edge positions).
+}
+
+// 8. UVs outside [0,1]: island A inside, island B in the next tile (u in [1.05,1.45]), island C
+// straddling u = 1. Overlap: two islands sharing UV square [0.4,0.6]^2.
+void write_uv_layout_cases() {
+  auto quad = [](ObjMesh& m, double x0, double x1, double y0, double y1, glm::dvec4 uv) {
+    ObjMesh q = height_field(1, 1, x0, x1, y0, y1, zero, up, true, uv);
+    const int nv = int(m.v.size()), nt = int(m.vt.size()), nn = int(m.vn.size());
+    m.v.insert(m.v.end(), q.v.begin(), q.v.end());
+    m.vt.insert(m.vt.end(), q.vt.begin(), q.vt.end());
+    m.vn.insert(m.vn.end(), q.vn.begin(), q.vn.end());
+    for (auto f : q.f) {
+      for (auto& c : f) c.v += nv, c.vt += nt, c.vn += nn;
+      m.f.push_back(f);
+    }
+  };
+  ObjMesh m;
+  quad(m, -1.5, -0.5, -0.5, 0.5, {0.05, 0.45, 0.05, 0.45});
+  quad(m, -0.5, 0.5, -0.5, 0.5, {1.05, 1.45, 0.05, 0.45});
+  quad(m, 0.5, 1.5, -0.5, 0.5, {0.8, 1.2, 0.5, 0.9});
+  m.comment = "case 8: island A in [0,1]^2, island B in the tile u in [1,2], island C straddling u = 1";
+  write_obj("uv_tiles_low.obj", m);
+  ObjMesh o;
+  quad(o, -1.5, 0.0, -0.75, 0.75, {0.1, 0.6, 0.1, 0.6});
+  quad(o, 0.0, 1.5, -0.75, 0.75, {0.4, 0.9, 0.4, 0.9});
+  o.comment = "case 8: two islands overlapping in UV square [0.4,0.6]^2";
+  write_obj("uv_overlap_low.obj", o);
+}
+
+// 9. Hard edges: the four sides of a square prism (half-width 1, z in [-1,1]) with split normals,
+// laid out as one strip (each side a quarter of u); a cylinder of radius 1.2 as the high-poly.
+// OBJ style (positions shared by the sides, one normal per side) and glTF style (every side has
+// its own copies of the edge positions).
+void write_hard_edge_cases() {
   for (bool shared : {true, false}) {
     ObjMesh m;
     const glm::dvec2 corner[4] = {{1, -1}, {1, 1}, {-1, 1}, {-1, -1}};
@@ -485,7 +505,10 @@ void make_all() {
     cyl.comment = "case 9: open cylinder radius 1.2 around z, 256 segments, radial normals";
     write_obj("cylinder_high.obj", cyl);
   }
-  // 10. High-poly topology defects.
+}
+
+// 10. High-poly topology defects.
+void write_topology_cases() {
   {
     // Non-manifold: a plane at z = 0.02 plus two fins standing on one of its edges (3 and 4 faces
     // on the edge x = 0).
@@ -536,6 +559,21 @@ void make_all() {
     m.comment = "case 10: bumps_nonormals_high wound clockwise throughout (computed normals point down)";
     write_obj("inverted_winding_high.obj", m);
   }
+}
+
+void make_all() {
+  write_shared_high_polys();
+  const ObjMesh grid = write_flat_grid();
+  write_degenerate_uv_case(grid);
+  write_zero_area_and_duplicate_cases(grid);
+  write_sliver_cases();
+  write_island_cases();
+  write_far_and_scaled_cases();
+  write_coincident_cases();
+  write_ray_cases();
+  write_uv_layout_cases();
+  write_hard_edge_cases();
+  write_topology_cases();
 }
 
 }  // namespace
