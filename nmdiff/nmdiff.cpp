@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/codec.h"
 #include "core/errors.h"
 #include "core/rasterize.h"
 
@@ -71,14 +72,8 @@ void check_normal_map(const Image& map, const std::string& name) {
 }
 
 bool decode_normal(const float* rgb, GreenAxis green, double n[3]) {
-  n[0] = double(rgb[0]) * 2.0 - 1.0;
-  n[1] = double(rgb[1]) * 2.0 - 1.0;
-  n[2] = double(rgb[2]) * 2.0 - 1.0;
+  if (!codec::decode_texel(rgb, n)) return false;  // the baker's codec (core/codec.h)
   if (green == GreenAxis::down) n[1] = -n[1];
-  const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-  // Below 1e-6 the direction is noise; an encoded (0.5, 0.5, 0.5) is exactly zero.
-  if (!std::isfinite(len) || len < 1e-6) return false;
-  for (int k = 0; k < 3; ++k) n[k] /= len;
   return true;
 }
 

@@ -263,43 +263,12 @@ Hit Scene::intersect(const Ray& ray, const HitRule& rule, bool outward, std::uin
 }
 
 void Scene::intersect(const Ray* rays, Hit* hits, std::size_t count) const {
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
-  alignas(32) RTCRayHit8 rh;
-  alignas(32) int valid[8];
-  for (std::size_t base = 0; base < count; base += 8) {
-    const std::size_t n = std::min<std::size_t>(8, count - base);
-    for (std::size_t k = 0; k < 8; ++k) {
-      const Ray& r = rays[base + std::min(k, n - 1)];
-      valid[k] = k < n ? -1 : 0;
-      rh.ray.org_x[k] = r.origin.x;
-      rh.ray.org_y[k] = r.origin.y;
-      rh.ray.org_z[k] = r.origin.z;
-      rh.ray.tnear[k] = r.tnear;
-      rh.ray.dir_x[k] = r.direction.x;
-      rh.ray.dir_y[k] = r.direction.y;
-      rh.ray.dir_z[k] = r.direction.z;
-      rh.ray.time[k] = 0.0f;
-      rh.ray.tfar[k] = r.tfar;
-      rh.ray.mask[k] = 0xffffffffu;
-      rh.ray.id[k] = unsigned(k);
-      rh.ray.flags[k] = 0;
-      rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-      rh.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
-      rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
-    }
-    rtcIntersect8(valid, impl_->scene, &context, &rh);
-    for (std::size_t k = 0; k < n; ++k) {
-      Hit& h = hits[base + k];
-      if (rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID) {
-        h.triangle = rh.hit.primID[k];
-        h.t = rh.ray.tfar[k];
-        h.u = rh.hit.u[k];
-        h.v = rh.hit.v[k];
-      } else {
-        h = Hit{};
-      }
-    }
+  // The one packet path (below), through arrays in its layout.
+  RayArrays arrays(rays, count);
+  intersect(arrays.rays(), arrays.hits(), count, nullptr);
+  for (std::size_t i = 0; i < count; ++i) {
+    const Hit h = arrays.hit(i);
+    hits[i] = h.hit() ? h : Hit{};
   }
 }
 

@@ -164,7 +164,7 @@ class Scene {
   std::unique_ptr<Impl> impl_;
 };
 
-// Brute-force reference: tests every triangle with a watertight double-precision test. For tests
+// Brute-force reference: tests every triangle with a Moller-Trumbore test in double precision. For tests
 // only (O(n) per ray).
 class ReferenceIntersector {
  public:

@@ -120,9 +120,8 @@ double angle_deg(const glm::dvec3& a, const glm::dvec3& b) {
 }
 
 glm::dvec3 decode_rgb(const float* c) {
-  const glm::dvec3 v(2.0 * c[0] - 1.0, 2.0 * c[1] - 1.0, 2.0 * c[2] - 1.0);
-  const double len = glm::length(v);
-  return len > 0.0 ? v / len : v;
+  double n[3];
+  return codec::decode_texel(c, n) ? glm::dvec3(n[0], n[1], n[2]) : glm::dvec3(0.0);
 }
 
 void for_each_decoded_texel(

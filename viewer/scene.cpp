@@ -40,7 +40,7 @@ Scene load_scene(const std::string& low_path, const std::string& map_path, const
 
   nmbake::Mesh high = nmbake::load_mesh(high_path);
   if (nmbake::ensure_normals(high))
-    log << "nmview: " << high_path << " has no normals; using angle-weighted vertex normals\n";
+    log << "nmview: " << high_path << " has no normals; using the bake's angle-weighted normals\n";
 
   scene.bounds = mesh_bounds(low);
   scene.bounds.extend(mesh_bounds(high));

@@ -11,6 +11,8 @@
 #include <cstdint>
 #include <cstring>
 
+#include "core/codec.h"
+
 // GCC 12 reports vectors built by gather() as "maybe uninitialized" in the AVX2 clones; every lane
 // is written before use (all four are assigned at once). Off for the kernel files that include this.
 #if defined(__GNUC__) && !defined(__clang__)
@@ -25,18 +27,10 @@ typedef float F __attribute__((vector_size(16)));
 typedef std::int32_t I __attribute__((vector_size(16)));  // also the comparison results of F
 constexpr int kLanes = 4;
 
-struct V3 {
-  V x, y, z;
-};
+using V3 = codec::Vec3<V>;
+using codec::cross;  // glm::cross, term for term
+using codec::dot;    // glm::dot: (x + y) + z of the products
 
-[[gnu::always_inline]] inline void cross(V3& r, const V3& a, const V3& b) {  // glm::cross, term for term
-  r.x = a.y * b.z - b.y * a.z;
-  r.y = a.z * b.x - b.z * a.x;
-  r.z = a.x * b.y - b.x * a.y;
-}
-[[gnu::always_inline]] inline void dot(V& r, const V3& a, const V3& b) {  // glm::dot: (x + y) + z of the products
-  r = a.x * b.x + a.y * b.y + a.z * b.z;
-}
 // One vector from four scalars, built in registers (lane stores followed by a vector load would
 // stall on store forwarding).
 template <typename Fn>
@@ -65,3 +59,10 @@ template <typename Fn>
 }
 
 }  // namespace nmbake::lanes
+
+namespace nmbake::codec {
+template <>
+struct Ops<lanes::V> {
+  [[gnu::always_inline]] static void root(lanes::V& r, const lanes::V& a) { lanes::vsqrt(r, a); }
+};
+}  // namespace nmbake::codec

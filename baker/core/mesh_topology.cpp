@@ -1,5 +1,7 @@
 #include "core/mesh_topology.h"
 
+#include "core/normals.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -173,29 +175,10 @@ MeshTopology inspect_topology(const Mesh& mesh) { return analyze(mesh).topo; }
 std::vector<glm::vec3> compute_high_corner_normals(const Mesh& m, std::size_t* reoriented) {
   const Analysis a = analyze(m);
   if (reoriented) *reoriented = a.topo.inconsistent_winding_faces;
-  std::vector<glm::dvec3> sum(m.positions.size(), glm::dvec3(0.0));  // indexed by welded id (< positions)
-  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
-    if (a.skip[t]) continue;
-    glm::dvec3 p[3];
-    for (int c = 0; c < 3; ++c) p[c] = glm::dvec3(m.positions[m.position_index[3 * t + c]]);
-    glm::dvec3 face = glm::cross(p[1] - p[0], p[2] - p[0]);
-    const double len = glm::length(face);
-    if (!(len > 0.0) || !std::isfinite(len)) continue;  // zero-area faces carry no direction
-    face /= len;
-    if (a.flip[t]) face = -face;
-    for (int c = 0; c < 3; ++c) {
-      const glm::dvec3 e1 = p[(c + 1) % 3] - p[c], e2 = p[(c + 2) % 3] - p[c];
-      if (!(glm::length(e1) > 0.0) || !(glm::length(e2) > 0.0)) continue;
-      // atan2 of |cross| and dot is accurate for angles near 0 and pi, unlike acos.
-      sum[a.corner[3 * t + c]] += std::atan2(glm::length(glm::cross(e1, e2)), glm::dot(e1, e2)) * face;
-    }
-  }
+  // Indexed by welded id (< positions).
+  const std::vector<glm::dvec3> sum = angle_weighted_sums(m, &a.corner, m.positions.size(), &a.skip, &a.flip);
   std::vector<glm::vec3> out(3 * m.triangle_count());
-  for (std::size_t c = 0; c < out.size(); ++c) {
-    const glm::dvec3 s = sum[a.corner[c]];
-    const double len = glm::length(s);
-    out[c] = (len > 0.0 && std::isfinite(len)) ? glm::vec3(s / len) : glm::vec3(0, 0, 1);
-  }
+  for (std::size_t c = 0; c < out.size(); ++c) out[c] = unit_or_up(sum[a.corner[c]]);
   return out;
 }
 

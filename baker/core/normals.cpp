@@ -2,38 +2,51 @@
 
 #include <cmath>
 
+#include "core/mesh_topology.h"
+
 namespace nmbake {
 
-std::vector<glm::vec3> compute_vertex_normals(const Mesh& mesh) {
-  std::vector<glm::dvec3> sum(mesh.positions.size(), glm::dvec3(0.0));
+std::vector<glm::dvec3> angle_weighted_sums(const Mesh& mesh, const std::vector<std::uint32_t>* corner_vertex, std::size_t vertices,
+                                            const std::vector<std::uint8_t>* skip, const std::vector<std::uint8_t>* flip) {
+  std::vector<glm::dvec3> sum(vertices, glm::dvec3(0.0));
   for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+    if (skip && (*skip)[t]) continue;
     const glm::dvec3 p[3] = {glm::dvec3(mesh.corner_position(t, 0)), glm::dvec3(mesh.corner_position(t, 1)),
                              glm::dvec3(mesh.corner_position(t, 2))};
-    const glm::dvec3 face = glm::cross(p[1] - p[0], p[2] - p[0]);
+    glm::dvec3 face = glm::cross(p[1] - p[0], p[2] - p[0]);
     const double len = glm::length(face);
     if (!(len > 0.0) || !std::isfinite(len)) continue;  // zero-area faces carry no direction
-    const glm::dvec3 unit = face / len;
+    face /= len;
+    if (flip && (*flip)[t]) face = -face;
     for (int c = 0; c < 3; ++c) {
       const glm::dvec3 a = p[(c + 1) % 3] - p[c], b = p[(c + 2) % 3] - p[c];
-      const double la = glm::length(a), lb = glm::length(b);
-      if (!(la > 0.0) || !(lb > 0.0)) continue;
+      if (!(glm::length(a) > 0.0) || !(glm::length(b) > 0.0)) continue;
       // atan2 of |cross| and dot is accurate for angles near 0 and pi, unlike acos.
       const double angle = std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
-      sum[mesh.position_index[3 * t + c]] += angle * unit;
+      const std::size_t corner = 3 * t + std::size_t(c);
+      sum[corner_vertex ? (*corner_vertex)[corner] : mesh.position_index[corner]] += angle * face;
     }
   }
+  return sum;
+}
+
+glm::vec3 unit_or_up(const glm::dvec3& sum) {
+  const double len = glm::length(sum);
+  return (len > 0.0 && std::isfinite(len)) ? glm::vec3(sum / len) : glm::vec3(0, 0, 1);
+}
+
+std::vector<glm::vec3> compute_vertex_normals(const Mesh& mesh) {
+  const std::vector<glm::dvec3> sum = angle_weighted_sums(mesh, nullptr, mesh.positions.size());
   std::vector<glm::vec3> out(sum.size());
-  for (std::size_t i = 0; i < sum.size(); ++i) {
-    const double len = glm::length(sum[i]);
-    out[i] = (len > 0.0 && std::isfinite(len)) ? glm::vec3(sum[i] / len) : glm::vec3(0, 0, 1);
-  }
+  for (std::size_t i = 0; i < sum.size(); ++i) out[i] = unit_or_up(sum[i]);
   return out;
 }
 
 bool ensure_normals(Mesh& mesh) {
   if (mesh.has_normals()) return false;
-  mesh.normals = compute_vertex_normals(mesh);
-  mesh.normal_index = mesh.position_index;
+  mesh.normals = compute_high_corner_normals(mesh);
+  mesh.normal_index.resize(mesh.normals.size());
+  for (std::size_t c = 0; c < mesh.normal_index.size(); ++c) mesh.normal_index[c] = std::uint32_t(c);
   return true;
 }
 

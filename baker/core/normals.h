@@ -1,6 +1,7 @@
 // Smooth vertex normals and position-averaged normals.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -9,11 +10,22 @@
 
 namespace nmbake {
 
-// Angle-weighted vertex normals (Thuermer and Wuethrich 1998), one per position. A position whose
-// faces all have zero area gets (0,0,1). Never NaN.
+// The one angle-weighted normal rule (Thuermer and Wuethrich 1998) of the baker and the viewer:
+// per vertex, the sum over its faces of the corner angle times the unit face normal. Vertices are
+// the corners' `corner_vertex` ids (null: the position index), `vertices` of them; faces marked in
+// `skip` count nothing, faces marked in `flip` count reversed. Zero-area faces carry no direction.
+std::vector<glm::dvec3> angle_weighted_sums(const Mesh& mesh, const std::vector<std::uint32_t>* corner_vertex, std::size_t vertices,
+                                            const std::vector<std::uint8_t>* skip = nullptr,
+                                            const std::vector<std::uint8_t>* flip = nullptr);
+// A sum made unit, or (0,0,1) when it has no direction. Never NaN.
+glm::vec3 unit_or_up(const glm::dvec3& sum);
+
+// Angle-weighted vertex normals, one per position (positions not welded: the low-poly's own
+// vertices, as its tangent frames take them).
 std::vector<glm::vec3> compute_vertex_normals(const Mesh& mesh);
 
-// Gives `mesh` per-position smooth normals (normal_index = position_index) when it has none.
+// Gives `mesh` the normals the bake computes for a high-poly without them, one per corner
+// (compute_high_corner_normals, mesh_topology.h: welded, one winding per piece), when it has none.
 // Returns true when normals were computed.
 bool ensure_normals(Mesh& mesh);
 

@@ -19,6 +19,7 @@
 
 #include <glm/glm.hpp>
 
+#include "core/codec.h"
 #include "core/mesh.h"
 
 namespace nmbake {
@@ -49,40 +50,48 @@ PixelFrame interpolate_frame(const TangentFrames& frames, std::size_t tri, const
 // The same from a triangle's three corner normals and tangents, given in float (glm::vec3/vec4) or
 // already widened to double (glm::dvec3/dvec4: the same result, without the per-call widening).
 // Inline: the bake calls it per sample.
+inline codec::Vec3<double> to_codec(const glm::dvec3& v) { return {v.x, v.y, v.z}; }
+inline glm::dvec3 from_codec(const codec::Vec3<double>& v) { return {v.x, v.y, v.z}; }
+
 template <typename Vec3, typename Vec4>
 inline PixelFrame interpolate_frame(const Vec3 normal[3], const Vec4 tangent[3], const double bary[3],
                                     BitangentMode mode = BitangentMode::per_pixel) {
+  if (mode == BitangentMode::per_pixel) {  // the codec's frame (codec.h)
+    codec::Vec3<double> n[3], t[3];
+    double w[3];
+    for (int c = 0; c < 3; ++c) {
+      n[c] = to_codec(glm::dvec3(normal[c]));
+      t[c] = to_codec(glm::dvec3(glm::dvec4(tangent[c])));
+      w[c] = double(tangent[c].w);
+    }
+    codec::Frame<double> f;
+    codec::per_pixel_frame(f, bary, n, t, w, 0.0);
+    return {from_codec(f.t), from_codec(f.b), from_codec(f.n)};
+  }
   PixelFrame f{glm::dvec3(0.0), glm::dvec3(0.0), glm::dvec3(0.0)};
-  double sign = 0.0;
   for (int c = 0; c < 3; ++c) {
     const glm::dvec3 n(normal[c]);
     const glm::dvec4 t(tangent[c]);
     f.n += bary[c] * n;
     f.t += bary[c] * glm::dvec3(t);
-    sign += bary[c] * t.w;
-    if (mode == BitangentMode::per_vertex) f.b += bary[c] * (t.w * glm::cross(n, glm::dvec3(t)));
+    f.b += bary[c] * (t.w * glm::cross(n, glm::dvec3(t)));
   }
-  if (mode == BitangentMode::per_pixel) f.b = sign * glm::cross(f.n, f.t);
   return f;
 }
 
 // Tangent-space unit vector whose decoding in `frame` is the direction of `world` (any positive
-// length): the exact inverse of normalize(t.x*T + t.y*B + t.z*N), renormalized. Falls back to
-// (0,0,1) when the frame is singular. Inline: the bake calls it per sample.
+// length): the exact inverse of normalize(t.x*T + t.y*B + t.z*N), renormalized (codec.h). Falls
+// back to (0,0,1) when the frame is singular or the result not finite. Inline: the bake calls it
+// per sample.
 inline glm::dvec3 encode_tangent_normal(const PixelFrame& f, const glm::dvec3& world) {
-  // Solve [T B N] x = world by Cramer's rule; x is defined up to a positive scale because the
-  // renderer normalizes, so the determinant's magnitude does not matter, only its sign and zero:
-  // the adjugate times world, normalized, negated when det < 0 (one division, not six).
-  const glm::dvec3 bxn = glm::cross(f.b, f.n), nxt = glm::cross(f.n, f.t), txb = glm::cross(f.t, f.b);
-  const double det = glm::dot(f.t, bxn);
-  // Singular when |det| <= 1e-12 |T||B||N|, compared squared to spare three square roots.
-  const double scale2 = glm::dot(f.t, f.t) * glm::dot(f.b, f.b) * glm::dot(f.n, f.n);
-  if (!(det * det > 1e-24 * scale2) || !std::isfinite(det)) return {0.0, 0.0, 1.0};
-  const glm::dvec3 x(glm::dot(world, bxn), glm::dot(world, nxt), glm::dot(world, txb));
-  const double len = std::sqrt(glm::dot(x, x));
-  if (!(len > 0.0) || !std::isfinite(len)) return {0.0, 0.0, 1.0};
-  const double inv = 1.0 / len;
-  return det > 0.0 ? x * inv : x * -inv;
+  codec::Encoding<double> e;
+  codec::encode_in_frame(e, codec::Frame<double>{to_codec(f.t), to_codec(f.b), to_codec(f.n)}, to_codec(world));
+  bool ok;
+  codec::trusted(ok, e);
+  if (!ok) return {0.0, 0.0, 1.0};
+  codec::Vec3<double> r;
+  codec::scaled(r, e.x, e.det > 0.0 ? e.inv : -e.inv);
+  return from_codec(r);
 }
 
 // World direction of a tangent-space vector (the renderer's decoding).

@@ -1,5 +1,7 @@
 #include "pipeline/error_estimate.h"
 
+#include "core/codec.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -12,9 +14,8 @@ namespace {
 constexpr double kDegPerRad = 57.29577951308232;
 
 glm::dvec3 decode(const float* c) {
-  const glm::dvec3 v(2.0 * c[0] - 1.0, 2.0 * c[1] - 1.0, 2.0 * c[2] - 1.0);
-  const double len = glm::length(v);
-  return len > 0.0 ? v / len : glm::dvec3(0, 0, 1);
+  double n[3];
+  return codec::decode_texel(c, n) ? glm::dvec3(n[0], n[1], n[2]) : glm::dvec3(0, 0, 1);
 }
 
 // atan2 form: accurate for tiny angles, where acos(dot) is not.

@@ -13,9 +13,12 @@ glm::dvec3 shade_sample(const Prepared& s, const HighScene& scene, std::size_t t
     return opt.space == NormalSpace::tangent ? glm::dvec3(0, 0, 1) : (nl > 0 ? frame.n / nl : glm::dvec3(0, 0, 1));
   }
   const std::size_t ht = h.triangle;
+  // The hit normal, interpolated as the codec does (codec.h; shade_batch.h's kernel the same).
   const double w[3] = {1.0 - double(h.u) - double(h.v), double(h.u), double(h.v)};
-  glm::dvec3 nh(0.0);
-  for (int c = 0; c < 3; ++c) nh += w[c] * glm::dvec3(scene.normals[3 * ht + c]);
+  codec::Vec3<double> corner[3], interpolated;
+  for (int c = 0; c < 3; ++c) corner[c] = to_codec(glm::dvec3(scene.normals[3 * ht + c]));
+  codec::interpolate(interpolated, w, corner, 0.0);
+  glm::dvec3 nh = from_codec(interpolated);
   const double len2 = glm::dot(nh, nh);
   // The encoding normalizes, so in tangent space the hit normal goes in at its own length, unless
   // that is too short to trust (encode_hits_per_pixel's test).

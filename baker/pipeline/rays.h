@@ -62,7 +62,7 @@ inline raycast::Ray inward_ray(const CageRay& c, double* signed_base, float* pre
   return {glm::vec3(c.p - c.search * c.d), 0.0f, glm::vec3(c.d), float(c.search + c.rear)};
 }
 
-// How a bake casts its rays (policy.h of the options, with the distances chosen).
+// How a bake casts its rays (BakeOptions::policy, with the distances chosen).
 struct RaySetup {
   float front = 0.0f, rear = 0.0f;
   bool cage = false, closest = false;

@@ -65,64 +65,30 @@ template <bool same_triangle>
     gather(v, [&](int k) { return double(in.v[at[k]]); });
   }
   const V hw[3] = {1.0 - u - v, u, v};
-  // interpolate_frame, per-pixel bitangent: sums start from zero as there.
-  V3 fn{zero, zero, zero}, ft{zero, zero, zero};
-  V sign = zero;
-#pragma GCC unroll 3
-  for (int c = 0; c < 3; ++c) {
-    fn.x += b[c] * n[c].x;
-    fn.y += b[c] * n[c].y;
-    fn.z += b[c] * n[c].z;
-    ft.x += b[c] * t[c].x;
-    ft.y += b[c] * t[c].y;
-    ft.z += b[c] * t[c].z;
-    sign += b[c] * tw[c];
-  }
-  V3 nt;
-  cross(nt, fn, ft);
-  const V3 fb{sign * nt.x, sign * nt.y, sign * nt.z};
-  // The hit normal, interpolated with the hit's barycentrics and normalized.
-  V3 h{zero, zero, zero};
-#pragma GCC unroll 3
-  for (int c = 0; c < 3; ++c) {
-    h.x += hw[c] * hn[c].x;
-    h.y += hw[c] * hn[c].y;
-    h.z += hw[c] * hn[c].z;
-  }
-  // The encoding normalizes its result, so h goes in at its own length.
+  // The codec (core/codec.h), four samples at a time: the per-pixel frame, the hit normal
+  // interpolated with the hit's barycentrics (it goes in at its own length: the encoding
+  // normalizes its result), the encoding.
+  codec::Frame<V> f;
+  codec::per_pixel_frame(f, b, n, t, tw, zero);
+  V3 h;
+  codec::interpolate(h, hw, hn, zero);
   V hh;
   dot(hh, h, h);
-  // encode_tangent_normal.
-  V3 bxn, nxt, txb;
-  cross(bxn, fb, fn);
-  cross(nxt, fn, ft);
-  cross(txb, ft, fb);
-  V det, tt, bb, nn;
-  dot(det, ft, bxn);
-  dot(tt, ft, ft);
-  dot(bb, fb, fb);
-  dot(nn, fn, fn);
-  const V scale2 = tt * bb * nn;
-  V3 x;
-  dot(x.x, h, bxn);
-  dot(x.y, h, nxt);
-  dot(x.z, h, txb);
-  V xx, len;
-  dot(xx, x, x);
-  vsqrt(len, xx);
-  const V inv = 1.0 / len;
-  // inv, negated where det is not positive (encode_tangent_normal's x * -inv): its sign bit flipped.
+  codec::Encoding<V> e;
+  codec::encode_in_frame(e, f, h);
+  // inv, negated where det is not positive (encode_tangent_normal's -inv): its sign bit flipped.
   const M sign_bit = {INT64_MIN, INT64_MIN, INT64_MIN, INT64_MIN};
   M inv_bits;
-  std::memcpy(&inv_bits, &inv, sizeof inv);
-  inv_bits ^= ~(det > zero) & sign_bit;
+  std::memcpy(&inv_bits, &e.inv, sizeof e.inv);
+  inv_bits ^= ~(e.det > zero) & sign_bit;
   V s;
   std::memcpy(&s, &inv_bits, sizeof s);
-  const V3 r{x.x * s, x.y * s, x.z * s};
-  // Degenerate: a miss, a short hit normal, a singular frame, a result not finite (NaN fails each
-  // comparison, and an infinite det or len is above DBL_MAX).
-  const M good = (hh > kShortHitNormal2) & (det * det > 1e-24 * scale2) & (det >= -DBL_MAX) & (det <= DBL_MAX) &
-                 (len > 0.0) & (len <= DBL_MAX);
+  V3 r;
+  codec::scaled(r, e.x, s);
+  // Degenerate: a miss, a short hit normal, an encoding not to be trusted.
+  M good;
+  codec::trusted(good, e);
+  good &= hh > kShortHitNormal2;
   const unsigned bad = (~bits(good) | miss) & 0xfu;
   if (full) {
     std::memcpy(&value[0][i], &r.x, sizeof(V));

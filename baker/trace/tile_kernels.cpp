@@ -274,7 +274,9 @@ __attribute__((target_clones("avx2", "default"))) void write_texel_row(const Tex
       V& u = *comp[c];
       const V mag = u < zero ? -u : u;
       u = mag < snap ? zero : u;
-      out[c] = __builtin_convertvector(u * 0.5 + 0.5, F);
+      V channel;
+      codec::to_channel(channel, u);
+      out[c] = __builtin_convertvector(channel, F);
     }
     if (filled == 0xfu && n == kLanes) {
       // Four texels, all with samples (most blocks): interleaved to r g b per texel in registers,

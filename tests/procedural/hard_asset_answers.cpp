@@ -63,7 +63,7 @@ KnownErrors measure_against_known(const HardAsset& a, const std::vector<KnownTex
       if (!r.coverage[kt.texel]) continue;
       if (!parts.empty() && std::find(parts.begin(), parts.end(), kt.part) == parts.end()) continue;
       const float* c = &r.map.pixels[3 * std::size_t(kt.texel)];
-      const glm::dvec3 t(2.0 * c[0] - 1.0, 2.0 * c[1] - 1.0, 2.0 * c[2] - 1.0);
+      const glm::dvec3 t(codec::from_channel(c[0]), codec::from_channel(c[1]), codec::from_channel(c[2]));
       const glm::dvec3 world = decode_tangent_normal(interpolate_frame(frames, kt.tri, kt.b), t);
       err[k] = float(angle_deg(world, kt.normal));
     }
