@@ -1,8 +1,9 @@
-// image_io.h for the nmbake command: OpenImageIO lives in the module libnmbake_oiio.so next to the
-// executable, loaded on a background thread that preload_image_io() starts first thing in main(),
-// while the meshes load and the bake runs. Loading it costs ~0.15-0.3 s of symbol relocation in its
-// ~260 libraries (measured: `nmbake --version` linked directly took 0.35 s, an empty program linked
-// to OpenImageIO 0.27 s); done beside the single-threaded mesh loading, the user no longer waits.
+// image_io.h for the nmbake command: OpenImageIO lives in the module libnmbake_oiio.so (next to the
+// executable in the build tree, in lib/nmbake/ when installed), loaded on a background thread that
+// preload_image_io() starts first thing in main(), while the meshes load and the bake runs. Loading
+// it costs ~0.15-0.3 s of symbol relocation in its ~260 libraries (measured: `nmbake --version`
+// linked directly took 0.35 s, an empty program linked to OpenImageIO 0.27 s); done beside the
+// single-threaded mesh loading, the user no longer waits.
 #include <dlfcn.h>
 #include <unistd.h>
 
@@ -14,6 +15,7 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "core/errors.h"
 #include "io/image_io.h"
@@ -27,8 +29,10 @@ struct Loaded {
   std::string error;  // why it could not be loaded
 };
 
-std::string module_path() {
-  // Next to the executable (the build tree's baker/ folder, or wherever both are installed).
+// Where the module may be, in the order looked at: next to the executable (the build tree's baker/
+// folder), then the installed layout's module folder relative to the executable's
+// (NMBAKE_IMAGE_MODULE_DIR, set by cmake/Install.cmake, e.g. "../lib/nmbake").
+std::vector<std::string> module_candidates() {
   char exe[PATH_MAX];
   const ssize_t n = ::readlink("/proc/self/exe", exe, sizeof exe - 1);
   std::string dir = ".";
@@ -36,12 +40,28 @@ std::string module_path() {
     dir.assign(exe, std::size_t(n));
     dir = dir.substr(0, dir.find_last_of('/'));
   }
-  return dir + "/" NMBAKE_IMAGE_MODULE;
+  std::vector<std::string> paths{dir + "/" NMBAKE_IMAGE_MODULE};
+#ifdef NMBAKE_IMAGE_MODULE_DIR
+  paths.push_back(dir + "/" NMBAKE_IMAGE_MODULE_DIR "/" NMBAKE_IMAGE_MODULE);
+#endif
+  return paths;
+}
+
+// The first candidate that exists; empty, with *error saying where it looked, when none does.
+std::string module_path(std::string* error) {
+  const std::vector<std::string> paths = module_candidates();
+  for (const std::string& p : paths)
+    if (::access(p.c_str(), F_OK) == 0) return p;
+  const int missing = errno;
+  *error = "cannot load the image library module " + paths.front() + ": " + std::strerror(missing);
+  for (std::size_t i = 1; i < paths.size(); ++i) *error += " (nor " + paths[i] + ")";
+  return {};
 }
 
 Loaded load() {
   Loaded l;
-  const std::string path = module_path();
+  const std::string path = module_path(&l.error);
+  if (path.empty()) return l;
   void* handle = ::dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (!handle) {
     const char* why = ::dlerror();
@@ -99,7 +119,9 @@ std::string image_io_problem() {
   start();
   if (g_loaded.wait_for(std::chrono::seconds(0)) == std::future_status::ready && !g_loaded.get().module)
     return g_loaded.get().error;
-  const std::string path = module_path();
+  std::string error;
+  const std::string path = module_path(&error);
+  if (path.empty()) return error;
   if (::access(path.c_str(), R_OK) != 0) return "cannot load the image library module " + path + ": " + std::strerror(errno);
   return {};
 }

@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# install.sh CMAKE BUILD WORK SAMPLE_DIR BINDIR MODULEDIR MODULE VIEWER(0|1)
+# Installs BUILD into a prefix under WORK, checks the layout, bakes the bundled sample with the
+# installed nmbake from another folder (by PATH), moves the prefix and bakes again, and runs the
+# installed nmdiff (and nmview) --help. Leaves nothing behind: WORK's scratch folder is removed and
+# BUILD's install_manifest.txt, which `cmake --install` rewrites, is put back as it was.
+set -euo pipefail
+cmake=$1 build=$2 work=$3 sample=$4 bindir=$5 moduledir=$6 module=$7 viewer=$8
+scratch=$(mktemp -d "$work/install-test.XXXXXX")
+manifest=$build/install_manifest.txt
+had_manifest=0
+if [ -e "$manifest" ]; then had_manifest=1; cp -p "$manifest" "$scratch/manifest.saved"; fi
+cleanup() {
+  if [ "$had_manifest" = 1 ]; then cp -p "$scratch/manifest.saved" "$manifest"; else rm -f "$manifest"; fi
+  rm -rf "$scratch"
+}
+trap cleanup EXIT
+fail() { echo "install test: $*" >&2; exit 1; }
+
+prefix=$scratch/prefix
+"$cmake" --install "$build" --prefix "$prefix" >"$scratch/install.log" || { cat "$scratch/install.log"; fail "cmake --install failed"; }
+
+# The layout: the commands in BINDIR, nmbake's image module in MODULEDIR and not beside the commands.
+expected="nmbake nmdiff"
+[ "$viewer" = 1 ] && expected="nmbake nmdiff nmview"
+[ "$(ls "$prefix/$bindir" | sort | tr '\n' ' ')" = "$expected " ] || fail "$bindir holds: $(ls "$prefix/$bindir" | tr '\n' ' ')"
+[ -f "$prefix/$moduledir/$module" ] || fail "no $moduledir/$module"
+
+bake() {  # bake PREFIX FOLDER: the installed nmbake, found by PATH, run in FOLDER
+  mkdir -p "$2"
+  (cd "$2" && PATH="$1/$bindir:$PATH" nmbake "$sample/torus_low.obj" "$sample/torus_high.ply" -o map.png --size 64 --quiet) \
+    || fail "installed nmbake exited $? in $2"
+  [ -s "$2/map.png" ] || fail "no map in $2"
+}
+bake "$prefix" "$scratch/elsewhere"
+mv "$prefix" "$scratch/moved"
+bake "$scratch/moved" "$scratch/elsewhere2"
+
+"$scratch/moved/$bindir/nmdiff" --help >/dev/null || fail "installed nmdiff --help failed"
+if [ "$viewer" = 1 ]; then "$scratch/moved/$bindir/nmview" --help >/dev/null || fail "installed nmview --help failed"; fi
+echo "install test: passed"
