@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cctype>
 #include <chrono>
+#include <climits>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -65,11 +66,9 @@ void parse_size(const std::string& text, int& w, int& h) {
   const auto x = text.find_first_of("xX");
   const long long a = parse_side(x == std::string::npos ? text : text.substr(0, x));
   const long long b = x == std::string::npos ? a : parse_side(text.substr(x + 1));
-  if (a < 1 || b < 1) throw UsageError("--size must be at least 1 texel per side, got '" + text + "'");
-  if (a > kMaxMapSide || b > kMaxMapSide)
-    throw ResourceError("--size " + text + " refused: the largest supported side is " + std::to_string(kMaxMapSide) + " texels");
-  w = int(a);
-  h = int(b);
+  // Sides beyond an int are clamped: validate_options refuses them.
+  w = int(std::min<long long>(a, INT_MAX));
+  h = int(std::min<long long>(b, INT_MAX));
 }
 
 std::string human(double v) {
@@ -122,9 +121,8 @@ class ProgressBar {
   int last_ = -1;
 };
 
-int run(int argc, char** argv) {
-  Args a;
-  CLI::App app{"nmbake: bake a tangent-space normal map from a high-poly mesh onto a low-poly mesh with UVs.", "nmbake"};
+// The command line's options, with its help text.
+void add_options(CLI::App& app, Args& a) {
   app.footer(std::string("\nInputs: OBJ, PLY (ascii/binary), OFF, STL. The low-poly must have UVs.\n"
                          "Maps use the OpenGL convention (green = +bitangent, \"Y+\") unless --green down;\n"
                          "tangent frames follow MikkTSpace (Blender, glTF, Substance, Unity, Unreal).\n\n") + kExitCodes);
@@ -172,30 +170,15 @@ int run(int argc, char** argv) {
                "about 10% of a 2048^2 1-sample bake (measured on torus_s3 and suz_L4: 0.13-0.31 s, 6-12% of the command)");
   app.set_version_flag("--version", std::string("nmbake ") + NMBAKE_VERSION);
 
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForVersion& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    throw UsageError(e.what());
-  }
+}
 
-  const auto start = Clock::now();
+// The library's options from the flags: translation only (validate_options checks them).
+BakeOptions bake_options(const Args& a) {
   BakeOptions o;
   parse_size(a.size, o.width, o.height);
-  if (a.samples < 1 || a.samples > kMaxSamples)
-    throw UsageError("--samples must be between 1 and " + std::to_string(kMaxSamples) + ", got " + std::to_string(a.samples));
-  if (a.padding < 0 || a.padding > kMaxMapSide)
-    throw UsageError("--padding must be between 0 and " + std::to_string(kMaxMapSide) + ", got " + std::to_string(a.padding));
-  if (a.threads < 0 || a.threads > 1024) throw UsageError("--threads must be between 0 and 1024, got " + std::to_string(a.threads));
-  auto check_distance = [](double d, const char* name) {
-    if (d != -1.0 && !(d >= 0.0 && d < 1e30)) throw UsageError(std::string(name) + " must be a distance >= 0 in scene units");
-  };
-  check_distance(a.front, "--front");
-  check_distance(a.rear, "--rear");
-  if (a.space == "object" && a.green == "down") throw UsageError("--green down applies to tangent-space maps only");
+  // A distance given must be one (the library reads a negative one as "measure it").
+  for (const auto& [d, name] : {std::pair{a.front, "--front"}, std::pair{a.rear, "--rear"}})
+    if (d != -1.0 && !(d >= 0.0)) throw UsageError(std::string(name) + " must be a distance >= 0 in scene units");
   o.samples = a.samples;
   o.front = float(a.front);
   o.rear = float(a.rear);
@@ -209,7 +192,11 @@ int run(int argc, char** argv) {
   o.suspect_mask = !a.suspect_mask.empty();
   o.cull_far = !a.no_cull;
   o.keep_backfaces = a.keep_backfaces;
-  const int bits = a.bits ? a.bits : default_bits_for(a.output);
+  return o;
+}
+
+// Fails early, before a long bake, on outputs that cannot be written.
+void check_outputs(const Args& a, int bits) {
   if (!a.save_cage.empty()) {
     if (!a.cage.empty() || a.front != -1.0 || a.rear != -1.0)
       throw UsageError("--save-cage writes the automatic cage, which is made only without --cage, --front and --rear");
@@ -231,54 +218,28 @@ int run(int argc, char** argv) {
     check_output_path(a.suspect_mask, "the suspect mask");
     check_output_format(a.suspect_mask, default_bits_for(a.suspect_mask));
   }
+}
 
-  std::signal(SIGINT, on_sigint);
-  const bool tty = !a.quiet && ::isatty(STDERR_FILENO);
-
-  // Load.
-  RunInfo run;
-  run.low_path = a.low;
-  run.high_path = a.high;
-  run.cage_path = a.cage;
-  run.output_path = a.output;
-  run.miss_mask_path = a.miss_mask;
-  run.suspect_mask_path = a.suspect_mask;
-  run.bits = bits;
-  auto t0 = Clock::now();
-  LoadOptions low_opts;
-  low_opts.require_uvs = true;
-  Mesh low = load_mesh(a.low, low_opts, &run.low_info);
-  Mesh high = load_mesh(a.high, {}, &run.high_info);
-  Mesh cage;
-  if (!a.cage.empty()) cage = load_mesh(a.cage, {}, &run.cage_info);
-  run.seconds_load = std::chrono::duration<double>(Clock::now() - t0).count();
-  if (g_interrupted) throw Cancelled();
-
-  ProgressBar bar(tty);
-  o.progress = [&](double f) { return bar.update(f); };
-  BakeResult r = bake_normal_map(low, high, a.cage.empty() ? nullptr : &cage, o);
-  const BakeStats& s = r.stats;
-  // Topology checks are only reported: they run beside the image write, which uses one core
-  // (about 0.3-0.6 s CPU per 400k triangles; beside the bake they took time from its threads).
-  auto topology = std::async(std::launch::async, [&high] { return inspect_topology(high); });
-  if (s.cage == BakeStats::CageSource::automatic && !a.quiet)
+// One line on how far rays reached, unless --quiet.
+void print_distances(const BakeStats& s) {
+  if (s.cage == BakeStats::CageSource::automatic)
     std::fprintf(stderr,
                  "nmbake: automatic cage: front %.3g-%.3g (mean %.3g), rear %.3g-%.3g (mean %.3g) per vertex; limited by a neighbouring "
                  "part at %zu and %zu vertices\n",
                  s.vertex_front.min, s.vertex_front.max, s.vertex_front.mean, s.vertex_rear.min, s.vertex_rear.max, s.vertex_rear.mean,
                  s.cage_front_limited, s.cage_rear_limited);
-  else if (s.cage == BakeStats::CageSource::file && s.auto_distances && !a.quiet)
+  else if (s.cage == BakeStats::CageSource::file && s.auto_distances)
     std::fprintf(stderr, "nmbake: rear distances measured per vertex: %.3g-%.3g (mean %.3g)\n", s.vertex_rear.min, s.vertex_rear.max,
                  s.vertex_rear.mean);
-  else if (s.auto_distances && !a.quiet)
+  else if (s.auto_distances)
     std::fprintf(stderr, "nmbake: ray distances measured: --front %.6g --rear %.6g (%.2f%% of probes lie beyond)\n", s.front, s.rear,
                  100.0 * s.auto_probe_beyond);
-  if (g_interrupted) throw Cancelled();
-  ErrorEstimate estimate;
-  if (a.estimate_error) {
+}
+
+ErrorEstimate estimate_error(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& o, const BakeResult& r, int bits) {
     ErrorEstimateOptions eo;
     eo.bits = bits;
-    estimate = estimate_bake_error(low, high, a.cage.empty() ? nullptr : &cage, o, r, eo);
+    const ErrorEstimate estimate = estimate_bake_error(low, high, cage, o, r, eo);
     // The estimate compares float values; say what the output's bit depth adds on top.
     char quant[128] = "float output adds no quantisation";
     if (bits != 32)
@@ -288,10 +249,11 @@ int run(int argc, char** argv) {
                  "nmbake: error estimate: mean %.4f deg, p95 %.4f deg, max %.4f deg against %d samples on %zu texels "
                  "(%.2f s); %s\n",
                  estimate.mean_deg, estimate.p95_deg, estimate.max_deg, estimate.samples, estimate.texels, estimate.seconds, quant);
-  }
+  return estimate;
+}
 
-  // Write.
-  t0 = Clock::now();
+// The map, the masks and the cage.
+void write_outputs(const Args& a, const BakeOptions& o, const BakeResult& r, const Mesh& low, int bits) {
   WriteOptions wo;
   wo.bits = bits;
   wo.metadata = {{"nmbake:space", to_string(o.space)},
@@ -321,25 +283,20 @@ int run(int argc, char** argv) {
     cage_mesh.uv_index = low.uv_index;
     write_text_atomically(a.save_cage, obj_text(cage_mesh, "nmbake " NMBAKE_VERSION " automatic cage of " + a.low + " for " + a.high));
   }
-  run.seconds_write = std::chrono::duration<double>(Clock::now() - t0).count();
-  run.high_topology = topology.get();
-  if (!a.quiet)
-    for (const std::string& w : bake_warnings(s, run.high_topology, a.low, a.high)) std::fprintf(stderr, "nmbake: %s\n", w.c_str());
-  run.seconds_total = std::chrono::duration<double>(Clock::now() - start).count();
-  run.peak_memory_bytes = peak_memory_bytes();
-  run.threads_used = a.threads > 0 ? unsigned(a.threads) : std::max(1u, std::thread::hardware_concurrency());
-  if (!a.report.empty()) {
-    nlohmann::json report = make_report(o, s, run);
-    if (a.estimate_error)
-      report["error_estimate"] = {{"mean_deg", estimate.mean_deg},
-                                  {"p95_deg", estimate.p95_deg},
-                                  {"max_deg", estimate.max_deg},
-                                  {"texels", estimate.texels},
-                                  {"seconds", estimate.seconds}};
-    write_text_atomically(a.report, report.dump(2) + "\n");
-  }
+}
 
-  if (!a.quiet) {
+void write_report(const Args& a, const BakeOptions& o, const RunInfo& run, const BakeStats& s, const ErrorEstimate* estimate) {
+    nlohmann::json report = make_report(o, s, run);
+    if (estimate)
+      report["error_estimate"] = {{"mean_deg", estimate->mean_deg},
+                                  {"p95_deg", estimate->p95_deg},
+                                  {"max_deg", estimate->max_deg},
+                                  {"texels", estimate->texels},
+                                  {"seconds", estimate->seconds}};
+    write_text_atomically(a.report, report.dump(2) + "\n");
+}
+
+void print_summary(const Args& a, const BakeOptions& o, const RunInfo& run, const BakeStats& s, int bits) {
     std::printf(
         "nmbake: wrote %s (%dx%d, %d-bit, %s%s): samples %d, rays %s, misses %llu (%.2f%%), coverage %.1f%%, "
         "seconds: load %.2f prepare %.2f bvh %.2f distances %.2f trace %.2f padding %.2f write %.2f total %.2f\n",
@@ -348,7 +305,73 @@ int run(int argc, char** argv) {
         (unsigned long long)s.misses, s.samples_covered ? 100.0 * double(s.misses) / double(s.samples_covered) : 0.0, 100.0 * s.coverage,
         run.seconds_load, s.seconds_prepare, s.seconds_bvh, s.seconds_distances, s.seconds_trace, s.seconds_padding, run.seconds_write,
         run.seconds_total);
+}
+
+int run(int argc, char** argv) {
+  Args a;
+  CLI::App app{"nmbake: bake a tangent-space normal map from a high-poly mesh onto a low-poly mesh with UVs.", "nmbake"};
+  add_options(app, a);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    throw UsageError(e.what());
   }
+
+  const auto start = Clock::now();
+  BakeOptions o = bake_options(a);
+  validate_options(o);  // the library's checks, before a long load
+  const int bits = a.bits ? a.bits : default_bits_for(a.output);
+  check_outputs(a, bits);
+  std::signal(SIGINT, on_sigint);
+  const bool tty = !a.quiet && ::isatty(STDERR_FILENO);
+
+  // Load.
+  RunInfo run;
+  run.low_path = a.low;
+  run.high_path = a.high;
+  run.cage_path = a.cage;
+  run.output_path = a.output;
+  run.miss_mask_path = a.miss_mask;
+  run.suspect_mask_path = a.suspect_mask;
+  run.bits = bits;
+  auto t0 = Clock::now();
+  LoadOptions low_opts;
+  low_opts.require_uvs = true;
+  Mesh low = load_mesh(a.low, low_opts, &run.low_info);
+  Mesh high = load_mesh(a.high, {}, &run.high_info);
+  Mesh cage;
+  if (!a.cage.empty()) cage = load_mesh(a.cage, {}, &run.cage_info);
+  const Mesh* cage_mesh = a.cage.empty() ? nullptr : &cage;
+  run.seconds_load = std::chrono::duration<double>(Clock::now() - t0).count();
+  if (g_interrupted) throw Cancelled();
+
+  ProgressBar bar(tty);
+  o.progress = [&](double f) { return bar.update(f); };
+  const BakeResult r = bake_normal_map(low, high, cage_mesh, o);
+  const BakeStats& s = r.stats;
+  // Topology checks are only reported: they run beside the image write, which uses one core
+  // (about 0.3-0.6 s CPU per 400k triangles; beside the bake they took time from its threads).
+  auto topology = std::async(std::launch::async, [&high] { return inspect_topology(high); });
+  if (!a.quiet) print_distances(s);
+  if (g_interrupted) throw Cancelled();
+  ErrorEstimate estimate;
+  if (a.estimate_error) estimate = estimate_error(low, high, cage_mesh, o, r, bits);
+
+  t0 = Clock::now();
+  write_outputs(a, o, r, low, bits);
+  run.seconds_write = std::chrono::duration<double>(Clock::now() - t0).count();
+  run.high_topology = topology.get();
+  if (!a.quiet)
+    for (const std::string& w : bake_warnings(s, run.high_topology, a.low, a.high)) std::fprintf(stderr, "nmbake: %s\n", w.c_str());
+  run.seconds_total = std::chrono::duration<double>(Clock::now() - start).count();
+  run.peak_memory_bytes = peak_memory_bytes();
+  run.threads_used = a.threads > 0 ? unsigned(a.threads) : std::max(1u, std::thread::hardware_concurrency());
+  if (!a.report.empty()) write_report(a, o, run, s, a.estimate_error ? &estimate : nullptr);
+  if (!a.quiet) print_summary(a, o, run, s, bits);
   return 0;
 }
 

@@ -57,42 +57,64 @@ glm::dvec3 project_normalize(const glm::dvec3& v, const glm::dvec3& n) {
 // +0 for -0 so that welding by bits treats them as equal, as a float comparison would.
 float canon(float x) { return x + 0.0f; }
 
-}  // namespace
+// The mesh's corners as the steps read them: normals (the file's, else smooth vertex normals),
+// positions and UVs in double.
+struct Corners {
+  explicit Corners(const Mesh& m) : mesh(m) {
+    if (!mesh.has_normals()) {
+      computed = compute_vertex_normals(mesh);
+      normals = &computed;
+      normal_index = &mesh.position_index;
+    }
+  }
+  glm::dvec3 normal(std::size_t c) const { return glm::dvec3((*normals)[(*normal_index)[c]]); }
+  glm::dvec3 pos(std::size_t c) const { return glm::dvec3(mesh.positions[mesh.position_index[c]]); }
+  glm::dvec2 uv(std::size_t c) const { return glm::dvec2(mesh.uvs[mesh.uv_index[c]]); }
 
-TangentFrames compute_tangent_frames(const Mesh& mesh) {
-  assert(mesh.has_uvs());
-  const std::size_t tris = mesh.triangle_count();
-  const std::size_t corners = 3 * tris;
-  TangentFrames out;
-
-  // Corner normals: the file's, else smooth vertex normals.
+  const Mesh& mesh;
   std::vector<glm::vec3> computed;
   const std::vector<glm::vec3>* normals = &mesh.normals;
   const std::vector<std::uint32_t>* normal_index = &mesh.normal_index;
-  if (!mesh.has_normals()) {
-    computed = compute_vertex_normals(mesh);
-    normals = &computed;
-    normal_index = &mesh.position_index;
-  }
-  auto corner_normal = [&](std::size_t c) { return glm::dvec3((*normals)[(*normal_index)[c]]); };
-  auto corner_pos = [&](std::size_t c) { return glm::dvec3(mesh.positions[mesh.position_index[c]]); };
-  auto corner_uv = [&](std::size_t c) { return glm::dvec2(mesh.uvs[mesh.uv_index[c]]); };
+};
 
-  // 1. Weld corners by the value of position, normal and UV.
+struct Group {
+  std::uint32_t rep;
+  bool orient_preserving;
+  std::vector<std::uint32_t> tris;
+};
+
+// The corner of triangle t at welded vertex rep, or -1.
+int corner_with(const std::vector<std::uint32_t>& vid, std::size_t t, std::uint32_t rep) {
+  for (int i = 0; i < 3; ++i)
+    if (vid[3 * t + std::size_t(i)] == rep) return i;
+  return -1;
+}
+
+// 1. Corners welded by the value of position, normal and UV: an id per corner.
+std::vector<std::uint32_t> weld_corners(const Corners& in) {
+  const Mesh& mesh = in.mesh;
+  const std::size_t corners = mesh.position_index.size();
   std::vector<std::uint32_t> vid(corners);
   {
     std::unordered_map<CornerKey, std::uint32_t, CornerKeyHash> ids;
     ids.reserve(corners);
     for (std::size_t c = 0; c < corners; ++c) {
       const glm::vec3 p = mesh.positions[mesh.position_index[c]];
-      const glm::vec3 n = (*normals)[(*normal_index)[c]];
+      const glm::vec3 n = (*in.normals)[(*in.normal_index)[c]];
       const glm::vec2 t = mesh.uvs[mesh.uv_index[c]];
       CornerKey key{{canon(p.x), canon(p.y), canon(p.z), canon(n.x), canon(n.y), canon(n.z), canon(t.x), canon(t.y)}};
       vid[c] = ids.emplace(key, std::uint32_t(ids.size())).first->second;
     }
   }
 
-  // 2. Per triangle: UV gradient dP/du, orientation, degeneracy.
+  return vid;
+}
+
+// 2. Per triangle: UV gradient dP/du, orientation, degeneracy.
+std::vector<TriInfo> triangle_info(const Corners& in, TangentFrames& out) {
+  const std::size_t tris = in.mesh.triangle_count();
+  auto corner_pos = [&](std::size_t c) { return in.pos(c); };
+  auto corner_uv = [&](std::size_t c) { return in.uv(c); };
   std::vector<TriInfo> info(tris);
   for (std::size_t t = 0; t < tris; ++t) {
     TriInfo& ti = info[t];
@@ -123,7 +145,12 @@ TangentFrames compute_tangent_frames(const Mesh& mesh) {
     }
   }
 
-  // 3. Neighbours across edges whose welded ends match with opposite direction.
+  return info;
+}
+
+// 3. Neighbours across edges whose welded ends match with opposite direction.
+std::vector<std::int32_t> edge_neighbours(const std::vector<std::uint32_t>& vid, const std::vector<TriInfo>& info) {
+  const std::size_t corners = vid.size(), tris = info.size();
   std::vector<std::int32_t> neighbour(corners, -1);  // across edge (i, i+1) of each triangle
   {
     std::unordered_map<std::uint64_t, std::uint32_t> edges;
@@ -142,19 +169,15 @@ TangentFrames compute_tangent_frames(const Mesh& mesh) {
     }
   }
 
-  // 4. Groups: around each welded vertex, the triangles reached across edges with one orientation.
-  struct Group {
-    std::uint32_t rep;
-    bool orient_preserving;
-    std::vector<std::uint32_t> tris;
-  };
+  return neighbour;
+}
+
+// 4. Groups: around each welded vertex, the triangles reached across edges with one orientation.
+// group_of receives each corner's group (-1: none).
+std::vector<Group> build_groups(const std::vector<std::uint32_t>& vid, std::vector<TriInfo>& info,
+                                const std::vector<std::int32_t>& neighbour, std::vector<std::int32_t>& group_of) {
+  const std::size_t tris = info.size();
   std::vector<Group> groups;
-  std::vector<std::int32_t> group_of(corners, -1);
-  auto corner_with = [&](std::size_t t, std::uint32_t rep) {
-    for (int i = 0; i < 3; ++i)
-      if (vid[3 * t + i] == rep) return i;
-    return -1;
-  };
   std::vector<std::uint32_t> stack;
   for (std::size_t f = 0; f < tris; ++f) {
     if (info[f].coincident || info[f].free_orientation) continue;
@@ -171,7 +194,7 @@ TangentFrames compute_tangent_frames(const Mesh& mesh) {
         const std::int32_t t = std::int32_t(stack.back());
         stack.pop_back();
         if (t < 0) continue;
-        const int k = corner_with(std::size_t(t), groups[g].rep);
+        const int k = corner_with(vid, std::size_t(t), groups[g].rep);
         if (k < 0 || group_of[3 * t + k] >= 0) continue;
         TriInfo& ti = info[t];
         if (ti.free_orientation && group_of[3 * t] < 0 && group_of[3 * t + 1] < 0 && group_of[3 * t + 2] < 0)
@@ -185,13 +208,20 @@ TangentFrames compute_tangent_frames(const Mesh& mesh) {
     }
   }
 
-  // 5. Per group: angle-weighted mean of the members' tangents projected onto the normal's plane.
+  return groups;
+}
+
+// 5. Per group: angle-weighted mean of the members' tangents projected onto the normal's plane.
+std::vector<glm::dvec3> group_tangents(const Corners& in, const std::vector<std::uint32_t>& vid, const std::vector<TriInfo>& info,
+                                       const std::vector<Group>& groups) {
+  auto corner_normal = [&](std::size_t c) { return in.normal(c); };
+  auto corner_pos = [&](std::size_t c) { return in.pos(c); };
   std::vector<glm::dvec3> group_tangent(groups.size(), glm::dvec3(0.0));
   for (std::size_t g = 0; g < groups.size(); ++g) {
     glm::dvec3 sum(0.0);
     for (std::uint32_t f : groups[g].tris) {
       if (!info[f].contributes) continue;
-      const int i = corner_with(f, groups[g].rep);
+      const int i = corner_with(vid, f, groups[g].rep);
       const glm::dvec3 n = corner_normal(3 * f + i);
       const glm::dvec3 os = project_normalize(info[f].tangent, n);
       const glm::dvec3 p1 = corner_pos(3 * f + i);
@@ -203,8 +233,15 @@ TangentFrames compute_tangent_frames(const Mesh& mesh) {
     group_tangent[g] = sum;
   }
 
-  // 6. Per corner output; corners without a group copy the first grouped corner of their welded
-  //    vertex (as MikkTSpace does for degenerate triangles), else any tangent orthogonal to N.
+  return group_tangent;
+}
+
+// 6. Per corner output; corners without a group copy the first grouped corner of their welded
+//    vertex (as MikkTSpace does for degenerate triangles), else any tangent orthogonal to N.
+void corner_frames(const Corners& in, const std::vector<std::uint32_t>& vid, const std::vector<Group>& groups,
+                   const std::vector<std::int32_t>& group_of, const std::vector<glm::dvec3>& group_tangent, TangentFrames& out) {
+  const std::size_t corners = vid.size();
+  auto corner_normal = [&](std::size_t c) { return in.normal(c); };
   std::vector<std::int32_t> first_grouped(corners, -1);  // by welded vertex id (ids < corners)
   for (std::size_t c = 0; c < corners; ++c)
     if (group_of[c] >= 0 && first_grouped[vid[c]] < 0) first_grouped[vid[c]] = group_of[c];
@@ -228,6 +265,20 @@ TangentFrames compute_tangent_frames(const Mesh& mesh) {
     out.normal[c] = glm::vec3(n);
     out.tangent[c] = glm::vec4(glm::vec3(t), float(sign));
   }
+}
+
+}  // namespace
+
+TangentFrames compute_tangent_frames(const Mesh& mesh) {
+  assert(mesh.has_uvs());
+  TangentFrames out;
+  const Corners in(mesh);
+  const std::vector<std::uint32_t> vid = weld_corners(in);
+  std::vector<TriInfo> info = triangle_info(in, out);
+  const std::vector<std::int32_t> neighbour = edge_neighbours(vid, info);
+  std::vector<std::int32_t> group_of(vid.size(), -1);
+  const std::vector<Group> groups = build_groups(vid, info, neighbour, group_of);
+  corner_frames(in, vid, groups, group_of, group_tangents(in, vid, info, groups), out);
   return out;
 }
 

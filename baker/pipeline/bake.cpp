@@ -36,15 +36,7 @@ constexpr int kTile = 16;  // texels per tile side (twice that up to 4 samples)
 
 // Options and inputs a bake refuses (bake.h).
 void check_bake_inputs(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt) {
-  if (opt.width < 1 || opt.height < 1)
-    throw UsageError("--size must be at least 1x1 (got " + std::to_string(opt.width) + "x" + std::to_string(opt.height) + ")");
-  if (opt.width > kMaxMapSide || opt.height > kMaxMapSide)
-    throw ResourceError("--size " + std::to_string(opt.width) + "x" + std::to_string(opt.height) +
-                        " refused: the largest supported side is " + std::to_string(kMaxMapSide) + " texels");
-  if (opt.samples < 1 || opt.samples > kMaxSamples)
-    throw UsageError("--samples must be between 1 and " + std::to_string(kMaxSamples) + " (got " + std::to_string(opt.samples) + ")");
-  if (opt.padding < 0) throw UsageError("--padding must not be negative");
-  if (!std::isfinite(opt.front) || !std::isfinite(opt.rear)) throw UsageError("--front and --rear must be finite");
+  validate_options(opt);
   if (!low.has_uvs()) throw InputError(low.source + ": the low-poly mesh has no UVs");
   if (low.triangle_count() == 0) throw InputError(low.source + ": no faces");
   if (high.triangle_count() == 0) throw InputError(high.source + ": no faces");
@@ -196,6 +188,23 @@ int tile_side(const BakeOptions& opt) { return opt.samples <= 4 ? 2 * kTile : kT
 int thread_count(const BakeOptions& opt) { return opt.threads > 0 ? opt.threads : std::max(1, int(std::thread::hardware_concurrency())); }
 
 }  // namespace
+
+void validate_options(const BakeOptions& o) {
+  // As --size takes it: N for a square map, WxH otherwise.
+  const std::string size = std::to_string(o.width) + (o.width == o.height ? "" : "x" + std::to_string(o.height));
+  if (o.width < 1 || o.height < 1) throw UsageError("--size must be at least 1 texel per side, got " + size);
+  if (o.width > kMaxMapSide || o.height > kMaxMapSide)
+    throw ResourceError("--size " + size + " refused: the largest supported side is " + std::to_string(kMaxMapSide) + " texels");
+  if (o.samples < 1 || o.samples > kMaxSamples)
+    throw UsageError("--samples must be between 1 and " + std::to_string(kMaxSamples) + ", got " + std::to_string(o.samples));
+  if (o.padding < 0 || o.padding > kMaxMapSide)
+    throw UsageError("--padding must be between 0 and " + std::to_string(kMaxMapSide) + ", got " + std::to_string(o.padding));
+  if (o.threads < 0 || o.threads > kMaxThreads)
+    throw UsageError("--threads must be between 0 and " + std::to_string(kMaxThreads) + ", got " + std::to_string(o.threads));
+  for (const auto& [d, name] : {std::pair{o.front, "--front"}, std::pair{o.rear, "--rear"}})
+    if (!(d < kMaxDistance)) throw UsageError(std::string(name) + " must be a distance >= 0 in scene units");  // NaN, infinite, huge
+  if (o.space == NormalSpace::object && o.green_down) throw UsageError("--green down applies to tangent-space maps only");
+}
 
 // The stages in order (README "Layout"): prepare, select, BVH, distances (and a narrower
 // selection once they are known), rasterize, trace and shade, pad. Loading and writing are the

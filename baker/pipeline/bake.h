@@ -31,6 +31,8 @@ enum class NormalSpace { tangent, object };
 
 constexpr int kMaxMapSide = 65536;  // texels per side; larger maps are refused (ResourceError)
 constexpr int kMaxSamples = 1024;   // sample points per texel
+constexpr int kMaxThreads = 1024;
+constexpr double kMaxDistance = 1e30;  // --front, --rear: scene units
 constexpr double kCoordinateSpacingWarn = 1e-3;  // BakeStats::coordinate_spacing above this: warn
 // BakeStats::backface_probe_share above which the high-poly is taken as inverted, and above which
 // (up to the first) as partly inverted, when back faces are kept.
@@ -163,7 +165,11 @@ struct Cancelled : Error {
   Cancelled() : Error(ExitCode::usage, "cancelled") {}
 };
 
-// Throws UsageError for absurd options, InputError for meshes that cannot be baked (no UVs, cage
+// Every check of the options alone, in one place (the command line calls it before loading the
+// meshes, bake_normal_map again): UsageError for absurd values, ResourceError for a refused size.
+void validate_options(const BakeOptions& options);
+
+// Throws UsageError for absurd options (validate_options), InputError for meshes that cannot be baked (no UVs, cage
 // topology mismatch), ResourceError when the buffers would not fit in memory, Cancelled.
 BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& options);
 
