@@ -37,8 +37,11 @@ bake sample_cage png "$sample/torus_low.obj" "$sample/torus_high.ply" --size 512
 bake sample_s4_float exr "$sample/torus_low.obj" "$sample/torus_high.ply" --size 256 --samples 4 --estimate-error
 bake sample_green png "$sample/torus_low.obj" "$sample/torus_high.ply" --size 256 --green down --bitangent vertex --threads 1
 bake sample_object png "$sample/torus_low.obj" "$sample/torus_high.ply" --size 256 --space object
+# The golden maps' bakes (tests/test_golden.cpp).
+bake golden_torus_256 png "$sample/torus_low.obj" "$sample/torus_high.ply" --size 256
+bake golden_torus_128_s4_green_down png "$sample/torus_low.obj" "$sample/torus_high.ply" --size 128 --samples 4 --green down --padding 4
 if [[ -d $sculpts ]]; then
-  for s in suz_L3 suz_L4 torus_s3; do
+  for s in $(ls "$sculpts"); do
     bake "$s" png "$sculpts/$s/low.obj" "$sculpts/$s/high.ply" --size 1024 --save-cage "$out/$s.cage.obj"
     bake "${s}_closest" png "$sculpts/$s/low.obj" "$sculpts/$s/high.ply" --size 512 --policy closest --samples 4
     bake "${s}_keep" png "$sculpts/$s/low.obj" "$sculpts/$s/high.ply" --size 512 --keep-backfaces --no-cull
