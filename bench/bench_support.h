@@ -1,5 +1,6 @@
-// Helpers for bench_bake: timing, the machine and commit, the generated scenes (subdivided and
-// far-geometry meshes written once into the scratch folder), whole nmbake commands, map hashes.
+// Helpers for bench_bake: timing, formatting, the machine and commit, the generated scenes
+// (subdivided and far-geometry meshes written once into the scratch folder), whole nmbake
+// commands, map hashes.
 #pragma once
 
 #include <chrono>
@@ -76,6 +77,9 @@ const nlohmann::json* find_key(const nlohmann::json& j, const std::string& key);
 std::uint64_t pixel_hash(const Image::Pixels& pixels);
 
 std::string mib(double bytes);
+std::string fmt(const char* format, double v);  // printf of one number
+std::string hex(std::uint64_t h);               // 16 hex digits
+double median(std::vector<double> v);           // 0 when empty
 
 }  // namespace nmbake::bench
 

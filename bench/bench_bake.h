@@ -1,0 +1,93 @@
+// The bake bench's sections (bench_bake.cpp runs them in order and prints their Markdown to
+// stdout), the state they share, and the helpers more than one of them uses.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "bench_support.h"
+#include "core/mesh.h"
+#include "pipeline/bake.h"
+#include "raycast.h"
+
+namespace nmbake::bench {
+
+// The command line (bench_bake.cpp's top comment).
+struct Args {
+  std::string shared = "../shared/data";  // the shared data folder (sculpts/)
+  std::string exe = "nmbake";             // the nmbake command the whole-command rows run
+  std::string scratch = (std::filesystem::temp_directory_path() / "nmbake-bench").string();  // generated meshes, reused
+  int rounds = 3;        // each timed figure the best of this many rounds
+  int trace_rounds = 7;  // rounds of section 1 at 1 and 4 samples
+  bool quick = false;    // fewer rows, as a smoke check
+};
+
+// Every target of the issues, with what this run measured (the closing "Targets" table).
+struct Target {
+  std::string what, goal, measured, verdict;  // verdict: MET, NOT MET or "-" (not judged)
+};
+
+// What every section reads, and the targets they add to.
+struct BenchRun {
+  Args args;
+  int threads = 1;      // of the in-process bakes and bare loops
+  std::string run_dir;  // this run's maps and reports, removed at the end
+  std::string report;   // the --report file of the whole commands
+  std::vector<Target> targets;
+
+  void add_target(const std::string& what, const std::string& goal, const std::string& measured, bool met);
+  void skip_target(const std::string& what, const std::string& goal, const std::string& why);  // not measured
+};
+
+// The scenes: folders of the shared sculpts and the meshes section 0 generates from them.
+struct Scenes {
+  std::string t3, s3, s4;                       // sculpts/torus_s3, suz_L3, suz_L4 (low.obj, high.ply)
+  std::string m1_ply, m1_obj, m4_ply, far_ply;  // suz_L4_x4 (1M triangles), suz_L4_x16 (4M), torus_s3_far4
+  Mesh t3_low, t3_high;                         // torus_s3, loaded once
+};
+
+const char* verdict(bool met);  // "MET" or "NOT MET"
+void flush();                   // stdout, so a long run shows each row as it is measured
+
+// A bake's distances pinned (so the timed rounds skip the measurement), and the rays a bake with
+// them casts (bake_rays: the bake's own stages up to the trace).
+struct Recorded {
+  std::vector<raycast::Ray> rays;
+  std::vector<glm::vec3> positions;  // high-poly, re-centred
+  BakeOptions options;
+  std::size_t culled = 0;  // high-poly triangles the bake left out of its BVH
+};
+Recorded record(const Mesh& low, const Mesh& high, int size, int samples);
+
+// BVH build time and 8-packet trace time of one build quality on recorded rays.
+struct QualityRow {
+  std::string scene;
+  int samples = 0;
+  raycast::BuildQuality quality{};
+  std::size_t triangles = 0;
+  double build = 1e30;  // seconds
+  Timing trace;
+  std::size_t rays = 0;
+};
+
+// Whole-command table: its header, and a row (wall, stage seconds, peak memory, hash of `map`).
+void print_command_header();
+void print_command_row(const std::string& label, const CommandRun& r, const std::string& map);
+// Runs `nmbake inputs -o RUN_DIR/map options` (the fastest of `reps`) and prints its row as `label`.
+CommandRun run_command_row(const BenchRun& run, const std::string& label, const std::string& inputs, const std::string& map,
+                           const std::string& options, int reps);
+std::size_t high_tris(const CommandRun& r);        // the high-poly triangle count of its report, or 0
+std::string map_hash_of(const std::string& path);  // hex pixel_hash of the image, or why it cannot be read
+
+// The sections, in the order they print; each adds its targets to `run`.
+void generate_scenes(const BenchRun& run, Scenes& scenes);                                      // 0
+std::vector<QualityRow> run_tracing(BenchRun& run);                                             // 1 (rows for 2)
+void run_bvh_quality(const BenchRun& run, const Scenes& scenes, std::vector<QualityRow> rows);  // 2
+CommandRun run_whole_commands(BenchRun& run, const Scenes& scenes);              // 3; returns the 1M 2048^2 .png row for 5
+void run_loading(BenchRun& run, const Scenes& scenes);                           // 4
+void run_scaling(BenchRun& run, const Scenes& scenes, const CommandRun& m1_2k);  // 5
+void run_far_geometry(BenchRun& run, const Scenes& scenes);                      // 6
+
+}  // namespace nmbake::bench
