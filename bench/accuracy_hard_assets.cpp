@@ -32,7 +32,8 @@ Mesh push_cage(const Mesh& low, double push) {
   cage.source = low.source + " (pushed cage)";
   cage.position_index = low.position_index;
   cage.positions.resize(low.positions.size());
-  for (std::size_t i = 0; i < low.positions.size(); ++i) cage.positions[i] = glm::vec3(glm::dvec3(low.positions[i]) + push * glm::dvec3(ray_n[i]));
+  for (std::size_t i = 0; i < low.positions.size(); ++i)
+    cage.positions[i] = glm::vec3(glm::dvec3(low.positions[i]) + push * glm::dvec3(ray_n[i]));
   return cage;
 }
 
@@ -49,7 +50,8 @@ std::vector<HardAssetRow> run_hard_assets(const std::vector<int>& sizes, std::ve
     for (int size : sizes) {
       t0 = Clock::now();
       const std::vector<procedural::KnownTexel> known = procedural::known_texels(a, size);
-      std::fprintf(stderr, "  %s at %d^2: known answers for %zu texels in %.2f s\n", a.name.c_str(), size, known.size(), since(t0));
+      std::fprintf(stderr, "  %s at %d^2: known answers for %zu texels in %.2f s\n", a.name.c_str(), size, known.size(),
+                   since(t0));
       auto run = [&](const std::string& setting, const BakeOptions& o, const Mesh* cage, double push = 0.0) {
         t0 = Clock::now();
         BakeResult r = bake_normal_map(a.low, a.high, cage, o);
@@ -71,11 +73,12 @@ std::vector<HardAssetRow> run_hard_assets(const std::vector<int>& sizes, std::ve
         row.rear = r.stats.rear;
         row.seconds = seconds;
         rows.push_back(row);
-        std::fprintf(stderr,
-                     "  %-32s %4d %-8s facing away %6.3f%%  mean %8.4f deg  >1deg %7.3f%%  >60deg %7.3f%%  worst %6.2f  misses %6llu  "
-                     "front %.4g rear %.4g  %.2f s\n",
-                     a.name.c_str(), size, setting.c_str(), 100 * row.facing_away, row.mean_deg, 100 * row.over1, 100 * row.over60,
-                     row.worst_deg, (unsigned long long)row.misses, row.front, row.rear, row.seconds);
+        std::fprintf(
+            stderr,
+            "  %-32s %4d %-8s facing away %6.3f%%  mean %8.4f deg  >1deg %7.3f%%  >60deg %7.3f%%  worst %6.2f  misses %6llu  "
+            "front %.4g rear %.4g  %.2f s\n",
+            a.name.c_str(), size, setting.c_str(), 100 * row.facing_away, row.mean_deg, 100 * row.over1, 100 * row.over60,
+            row.worst_deg, (unsigned long long)row.misses, row.front, row.rear, row.seconds);
         return r;
       };
       BakeOptions o;
@@ -136,15 +139,16 @@ std::string hard_assets_markdown(const std::vector<HardAssetRow>& rows, const st
        "filter). Facing away: covered texels whose normal points into the low-poly (`texels_facing_away` / "
        "`texels_covered`). Front, rear: the largest distances the bake used (`BakeStats::front`, `rear`); for `cage` the push. "
        "Seconds: `bake_normal_map` in-process; for `cage` and `old-rule` without the bakes that "
-       "measured their distances. The section took " + fmt("%.0f", seconds) + " s.\n\n";
+       "measured their distances. The section took " +
+       fmt("%.0f", seconds) + " s.\n\n";
   for (const std::string& n : notes) s += "- " + n + "\n";
   s += "\n| case | size | setting | facing away | mean deg | > 1 deg | > 60 deg | worst deg | misses | front | rear | seconds |\n"
        "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const HardAssetRow& r : rows)
-    s += "| " + r.asset + " | " + std::to_string(r.size) + " | " + r.setting + " | " + fmt("%.3f%%", 100 * r.facing_away) + " | " +
-         fmt("%.4f", r.mean_deg) + " | " + fmt("%.3f%%", 100 * r.over1) + " | " + fmt("%.3f%%", 100 * r.over60) + " | " +
-         fmt("%.2f", r.worst_deg) + " | " + std::to_string(r.misses) + " | " + fmt("%.4g", r.front) + " | " + fmt("%.4g", r.rear) +
-         " | " + fmt("%.3f", r.seconds) + " |\n";
+    s += "| " + r.asset + " | " + std::to_string(r.size) + " | " + r.setting + " | " + fmt("%.3f%%", 100 * r.facing_away) +
+         " | " + fmt("%.4f", r.mean_deg) + " | " + fmt("%.3f%%", 100 * r.over1) + " | " + fmt("%.3f%%", 100 * r.over60) + " | " +
+         fmt("%.2f", r.worst_deg) + " | " + std::to_string(r.misses) + " | " + fmt("%.4g", r.front) + " | " +
+         fmt("%.4g", r.rear) + " | " + fmt("%.3f", r.seconds) + " |\n";
   return s;
 }
 

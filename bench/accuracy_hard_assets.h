@@ -12,11 +12,11 @@
 namespace nmbake::bench {
 
 struct HardAssetRow {
-  std::string asset, setting;  // setting: default, closest, cage, old-rule
-  int size = 0;                // map side in texels (1 sample per texel)
-  std::size_t texels = 0;      // covered texel centres measured
-  double facing_away = 0.0;    // BakeStats::texels_facing_away / texels_covered
-  double mean_deg = 0.0;       // mean angular error against the analytic normal, degrees
+  std::string asset, setting;        // setting: default, closest, cage, old-rule
+  int size = 0;                      // map side in texels (1 sample per texel)
+  std::size_t texels = 0;            // covered texel centres measured
+  double facing_away = 0.0;          // BakeStats::texels_facing_away / texels_covered
+  double mean_deg = 0.0;             // mean angular error against the analytic normal, degrees
   double over1 = 0.0, over60 = 0.0;  // share of the texels more than 1 (60) degrees off
   double worst_deg = 0.0;
   std::uint64_t misses = 0, backface_skips = 0;
@@ -39,7 +39,6 @@ std::vector<HardAssetRow> run_hard_assets(const std::vector<int>& sizes, std::ve
 void write_hard_assets_csv(const std::string& path, const std::vector<HardAssetRow>& rows);
 
 // The Markdown section of accuracy.md: heading, what was measured, the notes and the table.
-std::string hard_assets_markdown(const std::vector<HardAssetRow>& rows, const std::vector<std::string>& notes,
-                                 double seconds);
+std::string hard_assets_markdown(const std::vector<HardAssetRow>& rows, const std::vector<std::string>& notes, double seconds);
 
 }  // namespace nmbake::bench

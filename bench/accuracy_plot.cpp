@@ -19,9 +19,8 @@ namespace IBA = OIIO::ImageBufAlgo;
 struct Colour {
   float c[3];
 };
-const Colour kPalette[] = {{{0.12f, 0.47f, 0.71f}}, {{0.84f, 0.15f, 0.16f}}, {{0.17f, 0.63f, 0.17f}},
-                           {{0.58f, 0.40f, 0.74f}}, {{1.00f, 0.50f, 0.05f}}, {{0.55f, 0.34f, 0.29f}},
-                           {{0.89f, 0.47f, 0.76f}}, {{0.50f, 0.50f, 0.50f}}};
+const Colour kPalette[] = {{{0.12f, 0.47f, 0.71f}}, {{0.84f, 0.15f, 0.16f}}, {{0.17f, 0.63f, 0.17f}}, {{0.58f, 0.40f, 0.74f}},
+                           {{1.00f, 0.50f, 0.05f}}, {{0.55f, 0.34f, 0.29f}}, {{0.89f, 0.47f, 0.76f}}, {{0.50f, 0.50f, 0.50f}}};
 const float kBlack[3] = {0, 0, 0};
 const float kGrid[3] = {0.88f, 0.88f, 0.88f};
 
@@ -40,11 +39,14 @@ class Canvas {
         const bool steep = std::abs(y1 - y0) > std::abs(x1 - x0);
         const double dx = steep ? o : 0, dy = steep ? 0 : o;
         IBA::render_line(buf_, int(std::lround(x0 + a * (x1 - x0) + dx)), int(std::lround(y0 + a * (y1 - y0) + dy)),
-                         int(std::lround(x0 + b * (x1 - x0) + dx)), int(std::lround(y0 + b * (y1 - y0) + dy)), OIIO::cspan<float>(c, 3));
+                         int(std::lround(x0 + b * (x1 - x0) + dx)), int(std::lround(y0 + b * (y1 - y0) + dy)),
+                         OIIO::cspan<float>(c, 3));
       }
     }
   }
-  void box(int x0, int y0, int x1, int y1, const float* c, bool fill) { IBA::render_box(buf_, x0, y0, x1, y1, OIIO::cspan<float>(c, 3), fill); }
+  void box(int x0, int y0, int x1, int y1, const float* c, bool fill) {
+    IBA::render_box(buf_, x0, y0, x1, y1, OIIO::cspan<float>(c, 3), fill);
+  }
   void text(int x, int y, const std::string& s, int size, const float* c, bool centred = false) {
     if (font_.empty() || s.empty()) return;
     if (centred) {
@@ -72,10 +74,9 @@ std::string tick_text(double v) {
 
 }  // namespace
 
-void write_log_log_plot(const std::string& path, const std::string& title, const std::string& x_label,
-                        const std::string& y_label, const std::vector<PlotSeries>& series,
-                        const std::vector<PlotHLine>& hlines, const std::string& footer, const std::string& font,
-                        int width, int height) {
+void write_log_log_plot(const std::string& path, const std::string& title, const std::string& x_label, const std::string& y_label,
+                        const std::vector<PlotSeries>& series, const std::vector<PlotHLine>& hlines, const std::string& footer,
+                        const std::string& font, int width, int height) {
   Canvas cv(width, height, font);
   // Data range in decades, widened to whole decades.
   double xmin = 1e300, xmax = -1e300, ymin = 1e300, ymax = -1e300;

@@ -24,9 +24,8 @@ struct PlotHLine {
 
 // Writes a PNG (width x height) to `path`; `font` is a TTF file (text is skipped when it cannot be
 // used). Throws OutputError when the file cannot be written.
-void write_log_log_plot(const std::string& path, const std::string& title, const std::string& x_label,
-                        const std::string& y_label, const std::vector<PlotSeries>& series,
-                        const std::vector<PlotHLine>& hlines, const std::string& footer, const std::string& font,
-                        int width = 1400, int height = 900);
+void write_log_log_plot(const std::string& path, const std::string& title, const std::string& x_label, const std::string& y_label,
+                        const std::vector<PlotSeries>& series, const std::vector<PlotHLine>& hlines, const std::string& footer,
+                        const std::string& font, int width = 1400, int height = 900);
 
 }  // namespace nmbake::bench

@@ -81,10 +81,8 @@ Image render_heatmap(const AngleField& field, double scale_max_deg) {
     for (int x = 0; x < w; ++x) {
       const float d = field.degrees[static_cast<std::size_t>(y) * w + x];
       float* p = out.at(x, y);
-      if (d < 0.0f)
-        p[0] = p[1] = p[2] = kNotCompared;
-      else
-        ramp(d / scale_max_deg, p);
+      if (d < 0.0f) p[0] = p[1] = p[2] = kNotCompared;
+      else ramp(d / scale_max_deg, p);
     }
   for (int x = 0; x < w; ++x) {
     float rgb[3];

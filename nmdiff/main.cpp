@@ -38,27 +38,25 @@ std::string fmt(const char* format, double v) {
   return buf;
 }
 
-void print_summary(const std::string& a, const std::string& b, const DiffStats& s,
-                   const nmbake::diff::DiffOptions& o, bool resampled, const std::string& resample) {
+void print_summary(const std::string& a, const std::string& b, const DiffStats& s, const nmbake::diff::DiffOptions& o,
+                   bool resampled, const std::string& resample) {
   std::cout << "nmdiff: " << a << " vs " << b << " (" << s.width << "x" << s.height
             << (resampled ? ", B resampled " + resample : std::string()) << ")\n";
   std::cout << "compared " << s.texels_compared << " texels";
   if (s.padding_compared) std::cout << " (" << s.padding_compared << " of them padding)";
-  std::cout << "; skipped " << s.skipped_mask << " outside the mask, " << s.skipped_alpha << " by alpha, "
-            << s.invalid_a << " invalid in A, " << s.invalid_b << " invalid in B\n";
-  std::cout << "angle (deg): mean " << fmt("%.4f", s.mean_deg) << "  rms " << fmt("%.4f", s.rms_deg)
-            << "  p95 " << fmt("%.4f", s.p95_deg) << "  p99 " << fmt("%.4f", s.p99_deg) << "  max "
-            << fmt("%.4f", s.max_deg);
+  std::cout << "; skipped " << s.skipped_mask << " outside the mask, " << s.skipped_alpha << " by alpha, " << s.invalid_a
+            << " invalid in A, " << s.invalid_b << " invalid in B\n";
+  std::cout << "angle (deg): mean " << fmt("%.4f", s.mean_deg) << "  rms " << fmt("%.4f", s.rms_deg) << "  p95 "
+            << fmt("%.4f", s.p95_deg) << "  p99 " << fmt("%.4f", s.p99_deg) << "  max " << fmt("%.4f", s.max_deg);
   if (s.worst_x >= 0) std::cout << " at texel (" << s.worst_x << ", " << s.worst_y << ")";
-  std::cout << "\nover 1 deg: " << fmt("%.3f", 100 * s.over_1deg) << "%  over 5 deg: "
-            << fmt("%.3f", 100 * s.over_5deg) << "%\n";
+  std::cout << "\nover 1 deg: " << fmt("%.3f", 100 * s.over_1deg) << "%  over 5 deg: " << fmt("%.3f", 100 * s.over_5deg) << "%\n";
   const auto& t = o.tolerances;
-  std::cout << "tolerances: mean <= " << t.max_mean_deg << ", p99 <= " << t.max_p99_deg << ", max <= "
-            << t.max_deg << ": " << (s.within ? "within" : "OUTSIDE") << "\n";
+  std::cout << "tolerances: mean <= " << t.max_mean_deg << ", p99 <= " << t.max_p99_deg << ", max <= " << t.max_deg << ": "
+            << (s.within ? "within" : "OUTSIDE") << "\n";
 }
 
-nlohmann::json to_json(const std::string& a, const std::string& b, const DiffStats& s,
-                       const nmbake::diff::DiffOptions& o, const std::string& mask, const std::string& resample) {
+nlohmann::json to_json(const std::string& a, const std::string& b, const DiffStats& s, const nmbake::diff::DiffOptions& o,
+                       const std::string& mask, const std::string& resample) {
   nlohmann::json j;
   j["a"] = a;
   j["b"] = b;
@@ -72,14 +70,11 @@ nlohmann::json to_json(const std::string& a, const std::string& b, const DiffSta
   j["over_1deg"] = s.over_1deg;
   j["over_5deg"] = s.over_5deg;
   j["texels_compared"] = s.texels_compared;
-  j["worst"] = s.worst_x >= 0 ? nlohmann::json{{"x", s.worst_x}, {"y", s.worst_y}, {"deg", s.max_deg}}
-                              : nlohmann::json(nullptr);
+  j["worst"] = s.worst_x >= 0 ? nlohmann::json{{"x", s.worst_x}, {"y", s.worst_y}, {"deg", s.max_deg}} : nlohmann::json(nullptr);
   j["within"] = s.within;
-  j["tolerances"] = {{"max_mean_deg", o.tolerances.max_mean_deg},
-                     {"max_p99_deg", o.tolerances.max_p99_deg},
-                     {"max_deg", o.tolerances.max_deg}};
-  j["skipped"] = {{"mask", s.skipped_mask}, {"alpha", s.skipped_alpha}, {"invalid_a", s.invalid_a},
-                  {"invalid_b", s.invalid_b}};
+  j["tolerances"] = {
+      {"max_mean_deg", o.tolerances.max_mean_deg}, {"max_p99_deg", o.tolerances.max_p99_deg}, {"max_deg", o.tolerances.max_deg}};
+  j["skipped"] = {{"mask", s.skipped_mask}, {"alpha", s.skipped_alpha}, {"invalid_a", s.invalid_a}, {"invalid_b", s.invalid_b}};
   j["padding_compared"] = s.padding_compared;
   j["green_a"] = o.green_a == nmbake::diff::GreenAxis::up ? "up" : "down";
   j["green_b"] = o.green_b == nmbake::diff::GreenAxis::up ? "up" : "down";
@@ -171,8 +166,9 @@ void apply_choices(CommandLine& cl) {
 // Parses the command line into `cl`. Returns the exit status when nmdiff is to stop there (after
 // --help, or with the error printed), nothing when it is to go on.
 std::optional<int> parse_command_line(int argc, char** argv, CommandLine& cl) {
-  CLI::App app{"nmdiff: compare two tangent-space normal maps by the angle between their normals.\n"
-               "Texels decode as n = normalize(rgb * 2 - 1); the angle is reported in degrees."};
+  CLI::App app{
+      "nmdiff: compare two tangent-space normal maps by the angle between their normals.\n"
+      "Texels decode as n = normalize(rgb * 2 - 1); the angle is reported in degrees."};
   add_arguments(app, cl);
 
   try {
@@ -205,9 +201,9 @@ Comparison compare_files(CommandLine& cl) {
   diff::check_normal_map(b, path_b);
   c.resized = a.width != b.width || a.height != b.height;
   if (c.resized && options.resample == diff::Resample::none)
-    throw nmbake::InputError("sizes differ: " + path_a + " is " + std::to_string(a.width) + "x" +
-                             std::to_string(a.height) + ", " + path_b + " is " + std::to_string(b.width) +
-                             "x" + std::to_string(b.height) + " (use --resample nearest|bilinear|box)");
+    throw nmbake::InputError("sizes differ: " + path_a + " is " + std::to_string(a.width) + "x" + std::to_string(a.height) +
+                             ", " + path_b + " is " + std::to_string(b.width) + "x" + std::to_string(b.height) +
+                             " (use --resample nearest|bilinear|box)");
   if (!cl.mask_path.empty()) {
     nmbake::LoadOptions load;
     load.require_uvs = true;
@@ -224,8 +220,9 @@ void write_heatmap(const CommandLine& cl, const Comparison& c) {
   nmbake::WriteOptions out;
   out.metadata = {{"nmdiff:scale_min_deg", "0"},
                   {"nmdiff:scale_max_deg", fmt("%.6g", scale)},
-                  {"nmdiff:legend", "bar under the map: 0 deg at the left, scale_max_deg at the right; "
-                                    "dark grey texels were not compared"},
+                  {"nmdiff:legend",
+                   "bar under the map: 0 deg at the left, scale_max_deg at the right; "
+                   "dark grey texels were not compared"},
                   {"nmdiff:a", cl.path_a},
                   {"nmdiff:b", cl.path_b}};
   nmbake::write_image(cl.heatmap_path, diff::render_heatmap(c.field, scale), out);

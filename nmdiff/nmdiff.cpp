@@ -36,8 +36,8 @@ double percentile(std::vector<float>& values, double p) {
 
 // Mean difference over the compared texels when B's channels are reinterpreted by `remap`.
 template <typename Remap>
-double mean_with_b_as(const Image& a, const Image& b, const DiffOptions& options,
-                      const std::vector<std::uint8_t>& compared, Remap remap) {
+double mean_with_b_as(const Image& a, const Image& b, const DiffOptions& options, const std::vector<std::uint8_t>& compared,
+                      Remap remap) {
   double sum = 0.0;
   std::size_t n = 0;
   for (std::size_t i = 0; i < compared.size(); ++i) {
@@ -45,9 +45,7 @@ double mean_with_b_as(const Image& a, const Image& b, const DiffOptions& options
     float rgb[3];
     remap(&b.pixels[i * b.channels], rgb);
     double na[3], nb[3];
-    if (!decode_normal(&a.pixels[i * a.channels], options.green_a, na) ||
-        !decode_normal(rgb, options.green_b, nb))
-      continue;
+    if (!decode_normal(&a.pixels[i * a.channels], options.green_a, na) || !decode_normal(rgb, options.green_b, nb)) continue;
     sum += angle_deg(na, nb);
     ++n;
   }
@@ -63,11 +61,8 @@ std::string deg_text(double v) {
 }  // namespace
 
 void check_normal_map(const Image& map, const std::string& name) {
-  if (map.width <= 0 || map.height <= 0 || map.pixels.empty())
-    throw InputError(name + ": empty image");
-  if (map.channels < 3)
-    throw InputError(name + ": has " + std::to_string(map.channels) +
-                     " channel(s); a normal map needs RGB");
+  if (map.width <= 0 || map.height <= 0 || map.pixels.empty()) throw InputError(name + ": empty image");
+  if (map.channels < 3) throw InputError(name + ": has " + std::to_string(map.channels) + " channel(s); a normal map needs RGB");
   assert(map.pixels.size() == static_cast<std::size_t>(map.width) * map.height * map.channels);
 }
 
@@ -80,8 +75,7 @@ bool decode_normal(const float* rgb, GreenAxis green, double n[3]) {
 Image resample_image(const Image& src, int width, int height, Resample mode) {
   if (src.width == width && src.height == height) return src;
   if (mode == Resample::none)
-    throw InputError("sizes differ: " + size_text(src) + " vs " + std::to_string(width) + "x" +
-                     std::to_string(height));
+    throw InputError("sizes differ: " + size_text(src) + " vs " + std::to_string(width) + "x" + std::to_string(height));
   const int c = src.channels;
   Image out(width, height, c);
   const double sx = double(src.width) / width, sy = double(src.height) / height;
@@ -127,21 +121,18 @@ std::vector<std::uint8_t> uv_layout_mask(const Mesh& low, int width, int height)
   return mask;
 }
 
-DiffStats compare_normal_maps(const Image& a, const Image& b_in, const DiffOptions& options,
-                              AngleField* field) {
+DiffStats compare_normal_maps(const Image& a, const Image& b_in, const DiffOptions& options, AngleField* field) {
   check_normal_map(a, "map A");
   check_normal_map(b_in, "map B");
   if ((a.width != b_in.width || a.height != b_in.height) && options.resample == Resample::none)
-    throw InputError("sizes differ: " + size_text(a) + " vs " + size_text(b_in) +
-                     " (use --resample nearest|bilinear|box)");
-  const Image resampled = (a.width != b_in.width || a.height != b_in.height)
-                              ? resample_image(b_in, a.width, a.height, options.resample)
-                              : Image();
+    throw InputError("sizes differ: " + size_text(a) + " vs " + size_text(b_in) + " (use --resample nearest|bilinear|box)");
+  const Image resampled =
+      (a.width != b_in.width || a.height != b_in.height) ? resample_image(b_in, a.width, a.height, options.resample) : Image();
   const Image& b = resampled.pixels.empty() ? b_in : resampled;
   const std::size_t texels = static_cast<std::size_t>(a.width) * a.height;
   if (!options.mask.empty() && options.mask.size() != texels)
-    throw InputError("mask has " + std::to_string(options.mask.size()) + " texels, the map " +
-                     size_text(a) + " has " + std::to_string(texels));
+    throw InputError("mask has " + std::to_string(options.mask.size()) + " texels, the map " + size_text(a) + " has " +
+                     std::to_string(texels));
 
   DiffStats s;
   s.width = a.width;
@@ -209,28 +200,25 @@ DiffStats compare_normal_maps(const Image& a, const Image& b_in, const DiffOptio
     s.p99_deg = percentile(angles, 0.99);
   }
   const Tolerances& t = options.tolerances;
-  s.within = s.texels_compared > 0 && s.mean_deg <= t.max_mean_deg && s.p99_deg <= t.max_p99_deg &&
-             s.max_deg <= t.max_deg;
+  s.within = s.texels_compared > 0 && s.mean_deg <= t.max_mean_deg && s.p99_deg <= t.max_p99_deg && s.max_deg <= t.max_deg;
   if (s.texels_compared == 0) s.warnings.push_back("no texels compared: nothing is within tolerance");
   if (s.invalid_a + s.invalid_b > 0)
     s.warnings.push_back(std::to_string(s.invalid_a + s.invalid_b) +
-                         " texel(s) decode to a zero vector and were not compared (A: " +
-                         std::to_string(s.invalid_a) + ", B: " + std::to_string(s.invalid_b) + ")");
+                         " texel(s) decode to a zero vector and were not compared (A: " + std::to_string(s.invalid_a) +
+                         ", B: " + std::to_string(s.invalid_b) + ")");
 
   // Common mistakes: the maps agree far better once B's green is flipped or R and G are swapped.
   if (options.detect_convention_mistakes && !s.within && s.texels_compared > 0) {
-    const double flipped = mean_with_b_as(a, b, options, compared, [](const float* p, float* q) {
-      q[0] = p[0], q[1] = 1.0f - p[1], q[2] = p[2];
-    });
-    const double swapped = mean_with_b_as(a, b, options, compared, [](const float* p, float* q) {
-      q[0] = p[1], q[1] = p[0], q[2] = p[2];
-    });
+    const double flipped =
+        mean_with_b_as(a, b, options, compared, [](const float* p, float* q) { q[0] = p[0], q[1] = 1.0f - p[1], q[2] = p[2]; });
+    const double swapped =
+        mean_with_b_as(a, b, options, compared, [](const float* p, float* q) { q[0] = p[1], q[1] = p[0], q[2] = p[2]; });
     // A quarter of the difference left is "far better"; the flipped/swapped map need not match
     // exactly (the two maps may also differ by rounding or a different bake).
     const double far_better = 0.25 * s.mean_deg;
     if (flipped < far_better && flipped <= swapped)
-      s.warnings.push_back("the maps look like they differ by a green flip (mean " + deg_text(s.mean_deg) +
-                           " deg as given, " + deg_text(flipped) +
+      s.warnings.push_back("the maps look like they differ by a green flip (mean " + deg_text(s.mean_deg) + " deg as given, " +
+                           deg_text(flipped) +
                            " deg with B's green flipped): check --green-a/--green-b (up = OpenGL Y+, "
                            "down = DirectX Y-)");
     else if (swapped < far_better)
@@ -242,8 +230,8 @@ DiffStats compare_normal_maps(const Image& a, const Image& b_in, const DiffOptio
 
 std::string summary_line(const DiffStats& s) {
   char buf[160];
-  std::snprintf(buf, sizeof buf, "mean=%.4f p99=%.4f max=%.4f texels=%zu within=%d", s.mean_deg, s.p99_deg,
-                s.max_deg, s.texels_compared, s.within ? 1 : 0);
+  std::snprintf(buf, sizeof buf, "mean=%.4f p99=%.4f max=%.4f texels=%zu within=%d", s.mean_deg, s.p99_deg, s.max_deg,
+                s.texels_compared, s.within ? 1 : 0);
   return buf;
 }
 

@@ -44,23 +44,23 @@ struct DiffOptions {
   bool use_alpha = true;              // a 4th channel is coverage: alpha < 0.5 is not compared
   bool include_padding = false;       // compare texels outside the mask and alpha coverage too
   Resample resample = Resample::none;
-  Tolerances tolerances;              // decides DiffStats::within
+  Tolerances tolerances;                   // decides DiffStats::within
   bool detect_convention_mistakes = true;  // warn about a green flip or R/G swap between the maps
 };
 
 struct DiffStats {
-  int width = 0, height = 0;          // the compared grid (map A's size)
+  int width = 0, height = 0;  // the compared grid (map A's size)
   std::size_t texels_compared = 0;
   double mean_deg = 0, rms_deg = 0, p95_deg = 0, p99_deg = 0, max_deg = 0;  // 0 when none compared
   double over_1deg = 0, over_5deg = 0;  // fraction of compared texels with a difference > 1 / > 5 deg
-  int worst_x = -1, worst_y = -1;     // first texel (row-major) with the largest difference; -1: none
+  int worst_x = -1, worst_y = -1;       // first texel (row-major) with the largest difference; -1: none
 
   // Texels not compared, by the first reason that applies.
-  std::size_t skipped_mask = 0;       // outside the mask
-  std::size_t skipped_alpha = 0;      // alpha < 0.5 in A or B
-  std::size_t invalid_a = 0;          // A decodes to a zero or non-finite vector
-  std::size_t invalid_b = 0;          // B decodes to a zero or non-finite vector (A valid)
-  std::size_t padding_compared = 0;   // compared only because of include_padding
+  std::size_t skipped_mask = 0;      // outside the mask
+  std::size_t skipped_alpha = 0;     // alpha < 0.5 in A or B
+  std::size_t invalid_a = 0;         // A decodes to a zero or non-finite vector
+  std::size_t invalid_b = 0;         // B decodes to a zero or non-finite vector (A valid)
+  std::size_t padding_compared = 0;  // compared only because of include_padding
 
   bool within = false;                // all three tolerances met and at least one texel compared
   std::vector<std::string> warnings;  // one line each, e.g. a likely green flip
@@ -89,8 +89,7 @@ std::vector<std::uint8_t> uv_layout_mask(const Mesh& low, int width, int height)
 // Compares A (e.g. a fresh bake) with B (e.g. the golden map). Throws InputError when a map is
 // unusable, the sizes differ without a resample mode, or the mask has the wrong size.
 // `field` (optional) receives the per-texel differences for a heatmap.
-DiffStats compare_normal_maps(const Image& a, const Image& b, const DiffOptions& options = {},
-                              AngleField* field = nullptr);
+DiffStats compare_normal_maps(const Image& a, const Image& b, const DiffOptions& options = {}, AngleField* field = nullptr);
 
 // One-line summary "mean=<deg> p99=<deg> max=<deg> texels=<n> within=<0|1>".
 std::string summary_line(const DiffStats& stats);

@@ -13,8 +13,7 @@ namespace nmbake::raycast {
 namespace {
 
 void throw_on_error(void* /*user*/, RTCError code, const char* message) {
-  throw std::runtime_error(std::string("embree: error ") + std::to_string(int(code)) + ": " +
-                           (message ? message : ""));
+  throw std::runtime_error(std::string("embree: error ") + std::to_string(int(code)) + ": " + (message ? message : ""));
 }
 
 RTCBuildQuality to_embree(BuildQuality q) {
@@ -28,8 +27,8 @@ RTCBuildQuality to_embree(BuildQuality q) {
 // Embree reports errors through the callback; after a failed call the callback has already thrown,
 // but device creation happens before any callback exists, so check it by hand.
 void check_device(RTCDevice device) {
-  if (!device) throw std::runtime_error("embree: cannot create a device (error " +
-                                        std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
+  if (!device)
+    throw std::runtime_error("embree: cannot create a device (error " + std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
 }
 
 // One ray for rtcIntersect1, with no hit yet; its id (a packet lane for the filter) is 0.
@@ -196,8 +195,8 @@ struct Scene::Impl {
   }
 };
 
-Scene::Scene(const float* positions, std::size_t vertex_count, const std::uint32_t* indices,
-             std::size_t triangle_count, BuildQuality quality, int threads)
+Scene::Scene(const float* positions, std::size_t vertex_count, const std::uint32_t* indices, std::size_t triangle_count,
+             BuildQuality quality, int threads)
     : impl_(std::make_unique<Impl>()) {
   std::string config = threads > 0 ? "threads=" + std::to_string(threads) : std::string();
   impl_->device = rtcNewDevice(config.empty() ? nullptr : config.c_str());
@@ -214,11 +213,11 @@ Scene::Scene(const float* positions, std::size_t vertex_count, const std::uint32
   RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
   rtcSetGeometryBuildQuality(geom, to_embree(quality));
   // Embree reads vertices with 16-byte loads: its own buffers carry the padding it needs.
-  auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                         3 * sizeof(float), vertex_count));
+  auto* vb = static_cast<float*>(
+      rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), vertex_count));
   std::memcpy(vb, positions, vertex_count * 3 * sizeof(float));
-  auto* ib = static_cast<std::uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                 3 * sizeof(std::uint32_t), triangle_count));
+  auto* ib = static_cast<std::uint32_t*>(
+      rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(std::uint32_t), triangle_count));
   std::memcpy(ib, indices, triangle_count * 3 * sizeof(std::uint32_t));
   rtcCommitGeometry(geom);
   rtcAttachGeometry(impl_->scene, geom);
@@ -245,7 +244,8 @@ Hit Scene::intersect(const Ray& ray) const {
   return h;
 }
 
-Hit Scene::intersect(const Ray& ray, const HitRule& rule, bool outward, std::uint8_t* flags, float prefer_lo, float prefer_hi) const {
+Hit Scene::intersect(const Ray& ray, const HitRule& rule, bool outward, std::uint8_t* flags, float prefer_lo,
+                     float prefer_hi) const {
   RuleContext rc(&rule);
   rc.reset_lanes();
   rc.outward[0] = outward;

@@ -92,8 +92,8 @@ inline std::int8_t facing_code(int sign, double lean) {
 
 // HitBatch::flags bits.
 enum HitFlags : std::uint8_t {
-  hit_passed_backface = 1,   // the first surface along the ray was a back face, passed over
-  hit_normal_disagrees = 2,  // the hit taken is one whose normal points away (no other was found)
+  hit_passed_backface = 1,    // the first surface along the ray was a back face, passed over
+  hit_normal_disagrees = 2,   // the hit taken is one whose normal points away (no other was found)
   hit_outside_preferred = 4,  // the hit taken lies outside the ray's preferred part (none inside)
 };
 
@@ -139,9 +139,8 @@ enum class BuildQuality { low, medium, high };
 class Scene {
  public:
   // positions: vertex_count xyz triples; indices: triangle_count index triples.
-  Scene(const float* positions, std::size_t vertex_count, const std::uint32_t* indices,
-        std::size_t triangle_count, BuildQuality quality = BuildQuality::medium,
-        int threads = 0 /* 0 = all cores */);
+  Scene(const float* positions, std::size_t vertex_count, const std::uint32_t* indices, std::size_t triangle_count,
+        BuildQuality quality = BuildQuality::medium, int threads = 0 /* 0 = all cores */);
   ~Scene();
   Scene(const Scene&) = delete;
   Scene& operator=(const Scene&) = delete;

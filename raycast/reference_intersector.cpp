@@ -6,20 +6,17 @@
 
 namespace nmbake::raycast {
 
-ReferenceIntersector::ReferenceIntersector(const float* positions, std::size_t vertex_count,
-                                           const std::uint32_t* indices, std::size_t triangle_count)
+ReferenceIntersector::ReferenceIntersector(const float* positions, std::size_t vertex_count, const std::uint32_t* indices,
+                                           std::size_t triangle_count)
     : positions_(positions), vertex_count_(vertex_count), indices_(indices), triangle_count_(triangle_count) {}
 
 Hit ReferenceIntersector::intersect(const Ray& ray) const {
   const glm::dvec3 o(ray.origin), d(ray.direction);
   Hit best;
   double best_t = ray.tfar;
-  auto vertex = [&](std::uint32_t i) {
-    return glm::dvec3(positions_[3 * i], positions_[3 * i + 1], positions_[3 * i + 2]);
-  };
+  auto vertex = [&](std::uint32_t i) { return glm::dvec3(positions_[3 * i], positions_[3 * i + 1], positions_[3 * i + 2]); };
   for (std::size_t t = 0; t < triangle_count_; ++t) {
-    const glm::dvec3 p0 = vertex(indices_[3 * t]), p1 = vertex(indices_[3 * t + 1]),
-                     p2 = vertex(indices_[3 * t + 2]);
+    const glm::dvec3 p0 = vertex(indices_[3 * t]), p1 = vertex(indices_[3 * t + 1]), p2 = vertex(indices_[3 * t + 2]);
     const glm::dvec3 e1 = p1 - p0, e2 = p2 - p0;
     const glm::dvec3 pv = glm::cross(d, e2);
     const double det = glm::dot(e1, pv);

@@ -13,7 +13,7 @@
 #include "test_support.h"
 
 // Skips the test when ../shared/data is absent.
-#define SKIP_WITHOUT_SHARED_DATA()                                      \
+#define SKIP_WITHOUT_SHARED_DATA()                                         \
   if (!::nmbake::test::exists(::nmbake::test::shared_data_path("meshes"))) \
   GTEST_SKIP() << "../shared/data is absent (" << ::nmbake::test::shared_data_path("meshes") << "); skipping"
 
@@ -36,8 +36,7 @@ inline void expect_error(const std::string& path, std::initializer_list<const ch
   std::string message = load_error(path, options);
   EXPECT_NE(message.find(file_name(path)), std::string::npos) << message;
   EXPECT_EQ(message.find('\n'), std::string::npos) << "not one line: " << message;
-  for (const char* word : words)
-    EXPECT_NE(message.find(word), std::string::npos) << "'" << word << "' not in: " << message;
+  for (const char* word : words) EXPECT_NE(message.find(word), std::string::npos) << "'" << word << "' not in: " << message;
 }
 
 inline void write_file(const std::string& path, const std::string& bytes) { std::ofstream(path, std::ios::binary) << bytes; }

@@ -55,7 +55,8 @@ inline bool all_finite(const Image& img) {
 
 // The high-poly's interpolated normal where the ray from `origin` along `dir` first meets it.
 struct HighProbe {
-  explicit HighProbe(const Mesh& m) : mesh(m), pos(m.positions), scene(&pos[0].x, pos.size(), m.position_index.data(), m.triangle_count()) {}
+  explicit HighProbe(const Mesh& m)
+      : mesh(m), pos(m.positions), scene(&pos[0].x, pos.size(), m.position_index.data(), m.triangle_count()) {}
   bool normal_at(const glm::dvec3& origin, const glm::dvec3& dir, float reach, glm::dvec3& n) const {
     const raycast::Hit h = scene.intersect({glm::vec3(origin), 0.0f, glm::vec3(dir), reach});
     if (!h.hit()) return false;

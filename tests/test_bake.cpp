@@ -11,9 +11,9 @@
 #include "test_support.h"
 
 using namespace nmbake;
+using procedural::make_sphere;
 using test::angle_deg;
 using test::decode_rgb;
-using procedural::make_sphere;
 
 namespace {
 
@@ -186,7 +186,8 @@ TEST(Bake, DisplacedSphereMatchesAnalyticNormal) {
   auto unit = [](double th, double ph) {
     return glm::dvec3(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th));
   };
-  const Mesh low = make_sphere(48, 24, [](double, double) { return 1.0; }, unit);
+  const Mesh low = make_sphere(
+      48, 24, [](double, double) { return 1.0; }, unit);
   const Mesh high = make_sphere(768, 384, radius, normal);
   BakeOptions o = options(512);
   o.height = 256;
@@ -234,7 +235,8 @@ TEST(Bake, MirroredUVHalvesDecodeToMirroredNormals) {
     return glm::normalize(glm::dvec3(-hx, -hy, 1.0));
   };
   const Mesh high = test::make_height_field(256, 256, hf, hf_n);
-  Mesh low = test::make_height_field(16, 16, base, [](double x, double) { return glm::normalize(glm::dvec3(0.4 * x, 0.0, 1.0)); });
+  Mesh low =
+      test::make_height_field(16, 16, base, [](double x, double) { return glm::normalize(glm::dvec3(0.4 * x, 0.0, 1.0)); });
   for (std::size_t i = 0; i < low.positions.size(); ++i) low.uvs[i].x = 1.0f - std::abs(low.positions[i].x);
   // Left half first: reorder triangles so every x < 0 triangle precedes the right half's.
   Mesh sorted = low;
@@ -267,7 +269,8 @@ TEST(Bake, MirroredUVHalvesDecodeToMirroredNormals) {
         const int side = t < half ? 0 : 1;
         if (found[side]) continue;
         double b[3];
-        const TexelTriangle tri = setup_texel_triangle(sorted.corner_uv(t, 0), sorted.corner_uv(t, 1), sorted.corner_uv(t, 2), 128, 128);
+        const TexelTriangle tri =
+            setup_texel_triangle(sorted.corner_uv(t, 0), sorted.corner_uv(t, 1), sorted.corner_uv(t, 2), 128, 128);
         if (!covers(tri, sample_point(x, y, 0.5, 0.5), b)) continue;
         decoded[side] = decode_tangent_normal(interpolate_frame(frames, t, b), decode_rgb(r.map.at(x, y)));
         found[side] = true;

@@ -135,7 +135,8 @@ TEST(CageCli, SaveCageOntoTheLowPolyIsRefused) {
     const CliRun r = run_nmbake(bake_args(c.low_arg) + " --save-cage " + c.save, "", dir);
     EXPECT_EQ(r.code, 1);
     EXPECT_TRUE(is_one_error_line(r.err)) << r.err;
-    EXPECT_TRUE(contains(r.err, "error: --save-cage " + c.save + " is the same file as " + c.low_arg + "; nothing written")) << r.err;
+    EXPECT_TRUE(contains(r.err, "error: --save-cage " + c.save + " is the same file as " + c.low_arg + "; nothing written"))
+        << r.err;
     EXPECT_TRUE(read_bytes(low) == before) << low << " was changed";
     EXPECT_TRUE(std::filesystem::is_symlink(dir + "/link.obj"));
     EXPECT_FALSE(test::exists(dir + "/out.png"));
@@ -153,7 +154,8 @@ TEST(CageCli, SaveCageWithoutAnAutomaticCageOrAsNonObjIsRefused) {
     const CliRun r = run_nmbake(bake_args_sample() + " --save-cage x.obj " + extra, "", dir);
     EXPECT_EQ(r.code, 1);
     EXPECT_TRUE(is_one_error_line(r.err)) << r.err;
-    EXPECT_TRUE(contains(r.err, "error: --save-cage writes the automatic cage, which is made only without --cage, --front and --rear"))
+    EXPECT_TRUE(
+        contains(r.err, "error: --save-cage writes the automatic cage, which is made only without --cage, --front and --rear"))
         << r.err;
     EXPECT_FALSE(test::exists(dir + "/x.obj"));
     EXPECT_FALSE(test::exists(dir + "/out.png"));

@@ -20,8 +20,7 @@ std::vector<std::uint32_t> iota_indices(std::size_t n) {
 // `a` with the triangles of `mesh` moved by `offset` appended (positions, normals, UVs).
 Mesh joined(const Mesh& a, const Mesh& mesh, const glm::vec3& offset) {
   Mesh m = a;
-  const auto np = std::uint32_t(a.positions.size()), nn = std::uint32_t(a.normals.size()),
-             nt = std::uint32_t(a.uvs.size());
+  const auto np = std::uint32_t(a.positions.size()), nn = std::uint32_t(a.normals.size()), nt = std::uint32_t(a.uvs.size());
   for (const glm::vec3& p : mesh.positions) m.positions.push_back(p + offset);
   m.normals.insert(m.normals.end(), mesh.normals.begin(), mesh.normals.end());
   m.uvs.insert(m.uvs.end(), mesh.uvs.begin(), mesh.uvs.end());

@@ -32,7 +32,8 @@ Mesh aliasing_height_field() {
   return test::make_height_field(
       504, 504, [&](double x, double y) { return a * std::sin(w * x) * std::sin(w * y); },
       [&](double x, double y) {
-        return glm::normalize(glm::dvec3(-a * w * std::cos(w * x) * std::sin(w * y), -a * w * std::sin(w * x) * std::cos(w * y), 1.0));
+        return glm::normalize(
+            glm::dvec3(-a * w * std::cos(w * x) * std::sin(w * y), -a * w * std::sin(w * x) * std::cos(w * y), 1.0));
       });
 }
 
@@ -96,8 +97,10 @@ TEST(ErrorEstimate, AliasedBakeEstimateIsCloseToTheTrueError) {
   const double p95 = err[std::size_t(0.95 * double(err.size() - 1) + 0.5)];
 
   const ErrorEstimate e = estimate_bake_error(low, high, nullptr, o, r);
-  std::printf("aliased 128^2, 1 sample: true mean %.3f p95 %.3f max %.3f deg; estimate mean %.3f p95 %.3f max %.3f deg on %zu texels, %.3f s\n",
-              mean, p95, err.back(), e.mean_deg, e.p95_deg, e.max_deg, e.texels, e.seconds);
+  std::printf(
+      "aliased 128^2, 1 sample: true mean %.3f p95 %.3f max %.3f deg; estimate mean %.3f p95 %.3f max %.3f deg on %zu texels, "
+      "%.3f s\n",
+      mean, p95, err.back(), e.mean_deg, e.p95_deg, e.max_deg, e.texels, e.seconds);
   EXPECT_EQ(e.texels, 4096u);  // a quarter of the map
   EXPECT_GT(mean, 1.0);
   EXPECT_NEAR(e.mean_deg, mean, 0.05 * mean);

@@ -43,8 +43,8 @@ void check_golden(const std::string& name, const BakeOptions& options) {
   if (!s.within) {
     const std::string heat = fresh + ".diff.png";
     write_image(heat, diff::render_heatmap(field, diff::auto_heatmap_scale(s, d.tolerances)));
-    ADD_FAILURE() << name << " differs from " << golden << ": " << diff::summary_line(s) << "; worst texel (" << s.worst_x
-                  << "," << s.worst_y << "); heatmap " << heat << "; fresh bake " << fresh;
+    ADD_FAILURE() << name << " differs from " << golden << ": " << diff::summary_line(s) << "; worst texel (" << s.worst_x << ","
+                  << s.worst_y << "); heatmap " << heat << "; fresh bake " << fresh;
   }
 }
 

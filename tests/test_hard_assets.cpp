@@ -107,7 +107,9 @@ double min_distance(const std::vector<glm::dvec3>& a, const std::vector<glm::dve
   auto cell = [reach](const glm::dvec3& p) {
     return std::array<long, 3>{long(std::floor(p.x / reach)), long(std::floor(p.y / reach)), long(std::floor(p.z / reach))};
   };
-  auto key = [](long x, long y, long z) { return (std::uint64_t(x & 0x1fffff) << 42) | (std::uint64_t(y & 0x1fffff) << 21) | std::uint64_t(z & 0x1fffff); };
+  auto key = [](long x, long y, long z) {
+    return (std::uint64_t(x & 0x1fffff) << 42) | (std::uint64_t(y & 0x1fffff) << 21) | std::uint64_t(z & 0x1fffff);
+  };
   std::unordered_map<std::uint64_t, std::vector<std::size_t>> grid;
   for (std::size_t i = 0; i < b.size(); ++i) {
     const auto c = cell(b[i]);
@@ -132,8 +134,13 @@ double min_distance(const std::vector<glm::dvec3>& a, const std::vector<glm::dve
 TEST(HardAssets, SetHasTheSevenCasesWithConsistentArrays) {
   const auto& set = assets();
   ASSERT_EQ(set.size(), 7u);
-  const char* names[] = {"close_tubes_gap0.012_bulge0.04", "close_tubes_gap0.004_bulge0.04", "close_tubes_gap0.012_bulge0.14",
-                         "thin_shell_t0.01", "cavity_gap0.01", "bevelled_box_h0.3_b0.03", "thin_shell_t0.01_flipped_no_normals"};
+  const char* names[] = {"close_tubes_gap0.012_bulge0.04",
+                         "close_tubes_gap0.004_bulge0.04",
+                         "close_tubes_gap0.012_bulge0.14",
+                         "thin_shell_t0.01",
+                         "cavity_gap0.01",
+                         "bevelled_box_h0.3_b0.03",
+                         "thin_shell_t0.01_flipped_no_normals"};
   for (std::size_t i = 0; i < set.size(); ++i) {
     const HardAsset& a = set[i];
     SCOPED_TRACE(a.name);
@@ -204,8 +211,8 @@ TEST(HardAssets, HighNormalsAreUnitAndFollowTheFaces) {
       worst_mean = std::max(worst_mean, e);
       sum_mean += e;
     }
-    std::printf("%-40s high normal to faces: max %.2f deg; to their mean: mean %.3f deg, max %.2f deg\n", a.name.c_str(),
-                worst, sum_mean / double(around.size()), worst_mean);
+    std::printf("%-40s high normal to faces: max %.2f deg; to their mean: mean %.3f deg, max %.2f deg\n", a.name.c_str(), worst,
+                sum_mean / double(around.size()), worst_mean);
     EXPECT_LT(worst_mean, 3.0) << a.name;
     EXPECT_LT(sum_mean / double(around.size()), 0.3) << a.name;
   }
@@ -279,7 +286,8 @@ TEST(HardAssets, LowUVsAreIslandsInsideTheUnitSquare) {
 TEST(HardAssets, LowPolyIsWithinMaxSOfTheHighPoly) {
   // Points inside the low triangles (not the corners: at the box's corners the face-normal line
   // misses the rounded high-poly by design) along the interpolated normal, as the bake casts.
-  const std::array<glm::dvec3, 4> bary = {glm::dvec3(1.0 / 3, 1.0 / 3, 1.0 / 3), {0.8, 0.1, 0.1}, {0.1, 0.8, 0.1}, {0.1, 0.1, 0.8}};
+  const std::array<glm::dvec3, 4> bary = {
+      glm::dvec3(1.0 / 3, 1.0 / 3, 1.0 / 3), {0.8, 0.1, 0.1}, {0.1, 0.8, 0.1}, {0.1, 0.1, 0.8}};
   for (const HardAsset& a : assets()) {
     const int parts = part_count(a);
     std::size_t samples = 0, own = 0, other = 0;

@@ -111,8 +111,7 @@ TEST(ImageIo, EveryIntegerCodeRoundTripsExactly) {
     std::string name;
     int bits, levels;
   };
-  for (const Case& c : {Case{"c8.png", 8, 256}, Case{"c16.png", 16, 65536}, Case{"c8.tif", 8, 256},
-                        Case{"c16.tif", 16, 65536}}) {
+  for (const Case& c : {Case{"c8.png", 8, 256}, Case{"c16.png", 16, 65536}, Case{"c8.tif", 8, 256}, Case{"c16.tif", 16, 65536}}) {
     Image img = code_ramp(c.levels);
     nmbake::write_image(dir + "/" + c.name, img, {c.bits, {}});
     Image back = nmbake::read_image(dir + "/" + c.name);
@@ -275,8 +274,8 @@ TEST(ImageIo, UnreadableFilesAreInputErrors) {
   spit(dir + "/text.png", "this is not a picture\n");
   spit(dir + "/empty.png", "");
   fs::create_directory(dir + "/folder.png");
-  for (const std::string name : {"missing.png", "folder.png", "text.png", "empty.png", "truncated.png",
-                                 "truncated.tif", "truncated.exr"}) {
+  for (const std::string name :
+       {"missing.png", "folder.png", "text.png", "empty.png", "truncated.png", "truncated.tif", "truncated.exr"}) {
     const std::string path = dir + "/" + name;
     try {
       nmbake::read_image(path);

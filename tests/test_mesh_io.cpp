@@ -36,8 +36,7 @@ TEST_P(DefectTest, FailsWithMessageNamingFileAndProblem) {
   std::string message = load_error(data_path(std::string("defects/") + d.file), options);
   EXPECT_NE(message.find(d.file), std::string::npos) << message;
   EXPECT_EQ(message.find('\n'), std::string::npos) << message;
-  for (const char* word : d.words)
-    EXPECT_NE(message.find(word), std::string::npos) << "'" << word << "' not in: " << message;
+  for (const char* word : d.words) EXPECT_NE(message.find(word), std::string::npos) << "'" << word << "' not in: " << message;
 }
 
 const Defect kDefects[] = {

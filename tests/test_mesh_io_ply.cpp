@@ -34,8 +34,7 @@ void put_binary(std::string& out, const std::string& type, double v, bool big_en
   auto put = [&](auto value) {
     unsigned char raw[sizeof(value)];
     std::memcpy(raw, &value, sizeof(value));
-    for (std::size_t i = 0; i < sizeof(value); ++i)
-      out.push_back(static_cast<char>(raw[big_endian ? sizeof(value) - 1 - i : i]));
+    for (std::size_t i = 0; i < sizeof(value); ++i) out.push_back(static_cast<char>(raw[big_endian ? sizeof(value) - 1 - i : i]));
   };
   if (type == "char" || type == "int8") return put(static_cast<std::int8_t>(v));
   if (type == "uchar" || type == "uint8") return put(static_cast<std::uint8_t>(v));
@@ -86,8 +85,8 @@ std::string make_ply(const std::string& format, const std::vector<PlyElement>& e
 
 // A quad and a triangle over 5 vertices with normals and UVs, with an unused element and unused
 // scalar and list properties around the used ones.
-std::vector<PlyElement> sample_ply(const std::string& coord_type, const std::string& count_type,
-                                   const std::string& index_type, const char* u = "s", const char* v = "t") {
+std::vector<PlyElement> sample_ply(const std::string& coord_type, const std::string& count_type, const std::string& index_type,
+                                   const char* u = "s", const char* v = "t") {
   PlyElement extra{"material", {{"uchar", "id", ""}, {"float", "weights", "uchar"}}, {}};
   extra.rows = {{{7}, {0.5, 0.25}}, {{8}, {}}};
   PlyElement vertex{"vertex",
@@ -104,8 +103,7 @@ std::vector<PlyElement> sample_ply(const std::string& coord_type, const std::str
                     {}};
   const double p[5][3] = {{0, 0, 0}, {2, 0, 0}, {2, 2, 0}, {0, 2, 0}, {1, 3, -1}};
   for (int i = 0; i < 5; ++i)
-    vertex.rows.push_back(
-        {{p[i][0]}, {200}, {p[i][1]}, {1, 2, 3}, {p[i][2]}, {0}, {0}, {1}, {p[i][0] / 4}, {p[i][1] / 4}});
+    vertex.rows.push_back({{p[i][0]}, {200}, {p[i][1]}, {1, 2, 3}, {p[i][2]}, {0}, {0}, {1}, {p[i][0] / 4}, {p[i][1] / 4}});
   PlyElement face{
       "face", {{"uchar", "flags", ""}, {index_type, "vertex_indices", count_type}, {"float", "quality", "uchar"}}, {}};
   face.rows = {{{1}, {0, 1, 2, 3}, {0.5}}, {{2}, {3, 2, 4}, {}}};
@@ -127,8 +125,7 @@ void expect_sample_mesh(const Mesh& m, const std::string& what) {
 TEST(MeshIo, PlyEveryEncodingAndScalarType) {
   const std::string dir = test::scratch_dir();
   const char* formats[] = {"ascii", "binary_little_endian", "binary_big_endian"};
-  const char* coord_types[] = {"float", "float32", "double", "float64", "char",
-                               "int8",  "short",   "int16",  "int",     "int32"};
+  const char* coord_types[] = {"float", "float32", "double", "float64", "char", "int8", "short", "int16", "int", "int32"};
   const char* count_types[] = {"uchar", "uint8", "char", "ushort", "short", "int", "uint", "uint32"};
   const char* index_types[] = {"int", "int32", "uint", "uint32", "uchar", "uint8", "short", "ushort", "uint16", "char"};
   int n = 0;

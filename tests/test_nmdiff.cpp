@@ -234,8 +234,18 @@ TEST(Nmdiff, UvLayoutMaskUsesTheBakersRasterizer) {
 }
 
 TEST(Nmdiff, AlphaIsCoverage) {
-  Image a = make_map(4, 4, [](int x, int) { return N3{0.1 * x, 0, 1}; }, 4);
-  Image b = make_map(4, 4, [](int x, int) { return N3{x == 3 ? 0.9 : 0.1 * x, 0, 1}; }, 4);
+  Image a = make_map(
+      4, 4,
+      [](int x, int) {
+        return N3{0.1 * x, 0, 1};
+      },
+      4);
+  Image b = make_map(
+      4, 4,
+      [](int x, int) {
+        return N3{x == 3 ? 0.9 : 0.1 * x, 0, 1};
+      },
+      4);
   for (int y = 0; y < 4; ++y) b.at(3, y)[3] = 0.0f;  // column 3 differs but is not covered in B
   diff::DiffOptions o;
   const diff::DiffStats s = diff::compare_normal_maps(a, b, o);

@@ -15,7 +15,8 @@ TEST(Rasterize, SharedEdgesNeitherCrackNorDoubleCount) {
   for (int trial = 0; trial < 50; ++trial) {
     Mesh m;
     // The centre stays well inside the heptagon, so the fan does not fold over itself.
-    const glm::vec2 c = trial % 2 ? glm::vec2(0.5f, 0.5f) : glm::vec2(0.5f + 0.3f * (u(rng) - 0.5f), 0.5f + 0.3f * (u(rng) - 0.5f));
+    const glm::vec2 c =
+        trial % 2 ? glm::vec2(0.5f, 0.5f) : glm::vec2(0.5f + 0.3f * (u(rng) - 0.5f), 0.5f + 0.3f * (u(rng) - 0.5f));
     const int n = 7;
     m.uvs.push_back(c);
     for (int k = 0; k < n; ++k) {

@@ -120,10 +120,8 @@ Mesh two_planes(bool flip_top, float half_x = 1.0f) {
     for (glm::vec2 xy : {glm::vec2(-half_x, -1), glm::vec2(half_x, -1), glm::vec2(half_x, 1), glm::vec2(-half_x, 1)})
       m.positions.push_back({xy, z});
   m.position_index = {0, 1, 2, 0, 2, 3};
-  if (flip_top)
-    m.position_index.insert(m.position_index.end(), {4, 6, 5, 4, 7, 6});
-  else
-    m.position_index.insert(m.position_index.end(), {4, 5, 6, 4, 6, 7});
+  if (flip_top) m.position_index.insert(m.position_index.end(), {4, 6, 5, 4, 7, 6});
+  else m.position_index.insert(m.position_index.end(), {4, 5, 6, 4, 6, 7});
   return m;
 }
 

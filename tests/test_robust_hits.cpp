@@ -36,11 +36,12 @@ BakeOptions options(int size) {
 }
 
 void record(const std::string& name, const Errors& e, const BakeResult& r) {
-  std::printf("measured: %s mean %.4f deg, over 1 deg %.3f%%, over 60 deg %zu, worst %.2f deg, texels %zu, misses %llu, "
-              "backface_skips %llu, front %.4g-%.4g, rear %.4g-%.4g\n",
-              name.c_str(), e.mean_deg, 100.0 * e.over1, e.over60_texels, e.worst_deg, e.texels, (unsigned long long)r.stats.misses,
-              (unsigned long long)r.stats.backface_skips, r.stats.vertex_front.min, r.stats.vertex_front.max, r.stats.vertex_rear.min,
-              r.stats.vertex_rear.max);
+  std::printf(
+      "measured: %s mean %.4f deg, over 1 deg %.3f%%, over 60 deg %zu, worst %.2f deg, texels %zu, misses %llu, "
+      "backface_skips %llu, front %.4g-%.4g, rear %.4g-%.4g\n",
+      name.c_str(), e.mean_deg, 100.0 * e.over1, e.over60_texels, e.worst_deg, e.texels, (unsigned long long)r.stats.misses,
+      (unsigned long long)r.stats.backface_skips, r.stats.vertex_front.min, r.stats.vertex_front.max, r.stats.vertex_rear.min,
+      r.stats.vertex_rear.max);
 }
 
 }  // namespace
@@ -129,8 +130,8 @@ TEST(RobustHits, SuspectTexelsAreCountedAndMasked) {
   o.keep_backfaces = true;
   o.front = o.rear = 0.06f;
   const BakeResult bad = bake_normal_map(a.low, a.high, nullptr, o);
-  std::printf("measured: suspect share default %.4f%%, back faces kept with --front/--rear 0.06 %.2f%%\n", 100.0 * r.stats.suspect_share,
-              100.0 * bad.stats.suspect_share);
+  std::printf("measured: suspect share default %.4f%%, back faces kept with --front/--rear 0.06 %.2f%%\n",
+              100.0 * r.stats.suspect_share, 100.0 * bad.stats.suspect_share);
   EXPECT_LT(r.stats.suspect_share, kSuspectShareWarn);
   EXPECT_GT(bad.stats.suspect_share, 0.05);
   for (const BakeResult* b : {&r, &bad}) {
@@ -215,8 +216,9 @@ TEST(RobustHits, SuspectTexelsAreWarnedAboutAndWrittenByTheCli) {
   test::CliRun bad = test::run_nmbake(files + " --keep-backfaces --front 0.06 --rear 0.06", "", dir);
   ASSERT_EQ(bad.code, 0) << bad.err;
   EXPECT_GT(bad.report["suspect_share"].get<double>(), kSuspectShareWarn);
-  EXPECT_TRUE(test::contains(bad.err, "of covered texels are suspect (normal tilted over 85 degrees from the low-poly's, or samples "
-                                      "disagreeing)"))
+  EXPECT_TRUE(test::contains(bad.err,
+                             "of covered texels are suspect (normal tilted over 85 degrees from the low-poly's, or samples "
+                             "disagreeing)"))
       << bad.err;
   EXPECT_TRUE(test::exists(dir + "/s.png"));
   EXPECT_EQ(bad.report["options"]["suspect_mask"], "s.png");
@@ -269,7 +271,8 @@ TEST(RobustHits, CageStopsBeforeANeighbouringPartsHighPoly) {
     return m;
   };
   auto join = [](Mesh a, const Mesh& b) {
-    const std::uint32_t np = std::uint32_t(a.positions.size()), nt = std::uint32_t(a.uvs.size()), nn = std::uint32_t(a.normals.size());
+    const std::uint32_t np = std::uint32_t(a.positions.size()), nt = std::uint32_t(a.uvs.size()),
+                        nn = std::uint32_t(a.normals.size());
     a.positions.insert(a.positions.end(), b.positions.begin(), b.positions.end());
     a.uvs.insert(a.uvs.end(), b.uvs.begin(), b.uvs.end());
     a.normals.insert(a.normals.end(), b.normals.begin(), b.normals.end());

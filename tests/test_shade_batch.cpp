@@ -40,9 +40,9 @@ TEST(ShadeBatch, BitIdenticalToOneAtATime) {
   std::vector<glm::vec3> high_normals;
   for (int i = 0; i < 3 * 50; ++i) high_normals.push_back(glm::normalize(glm::vec3(uf(rng), uf(rng), 1.0f)));
   for (int c = 0; c < 3; ++c) {
-    high_normals[3 * 7 + c] = glm::vec3(0.0f);      // a zero hit normal: flagged
-    high_normals[3 * 9 + c] *= 1e-13f;              // squared length below 1e-24: flagged
-    high_normals[3 * 11 + c] *= 1e-10f;             // short but above it: encoded at its own length
+    high_normals[3 * 7 + c] = glm::vec3(0.0f);  // a zero hit normal: flagged
+    high_normals[3 * 9 + c] *= 1e-13f;          // squared length below 1e-24: flagged
+    high_normals[3 * 11 + c] *= 1e-10f;         // short but above it: encoded at its own length
   }
   const std::size_t n = 77;  // not a multiple of the lane count
   // The first 30 samples share a triangle (the kernel broadcasts it), the rest mix triangles.

@@ -36,7 +36,8 @@ TEST(Stability, DegenerateUvTrianglesChangeNothing) {
 }
 
 TEST(Stability, DegenerateUvTrianglesAreReportedByTheCli) {
-  const CliRun r = run_nmbake(data("degenerate_uv_low.obj") + " " + data("bumps_high.obj") + " -o out.png --size 64 --report r.json");
+  const CliRun r =
+      run_nmbake(data("degenerate_uv_low.obj") + " " + data("bumps_high.obj") + " -o out.png --size 64 --report r.json");
   ASSERT_EQ(r.code, 0);
   EXPECT_EQ(r.report["degenerate"]["uv_triangles"], 3);
   EXPECT_TRUE(contains(r.err, "warning: " + data("degenerate_uv_low.obj") + ": 3 triangles have zero UV area")) << r.err;
@@ -176,9 +177,8 @@ TEST(Stability, MirroredAndRotatedIslandsDecodeToTheSameWorldNormals) {
     Image q = r.map;
     for (float& c : q.pixels) c = float(double(quantize8(c)) / 255.0);
     std::vector<glm::dvec3> world8(std::size_t(S) * S, glm::dvec3(0.0));
-    test::for_each_decoded_texel(low, q, [&](int x, int y, const glm::dvec3& w, const glm::dvec3&, std::size_t) {
-      world8[std::size_t(y) * S + x] = w;
-    });
+    test::for_each_decoded_texel(
+        low, q, [&](int x, int y, const glm::dvec3& w, const glm::dvec3&, std::size_t) { world8[std::size_t(y) * S + x] = w; });
     double worst = 0.0, worst8 = 0.0;
     std::size_t compared = 0;
     for (int y = 0; y < S; ++y)

@@ -70,10 +70,12 @@ TEST(Stability, TranslatedAndScaledScenesMatchTheOriginal) {
 }
 
 TEST(Stability, FarFromOriginWarnsPastTheFloatLimit) {
-  const CliRun ok = run_nmbake(data("far_1e5_low.obj") + " " + data("far_1e5_high.obj") + " -o out.png --size 64 --report r.json");
+  const CliRun ok =
+      run_nmbake(data("far_1e5_low.obj") + " " + data("far_1e5_high.obj") + " -o out.png --size 64 --report r.json");
   ASSERT_EQ(ok.code, 0);
   EXPECT_FALSE(contains(ok.err, "float precision")) << ok.err;
-  const CliRun far = run_nmbake(data("far_1e7_low.obj") + " " + data("far_1e7_high.obj") + " -o out.png --size 64 --report r.json");
+  const CliRun far =
+      run_nmbake(data("far_1e7_low.obj") + " " + data("far_1e7_high.obj") + " -o out.png --size 64 --report r.json");
   ASSERT_EQ(far.code, 0);
   EXPECT_TRUE(contains(far.err, "warning: coordinates reach 1e+07")) << far.err;
   EXPECT_TRUE(contains(far.err, "float precision")) << far.err;
@@ -221,8 +223,8 @@ TEST(Stability, HighPolyInsideOrOutsideTheLowPoly) {
 }
 
 TEST(Stability, AllMissedIsAWarningThroughTheCli) {
-  const CliRun r =
-      run_nmbake(data("sphere_low.obj") + " " + data("inside_high.obj") + " -o out.png --size 64 --front 0.1 --rear 0.1 --report r.json");
+  const CliRun r = run_nmbake(data("sphere_low.obj") + " " + data("inside_high.obj") +
+                              " -o out.png --size 64 --front 0.1 --rear 0.1 --report r.json");
   ASSERT_EQ(r.code, 0);
   EXPECT_EQ(r.report["misses"], r.report["samples_covered"]);
   EXPECT_TRUE(contains(r.err, "warning: 100.0% of samples missed " + data("inside_high.obj"))) << r.err;
@@ -264,7 +266,7 @@ TEST(Stability, UvTilesBakeOnlyTheMapRegionAndWarn) {
   for (int y = 0; y < 64; ++y)
     for (int x = 0; x < 64; ++x) {
       const double u = (x + 0.5) / 64, v = 1 - (y + 0.5) / 64;
-      const bool a = u > 0.05 && u < 0.45 && v > 0.05 && v < 0.45, c = u > 0.8 && v > 0.5 && v < 0.9;
+      const bool a = u > 0.05 && u < 0.45 && v > 0.05 && v<0.45, c = u> 0.8 && v > 0.5 && v < 0.9;
       wrong += r.coverage[std::size_t(y) * 64 + x] != (a || c);
       covered += a || c;
     }
@@ -276,7 +278,8 @@ TEST(Stability, UvTilesBakeOnlyTheMapRegionAndWarn) {
     worst = std::max(worst, angle_deg(w, expect));
   });
   EXPECT_LT(worst, 1e-3);
-  const CliRun cli = run_nmbake(data("uv_tiles_low.obj") + " " + data("tilted_plane_high.obj") + " -o out.png --size 64 --report r.json");
+  const CliRun cli =
+      run_nmbake(data("uv_tiles_low.obj") + " " + data("tilted_plane_high.obj") + " -o out.png --size 64 --report r.json");
   ASSERT_EQ(cli.code, 0);
   EXPECT_TRUE(contains(cli.err, "4 triangles have UVs outside [0,1] (2 entirely outside, not baked)")) << cli.err;
   EXPECT_EQ(cli.report["uv_outside_triangles"], 4);
@@ -288,7 +291,7 @@ TEST(Stability, OverlappingIslandsAreCountedAndTheFirstWins) {
   const Mesh high = load("bumps_high.obj");
   const BakeResult r = bake_normal_map(low, high, nullptr, options(64, 0.1f));
   EXPECT_EQ(r.stats.overlapping_samples, 144u);  // texel centres in (0.4,0.6)^2: 12 x 12
-  Mesh first = low;  // island 1 alone
+  Mesh first = low;                              // island 1 alone
   first.position_index.resize(6);
   first.uv_index.resize(6);
   first.normal_index.resize(6);
@@ -301,7 +304,8 @@ TEST(Stability, OverlappingIslandsAreCountedAndTheFirstWins) {
       worst = std::max(worst, angle_deg(decode_rgb(r.map.at(x, y)), decode_rgb(f.map.at(x, y))));
     }
   EXPECT_LT(worst, 1e-3);
-  const CliRun cli = run_nmbake(data("uv_overlap_low.obj") + " " + data("bumps_high.obj") + " -o out.png --size 64 --report r.json");
+  const CliRun cli =
+      run_nmbake(data("uv_overlap_low.obj") + " " + data("bumps_high.obj") + " -o out.png --size 64 --report r.json");
   ASSERT_EQ(cli.code, 0);
   EXPECT_TRUE(contains(cli.err, "UV islands overlap (144 samples covered twice")) << cli.err;
   EXPECT_EQ(cli.report["overlapping_samples"], 144);
@@ -323,7 +327,8 @@ TEST(Stability, TinyAndOddMapSizes) {
       EXPECT_EQ(r.stats.texels_covered, std::size_t(w) * h);
       for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x)
-          for (int k = 0; k < 3; ++k) EXPECT_EQ(quantize8(r.map.at(x, y)[k]), std::lround((n[k] * 0.5 + 0.5) * 255.0)) << w << "x" << h;
+          for (int k = 0; k < 3; ++k)
+            EXPECT_EQ(quantize8(r.map.at(x, y)[k]), std::lround((n[k] * 0.5 + 0.5) * 255.0)) << w << "x" << h;
     }
   }
   const CliRun r = run_nmbake(data("flat_grid_low.obj") + " " + data("tilted_plane_high.obj") + " -o out.png --size 7x3");

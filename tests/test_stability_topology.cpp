@@ -50,7 +50,7 @@ TEST(Stability, HardEdgesOpenNoGapsAndNoCracks) {
     measured(std::string(name) + ".largest_azimuth_step_deg", worst_step);
     measured(std::string(name) + ".smallest_azimuth_step_deg", min_step);
     measured(std::string(name) + ".worst_vertical_component", worst_z);
-    EXPECT_GT(min_step, 0.0) << name;   // monotonic: no overlap, no jump back
+    EXPECT_GT(min_step, 0.0) << name;    // monotonic: no overlap, no jump back
     EXPECT_LT(worst_step, 6.0) << name;  // 360/128 = 2.8 on average: no gap
     EXPECT_LT(worst_z, 1e-3) << name;
   }
@@ -179,15 +179,17 @@ TEST(Stability, TopologyAndInversionAreReportedByTheCli) {
   EXPECT_EQ(r.report["texels_facing_away"], 32 * 32);
   EXPECT_EQ(r.report["high_facing"], "inverted");
   EXPECT_TRUE(contains(r.err, "warning: 100.0% of covered texels point into the low-poly")) << r.err;
-  EXPECT_TRUE(contains(r.err, "inverted_normals_high.obj: its faces look inverted (100% of the surfaces nearest the low-poly face "
-                              "into it): their fronts were taken the other way round; the file's normals are kept"))
+  EXPECT_TRUE(contains(r.err,
+                       "inverted_normals_high.obj: its faces look inverted (100% of the surfaces nearest the low-poly face "
+                       "into it): their fronts were taken the other way round; the file's normals are kept"))
       << r.err;
   r = run_nmbake(low + " " + data("inverted_winding_high.obj") + " -o out.png --size 32 --report r.json");
   ASSERT_EQ(r.code, 0);
   EXPECT_EQ(r.report["texels_facing_away"], 0);
   EXPECT_EQ(r.report["high_facing"], "inverted");
-  EXPECT_TRUE(contains(r.err, "inverted_winding_high.obj: its faces look inverted (100% of the surfaces nearest the low-poly face "
-                              "into it): their fronts were taken the other way round and the computed normals turned outwards"))
+  EXPECT_TRUE(contains(r.err,
+                       "inverted_winding_high.obj: its faces look inverted (100% of the surfaces nearest the low-poly face "
+                       "into it): their fronts were taken the other way round and the computed normals turned outwards"))
       << r.err;
   // --keep-backfaces: the first hit, as it lies.
   r = run_nmbake(low + " " + data("inverted_winding_high.obj") + " -o out.png --size 32 --report r.json --keep-backfaces");

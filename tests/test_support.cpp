@@ -18,9 +18,7 @@ namespace nmbake::test {
 
 std::string data_path(const std::string& relative) { return std::string(NMBAKE_DATA_DIR) + "/" + relative; }
 
-std::string shared_data_path(const std::string& relative) {
-  return std::string(NMBAKE_SHARED_DATA_DIR) + "/" + relative;
-}
+std::string shared_data_path(const std::string& relative) { return std::string(NMBAKE_SHARED_DATA_DIR) + "/" + relative; }
 
 bool exists(const std::string& path) { return std::filesystem::exists(path); }
 
@@ -134,7 +132,8 @@ void for_each_decoded_texel(
       const std::int32_t t = owner[std::size_t(y) * map.width + x];
       if (t < 0) continue;
       double b[3];
-      const TexelTriangle tri = setup_texel_triangle(low.corner_uv(t, 0), low.corner_uv(t, 1), low.corner_uv(t, 2), map.width, map.height);
+      const TexelTriangle tri =
+          setup_texel_triangle(low.corner_uv(t, 0), low.corner_uv(t, 1), low.corner_uv(t, 2), map.width, map.height);
       if (!covers(tri, sample_point(x, y, 0.5, 0.5), b)) continue;
       glm::dvec3 p(0.0);
       for (int c = 0; c < 3; ++c) p += b[c] * glm::dvec3(low.corner_position(std::size_t(t), c));

@@ -25,7 +25,10 @@ struct Slots {
   Slots& operator=(const Slots&) = delete;
   void point_view() {
     const std::size_t n = tri.size();
-    view = {tri.data(), {&b[0], &b[n], &b[2 * n]}, {&ray[0], &ray[n], &ray[2 * n]}, {&ray[3 * n], &ray[4 * n], &ray[5 * n]},
+    view = {tri.data(),
+            {&b[0], &b[n], &b[2 * n]},
+            {&ray[0], &ray[n], &ray[2 * n]},
+            {&ray[3 * n], &ray[4 * n], &ray[5 * n]},
             fallback.data()};
   }
   std::vector<std::int32_t> tri;
@@ -163,10 +166,10 @@ TEST(TileKernels, WriteTexelRowIsTheTexelFormula) {
       const TexelSums sums{{&acc[0], &acc[16], &acc[32]}, &acc[48]};
       for (int x = 0; x < 16; ++x) {
         for (int c = 0; c < 3; ++c) sums.sum[c][x] = u(rng);
-        sums.count[x] = x < 8 ? double(1 + x % 3) : double(x % 5);  // two blocks all with samples, then some without
-        if (x % 7 == 3) sums.sum[0][x] = sums.sum[1][x] = sums.sum[2][x] = 0.0;       // zero sum
-        if (x % 6 == 2) sums.sum[1][x] = 1e-9 * sums.sum[0][x];                       // snaps to 0
-        if (x % 8 == 5) sums.sum[2][x] = -0.0;                                         // a negative zero
+        sums.count[x] = x < 8 ? double(1 + x % 3) : double(x % 5);               // two blocks all with samples, then some without
+        if (x % 7 == 3) sums.sum[0][x] = sums.sum[1][x] = sums.sum[2][x] = 0.0;  // zero sum
+        if (x % 6 == 2) sums.sum[1][x] = 1e-9 * sums.sum[0][x];                  // snaps to 0
+        if (x % 8 == 5) sums.sum[2][x] = -0.0;                                   // a negative zero
       }
       std::vector<float> rgb(3 * 16, -7.0f);
       std::vector<std::uint8_t> covered(16, 0);
@@ -226,8 +229,7 @@ TEST(TileKernels, CompactAndAccumulateKeepSampleOrder) {
       EXPECT_EQ(texel[r], i % kTexels) << i;
       EXPECT_EQ(fallback[r], slots.fallback[i]) << i;
       for (int c = 0; c < 3; ++c) EXPECT_TRUE(same_bits(b[std::size_t(c) * n + r], slots.b[std::size_t(c) * n + i])) << i;
-      for (int c = 0; c < 6; ++c)
-        EXPECT_TRUE(same_bits(ray[std::size_t(c) * n + r], slots.ray[std::size_t(c) * n + i])) << i;
+      for (int c = 0; c < 6; ++c) EXPECT_TRUE(same_bits(ray[std::size_t(c) * n + r], slots.ray[std::size_t(c) * n + i])) << i;
       ++r;
     }
     EXPECT_EQ(count, r);

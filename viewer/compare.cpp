@@ -6,8 +6,7 @@
 
 namespace nmview {
 
-CompareResult run_compare(Renderer& renderer, int pane_width, int pane_height, const Light& light,
-                          const Toggles& toggles) {
+CompareResult run_compare(Renderer& renderer, int pane_width, int pane_height, const Light& light, const Toggles& toggles) {
   CompareResult result;
   for (const OrbitView& view : compare_views()) {
     renderer.render_panes(pane_width, pane_height, view, light, toggles);

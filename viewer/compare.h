@@ -25,8 +25,7 @@ struct CompareResult {
 
 // Renders every view at `pane_width` x `pane_height` with `toggles` (map on or off; wireframe and
 // colour modes should be off) and measures.
-CompareResult run_compare(Renderer& renderer, int pane_width, int pane_height, const Light& light,
-                          const Toggles& toggles);
+CompareResult run_compare(Renderer& renderer, int pane_width, int pane_height, const Light& light, const Toggles& toggles);
 
 // One line per view, a blank line, then the summary; the last line is machine-readable:
 // "psnr=<dB> rmse=<0..1> within2=<fraction> silhouette_mismatch=<fraction> union_psnr=<dB>

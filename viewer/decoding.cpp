@@ -8,8 +8,8 @@ namespace {
 // The value of one setting: the override, else the stored value, else the default; returns
 // whether `first` of the two allowed values was chosen and appends "name first|second (source)".
 bool choose(const std::map<std::string, std::string>& metadata, const std::string& key, const std::string& given,
-            const std::string& flag, const char* first, const char* second, bool first_is_default,
-            const std::string& map_name, std::string& note) {
+            const std::string& flag, const char* first, const char* second, bool first_is_default, const std::string& map_name,
+            std::string& note) {
   std::string value, source;
   if (!given.empty()) {
     if (given != first && given != second)
@@ -38,10 +38,10 @@ MapDecoding resolve_decoding(const std::map<std::string, std::string>& metadata,
   d.object_space = choose(metadata, "nmbake:space", overrides.space, "--space", "object", "tangent", false, map_name, text);
   if (!d.object_space) {
     d.green_down = choose(metadata, "nmbake:green", overrides.green, "--green", "down", "up", false, map_name, text);
-    d.bitangent = choose(metadata, "nmbake:bitangent", overrides.bitangent, "--bitangent", "vertex", "pixel", false,
-                         map_name, text)
-                      ? nmbake::BitangentMode::per_vertex
-                      : nmbake::BitangentMode::per_pixel;
+    d.bitangent =
+        choose(metadata, "nmbake:bitangent", overrides.bitangent, "--bitangent", "vertex", "pixel", false, map_name, text)
+            ? nmbake::BitangentMode::per_vertex
+            : nmbake::BitangentMode::per_pixel;
   } else if (!overrides.green.empty() || !overrides.bitangent.empty()) {
     throw nmbake::UsageError("--green and --bitangent apply to tangent-space maps only");
   }

@@ -77,8 +77,7 @@ bool glyph_pixel(char c, int x, int y) {
   return find_glyph(c).rows[y][x] == '#';
 }
 
-void append_text_triangles(const std::string& text, glm::vec2 origin, float scale,
-                           std::vector<glm::vec2>& out) {
+void append_text_triangles(const std::string& text, glm::vec2 origin, float scale, std::vector<glm::vec2>& out) {
   for (std::size_t i = 0; i < text.size(); ++i) {
     const Glyph& g = find_glyph(text[i]);
     float x0 = origin.x + float(i) * kCellWidth * scale;

@@ -19,8 +19,7 @@ bool glyph_pixel(char c, int x, int y);
 // Axis-aligned squares (one per set font pixel) covering `text` drawn with its top-left corner at
 // `origin` in window pixels (y down), each font pixel `scale` window pixels wide. Two triangles per
 // square, 6 vertices, appended to `out` as (x, y) pairs.
-void append_text_triangles(const std::string& text, glm::vec2 origin, float scale,
-                           std::vector<glm::vec2>& out);
+void append_text_triangles(const std::string& text, glm::vec2 origin, float scale, std::vector<glm::vec2>& out);
 
 // Width in window pixels of `text` at `scale`.
 float text_width(const std::string& text, float scale);

@@ -34,8 +34,7 @@ EGLContext make_context(EGLDisplay display, std::string& why) {
     why = "EGL has no desktop OpenGL";
     return EGL_NO_CONTEXT;
   }
-  const EGLint config_attribs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE, EGL_PBUFFER_BIT,
-                                   EGL_NONE};
+  const EGLint config_attribs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_NONE};
   EGLConfig config = nullptr;
   EGLint count = 0;
   if (!eglChooseConfig(display, config_attribs, &config, 1, &count) || count == 0) {
@@ -46,9 +45,9 @@ EGLContext make_context(EGLDisplay display, std::string& why) {
     }
     config = EGL_NO_CONFIG_KHR;
   }
-  const EGLint context_attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 3,
-                                    EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
-                                    EGL_NONE};
+  const EGLint context_attribs[] = {
+      EGL_CONTEXT_MAJOR_VERSION,           3,       EGL_CONTEXT_MINOR_VERSION, 3, EGL_CONTEXT_OPENGL_PROFILE_MASK,
+      EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
   EGLContext context = eglCreateContext(display, config, EGL_NO_CONTEXT, context_attribs);
   if (context == EGL_NO_CONTEXT) {
     why = "no OpenGL 3.3 core context";
@@ -90,8 +89,7 @@ HeadlessContext::HeadlessContext() {
   };
 
   if (has_extension(client, "EGL_MESA_platform_surfaceless") &&
-      attempt(eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr),
-              "surfaceless"))
+      attempt(eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr), "surfaceless"))
     return;
   if (has_extension(client, "EGL_EXT_platform_device") && has_extension(client, "EGL_EXT_device_enumeration")) {
     EGLint count = 0;
@@ -101,8 +99,8 @@ HeadlessContext::HeadlessContext() {
       for (EGLDeviceEXT device : devices)
         if (attempt(eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, device, nullptr), "device")) return;
   }
-  if (tried.empty()) tried = "no EGL surfaceless or device platform (client extensions: " +
-                             std::string(client ? client : "none") + ")";
+  if (tried.empty())
+    tried = "no EGL surfaceless or device platform (client extensions: " + std::string(client ? client : "none") + ")";
   fail("cannot create a headless OpenGL 3.3 context (" + tried +
        "); install Mesa's EGL and DRI drivers (libegl-mesa0, libgl1-mesa-dri)");
 }

@@ -107,8 +107,8 @@ void on_scroll(GLFWwindow* window, double, double y) {
 void on_resize(GLFWwindow* window, int, int) { state_of(window).dirty = true; }
 
 std::string title(const Scene& scene) {
-  return "nmview - " + scene.low_name + " (" + with_thousands(scene.low_triangles) + " tris) + " + scene.map_name +
-         " | " + scene.high_name + " (" + with_thousands(scene.high_triangles) + " tris)";
+  return "nmview - " + scene.low_name + " (" + with_thousands(scene.low_triangles) + " tris) + " + scene.map_name + " | " +
+         scene.high_name + " (" + with_thousands(scene.high_triangles) + " tris)";
 }
 
 }  // namespace
@@ -136,10 +136,8 @@ void run_interactive(const Scene& scene, const InteractiveOptions& options) {
   int screenshots = 0;
   while (!glfwWindowShouldClose(w)) {
     // Sleep until input arrives unless the light is orbiting on its own.
-    if (s.orbit_light)
-      glfwPollEvents();
-    else
-      glfwWaitEvents();
+    if (s.orbit_light) glfwPollEvents();
+    else glfwWaitEvents();
     const double now = glfwGetTime();
     if (s.orbit_light) {
       s.light.azimuth += float(now - last_time) * kLightOrbitDegreesPerSecond;

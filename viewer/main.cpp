@@ -50,8 +50,7 @@ void parse_size(const std::string& text, int& width, int& height) {
   std::istringstream in(text);
   char x = 0;
   long w = 0, h = 0;
-  if (!(in >> w >> x >> h) || (x != 'x' && x != 'X') || !(in >> std::ws).eof() || w < 16 || h < 16 || w > 16384 ||
-      h > 16384)
+  if (!(in >> w >> x >> h) || (x != 'x' && x != 'X') || !(in >> std::ws).eof() || w < 16 || h < 16 || w > 16384 || h > 16384)
     throw nmbake::UsageError("--size: expected WxH with 16..16384 pixels each (e.g. 1600x800), got '" + text + "'");
   width = int(w);
   height = int(h);
@@ -119,20 +118,18 @@ int run(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"nmview: the low-poly with its baked tangent-space normal map beside the high-poly, "
-               "lit alike from one camera"};
+  CLI::App app{
+      "nmview: the low-poly with its baked tangent-space normal map beside the high-poly, "
+      "lit alike from one camera"};
   Options o;
   app.add_option("low", o.low, "Low-poly mesh with UVs (OBJ, PLY, OFF, STL), as given to nmbake")->required();
-  app.add_option("map", o.map, "Normal map baked for it (any size; its nmbake:* metadata says how it was baked)")
-      ->required();
+  app.add_option("map", o.map, "Normal map baked for it (any size; its nmbake:* metadata says how it was baked)")->required();
   app.add_option("high", o.high, "High-poly mesh (its normals, else computed ones)")->required();
   app.add_option("--screenshot", o.screenshot,
                  "Render without a display to FILE and exit (with --compare: the worst view's difference image)");
   app.add_option("--size", o.size, "Window or image size WxH in pixels (both panes together)")->capture_default_str();
-  app.add_option("--view", o.view, "Camera azimuth,elevation in degrees (Y up; 0,0 looks from +Z)")
-      ->capture_default_str();
-  app.add_option("--light", o.light,
-                 "Light azimuth,elevation in degrees relative to the view direction (0,0 = from the eye)")
+  app.add_option("--view", o.view, "Camera azimuth,elevation in degrees (Y up; 0,0 looks from +Z)")->capture_default_str();
+  app.add_option("--light", o.light, "Light azimuth,elevation in degrees relative to the view direction (0,0 = from the eye)")
       ->capture_default_str();
   app.add_flag("--no-map", o.no_map, "Left pane without the normal map (the low-poly's bare shading)");
   app.add_flag("--compare", o.compare,

@@ -33,15 +33,15 @@ struct ErrorSums {
 
   void add(const ErrorSums& other);
   void add_pixel(const std::uint8_t* a, const std::uint8_t* b);  // RGB of both
-  double rmse() const;     // 0..1 over RGB channels; 0 when there are no pixels
-  double psnr() const;     // 20 log10(1 / rmse) in dB; +infinity when rmse == 0
-  double within2() const;  // fraction of the pixels; 1 when there are none
+  double rmse() const;                                           // 0..1 over RGB channels; 0 when there are no pixels
+  double psnr() const;                                           // 20 log10(1 / rmse) in dB; +infinity when rmse == 0
+  double within2() const;                                        // fraction of the pixels; 1 when there are none
 };
 
 struct DifferenceStats {
-  ErrorSums interior;                // both models fully cover the pixel and its neighbourhood
-  ErrorSums object;                  // covered by either model (the union), silhouettes included
-  std::size_t mismatch_pixels = 0;   // covered by exactly one model (alpha > 0 in one only)
+  ErrorSums interior;               // both models fully cover the pixel and its neighbourhood
+  ErrorSums object;                 // covered by either model (the union), silhouettes included
+  std::size_t mismatch_pixels = 0;  // covered by exactly one model (alpha > 0 in one only)
 
   void add(const DifferenceStats& other);
   // mismatch_pixels / object pixels: 0 when both silhouettes agree; 0 when there are none.

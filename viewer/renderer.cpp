@@ -56,8 +56,8 @@ GLint uniform(GLuint program, const char* name) { return glGetUniformLocation(pr
 
 // Uploads vertices and indices once; `attributes` lists (location, float count) in vertex order.
 template <class V>
-void upload(const IndexedVertices<V>& data, std::initializer_list<std::pair<GLuint, GLint>> attributes,
-            GLuint& vao, GLuint& vbo, GLuint& ebo) {
+void upload(const IndexedVertices<V>& data, std::initializer_list<std::pair<GLuint, GLint>> attributes, GLuint& vao, GLuint& vbo,
+            GLuint& ebo) {
   glGenVertexArrays(1, &vao);
   glBindVertexArray(vao);
   glGenBuffers(1, &vbo);
@@ -70,8 +70,7 @@ void upload(const IndexedVertices<V>& data, std::initializer_list<std::pair<GLui
   std::size_t offset = 0;
   for (auto [location, count] : attributes) {
     glEnableVertexAttribArray(location);
-    glVertexAttribPointer(location, count, GL_FLOAT, GL_FALSE, GLsizei(sizeof(V)),
-                          reinterpret_cast<const void*>(offset));
+    glVertexAttribPointer(location, count, GL_FLOAT, GL_FALSE, GLsizei(sizeof(V)), reinterpret_cast<const void*>(offset));
     offset += std::size_t(count) * sizeof(float);
   }
   glBindVertexArray(0);
@@ -199,8 +198,8 @@ Renderer::~Renderer() {
   glDeleteVertexArrays(1, &empty_vao_);
   glDeleteVertexArrays(1, &text_vao_);
   glDeleteBuffers(1, &text_vbo_);
-  for (GLuint p : {low_program_, high_program_, wire_program_, background_program_, pane_program_,
-                   difference_program_, text_program_})
+  for (GLuint p :
+       {low_program_, high_program_, wire_program_, background_program_, pane_program_, difference_program_, text_program_})
     glDeleteProgram(p);
 }
 
@@ -280,8 +279,7 @@ void Renderer::draw_model(int which, const CameraMatrices& camera, const Toggles
   glBindVertexArray(0);
 }
 
-void Renderer::render_panes(int width, int height, const OrbitView& view, const Light& light,
-                            const Toggles& toggles) {
+void Renderer::render_panes(int width, int height, const OrbitView& view, const Light& light, const Toggles& toggles) {
   ensure_pane_size(width, height);
   const CameraMatrices camera = camera_matrices(view, light, radius_, float(pane_width_) / float(pane_height_));
   glDisable(GL_BLEND);
@@ -297,16 +295,13 @@ void Renderer::render_panes(int width, int height, const OrbitView& view, const 
     draw_model(which, camera, toggles);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, p.msaa_fbo);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, p.fbo);
-    glBlitFramebuffer(0, 0, pane_width_, pane_height_, 0, 0, pane_width_, pane_height_, GL_COLOR_BUFFER_BIT,
-                      GL_NEAREST);
+    glBlitFramebuffer(0, 0, pane_width_, pane_height_, 0, 0, pane_width_, pane_height_, GL_COLOR_BUFFER_BIT, GL_NEAREST);
   }
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   glDisable(GL_DEPTH_TEST);
 }
 
-Rgba8Image Renderer::read_pane(int which) const {
-  return read_framebuffer(panes_[which].fbo, pane_width_, pane_height_);
-}
+Rgba8Image Renderer::read_pane(int which) const { return read_framebuffer(panes_[which].fbo, pane_width_, pane_height_); }
 
 Rgba8Image Renderer::read_framebuffer(unsigned target, int width, int height) {
   Rgba8Image image{width, height, std::vector<std::uint8_t>(std::size_t(width) * std::size_t(height) * 4)};
@@ -321,8 +316,7 @@ Rgba8Image Renderer::read_framebuffer(unsigned target, int width, int height) {
   return image;
 }
 
-void Renderer::draw_text(const std::string& text, float x, float y, float scale, int target_width,
-                         int target_height) {
+void Renderer::draw_text(const std::string& text, float x, float y, float scale, int target_width, int target_height) {
   std::vector<glm::vec2> triangles;
   append_text_triangles(text, {x, y}, scale, triangles);
   if (triangles.empty()) return;
@@ -341,8 +335,8 @@ void Renderer::draw_text(const std::string& text, float x, float y, float scale,
   glBindVertexArray(0);
 }
 
-void Renderer::render(unsigned target, int width, int height, const OrbitView& view, const Light& light,
-                      const Toggles& toggles, const std::vector<std::string>& help) {
+void Renderer::render(unsigned target, int width, int height, const OrbitView& view, const Light& light, const Toggles& toggles,
+                      const std::vector<std::string>& help) {
   const std::vector<Rect> layout = pane_layout(width, height, toggles.difference);
   render_panes(layout[0].width, layout[0].height, view, light, toggles);
 

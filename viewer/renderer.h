@@ -52,8 +52,8 @@ class Renderer {
 
   // A whole frame into framebuffer `target` (0 = the window) of `width` x `height` pixels.
   // `help` lines are printed at the bottom left.
-  void render(unsigned target, int width, int height, const OrbitView& view, const Light& light,
-              const Toggles& toggles, const std::vector<std::string>& help = {});
+  void render(unsigned target, int width, int height, const OrbitView& view, const Light& light, const Toggles& toggles,
+              const std::vector<std::string>& help = {});
 
   // Just the two panes at `width` x `height` each, for measuring; then read_pane(0 = low, 1 = high).
   void render_panes(int width, int height, const OrbitView& view, const Light& light, const Toggles& toggles);

@@ -10,8 +10,8 @@
 
 namespace nmview {
 
-Scene load_scene(const std::string& low_path, const std::string& map_path, const std::string& high_path,
-                 std::ostream& log, const DecodingOverrides& overrides) {
+Scene load_scene(const std::string& low_path, const std::string& map_path, const std::string& high_path, std::ostream& log,
+                 const DecodingOverrides& overrides) {
   Scene scene;
   scene.low_name = low_path;
   scene.map_name = map_path;
@@ -24,8 +24,7 @@ Scene load_scene(const std::string& low_path, const std::string& map_path, const
 
   scene.map = nmbake::read_image(map_path);
   if (scene.map.channels < 3)
-    throw nmbake::InputError(map_path + ": has " + std::to_string(scene.map.channels) +
-                             " channel(s); a normal map needs RGB");
+    throw nmbake::InputError(map_path + ": has " + std::to_string(scene.map.channels) + " channel(s); a normal map needs RGB");
   if (scene.map.width <= 0 || scene.map.height <= 0) throw nmbake::InputError(map_path + ": empty image");
   std::string note;
   scene.decoding = resolve_decoding(nmbake::read_image_metadata(map_path), overrides, map_path, &note);
@@ -48,8 +47,7 @@ Scene load_scene(const std::string& low_path, const std::string& map_path, const
   // The camera frames the sphere around the box centre through the farthest vertex: tighter than
   // the box's half diagonal for round or flat shapes.
   for (const nmbake::Mesh* mesh : {&low, &high})
-    for (std::uint32_t i : mesh->position_index)
-      scene.radius = std::max(scene.radius, glm::length(mesh->positions[i] - centre));
+    for (std::uint32_t i : mesh->position_index) scene.radius = std::max(scene.radius, glm::length(mesh->positions[i] - centre));
 
   const nmbake::TangentFrames frames = nmbake::compute_tangent_frames(low);
   scene.low = build_low_vertices(low, frames, centre);

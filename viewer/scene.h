@@ -16,12 +16,12 @@
 namespace nmview {
 
 struct Scene {
-  LowVertices low;        // low-poly with the baker's per-corner frames
-  HighVertices high;      // high-poly with its file normals, else angle-weighted vertex normals
-  nmbake::Image map;      // the normal map as read, at least 3 channels, any size
-  MapDecoding decoding;   // the convention the map was baked with (metadata, then overrides)
-  Bounds bounds;          // union of both meshes, object space
-  float radius = 0.0f;    // largest distance of a vertex of either mesh from bounds.centre()
+  LowVertices low;       // low-poly with the baker's per-corner frames
+  HighVertices high;     // high-poly with its file normals, else angle-weighted vertex normals
+  nmbake::Image map;     // the normal map as read, at least 3 channels, any size
+  MapDecoding decoding;  // the convention the map was baked with (metadata, then overrides)
+  Bounds bounds;         // union of both meshes, object space
+  float radius = 0.0f;   // largest distance of a vertex of either mesh from bounds.centre()
   std::string low_name, map_name, high_name;
   std::size_t low_triangles = 0, high_triangles = 0;
 };
@@ -29,8 +29,8 @@ struct Scene {
 // Throws nmbake::InputError (from the loaders, or "<map>: has N channel(s); a normal map needs
 // RGB") on bad input, nmbake::UsageError for a bad override. Notes (the map's decoding and where it
 // came from, normals computed, a tangent-space map that does not look like one) go to `log`.
-Scene load_scene(const std::string& low_path, const std::string& map_path, const std::string& high_path,
-                 std::ostream& log, const DecodingOverrides& overrides = {});
+Scene load_scene(const std::string& low_path, const std::string& map_path, const std::string& high_path, std::ostream& log,
+                 const DecodingOverrides& overrides = {});
 
 // Writes the RGB of `image` with nmbake::write_image (8-bit for PNG). Throws nmbake::OutputError.
 void write_screenshot(const std::string& path, const Rgba8Image& image);

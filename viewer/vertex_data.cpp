@@ -14,8 +14,7 @@ Bounds mesh_bounds(const nmbake::Mesh& mesh) {
   return b;
 }
 
-LowVertices build_low_vertices(const nmbake::Mesh& mesh, const nmbake::TangentFrames& frames,
-                               glm::vec3 centre) {
+LowVertices build_low_vertices(const nmbake::Mesh& mesh, const nmbake::TangentFrames& frames, glm::vec3 centre) {
   assert(mesh.has_uvs());
   const std::size_t corners = mesh.position_index.size();
   assert(frames.normal.size() == corners && frames.tangent.size() == corners);
@@ -27,8 +26,7 @@ LowVertices build_low_vertices(const nmbake::Mesh& mesh, const nmbake::TangentFr
     corner[c].tangent = frames.tangent[c];
     corner[c].uv = mesh.uvs[mesh.uv_index[c]];
     const double at_corner[3] = {c % 3 == 0 ? 1.0 : 0.0, c % 3 == 1 ? 1.0 : 0.0, c % 3 == 2 ? 1.0 : 0.0};
-    corner[c].bitangent =
-        glm::vec3(nmbake::interpolate_frame(frames, c / 3, at_corner, nmbake::BitangentMode::per_vertex).b);
+    corner[c].bitangent = glm::vec3(nmbake::interpolate_frame(frames, c / 3, at_corner, nmbake::BitangentMode::per_vertex).b);
   }
 
   // Merge corners with identical bytes: sort an index permutation, then number the runs.
@@ -45,8 +43,7 @@ LowVertices build_low_vertices(const nmbake::Mesh& mesh, const nmbake::TangentFr
   out.indices.resize(corners);
   for (std::size_t k = 0; k < corners; ++k) {
     std::uint32_t c = order[k];
-    if (k == 0 || std::memcmp(&corner[c], &out.vertices.back(), sizeof(LowVertex)) != 0)
-      out.vertices.push_back(corner[c]);
+    if (k == 0 || std::memcmp(&corner[c], &out.vertices.back(), sizeof(LowVertex)) != 0) out.vertices.push_back(corner[c]);
     out.indices[c] = static_cast<std::uint32_t>(out.vertices.size() - 1);
   }
   return out;
@@ -59,8 +56,7 @@ HighVertices build_high_vertices(const nmbake::Mesh& mesh, glm::vec3 centre) {
 
   if (mesh.normal_index == mesh.position_index && mesh.normals.size() == mesh.positions.size()) {
     out.vertices.resize(mesh.positions.size());
-    for (std::size_t i = 0; i < mesh.positions.size(); ++i)
-      out.vertices[i] = {mesh.positions[i] - centre, mesh.normals[i]};
+    for (std::size_t i = 0; i < mesh.positions.size(); ++i) out.vertices[i] = {mesh.positions[i] - centre, mesh.normals[i]};
     out.indices = mesh.position_index;
     return out;
   }

@@ -40,12 +40,12 @@ Bounds mesh_bounds(const nmbake::Mesh& mesh);
 // Low-poly corner: exactly the baker's per-corner frame (normal, tangent xyz + sign in w, and the
 // per-vertex bitangent).
 struct LowVertex {
-  glm::vec3 position;  // object space minus the scene centre
-  glm::vec3 normal;    // frames.normal of the corner, unit length
-  glm::vec4 tangent;   // frames.tangent of the corner: xyz unit, w = +1 or -1
-  glm::vec2 uv;        // OBJ convention, v = 1 at the top of the image
-  glm::vec3 bitangent; // the corner's B of BitangentMode::per_vertex (nmbake::interpolate_frame at
-                       // the corner), interpolated when a map was baked that way
+  glm::vec3 position;   // object space minus the scene centre
+  glm::vec3 normal;     // frames.normal of the corner, unit length
+  glm::vec4 tangent;    // frames.tangent of the corner: xyz unit, w = +1 or -1
+  glm::vec2 uv;         // OBJ convention, v = 1 at the top of the image
+  glm::vec3 bitangent;  // the corner's B of BitangentMode::per_vertex (nmbake::interpolate_frame at
+                        // the corner), interpolated when a map was baked that way
 };
 static_assert(sizeof(LowVertex) == 60, "LowVertex is uploaded as tightly packed floats");
 
@@ -67,8 +67,7 @@ using HighVertices = IndexedVertices<HighVertex>;
 
 // One vertex per distinct (position, normal, tangent, uv) corner of `mesh`, which must have UVs;
 // `frames` must come from nmbake::compute_tangent_frames(mesh).
-LowVertices build_low_vertices(const nmbake::Mesh& mesh, const nmbake::TangentFrames& frames,
-                               glm::vec3 centre);
+LowVertices build_low_vertices(const nmbake::Mesh& mesh, const nmbake::TangentFrames& frames, glm::vec3 centre);
 
 // One vertex per distinct (position, normal) pair; `mesh` must have normals (see
 // nmbake::ensure_normals). Meshes whose normals are indexed like their positions take a fast path

@@ -28,10 +28,10 @@ struct Light {
 };
 
 struct CameraMatrices {
-  glm::mat4 view;           // scene (re-centred) to eye
-  glm::mat4 projection;     // eye to clip
-  glm::vec3 eye;            // camera position in the re-centred scene
-  glm::vec3 light_dir;      // unit direction towards the light, in the re-centred scene
+  glm::mat4 view;        // scene (re-centred) to eye
+  glm::mat4 projection;  // eye to clip
+  glm::vec3 eye;         // camera position in the re-centred scene
+  glm::vec3 light_dir;   // unit direction towards the light, in the re-centred scene
 };
 
 // Camera matrices for a pane of `aspect` = width / height that frames a sphere of `radius`

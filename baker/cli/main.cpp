@@ -96,8 +96,10 @@ void check_output_path(const std::string& path, const char* what) {
   if (fs::is_directory(path, ec)) throw OutputError(path + ": cannot write " + what + ": it is a directory");
   fs::path dir = fs::path(path).parent_path();
   if (dir.empty()) dir = ".";
-  if (!fs::is_directory(dir, ec)) throw OutputError(path + ": cannot write " + what + ": folder " + dir.string() + " does not exist");
-  if (::access(dir.c_str(), W_OK) != 0) throw OutputError(path + ": cannot write " + what + ": folder " + dir.string() + " is not writable");
+  if (!fs::is_directory(dir, ec))
+    throw OutputError(path + ": cannot write " + what + ": folder " + dir.string() + " does not exist");
+  if (::access(dir.c_str(), W_OK) != 0)
+    throw OutputError(path + ": cannot write " + what + ": folder " + dir.string() + " is not writable");
 }
 
 class ProgressBar {
@@ -110,7 +112,8 @@ class ProgressBar {
     if (pct == last_) return true;
     last_ = pct;
     const int width = 40, filled = int(f * width);
-    std::fprintf(stderr, "\rbaking [%s%s] %3d%%", std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(), pct);
+    std::fprintf(stderr, "\rbaking [%s%s] %3d%%", std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(),
+                 pct);
     if (pct >= 100) std::fprintf(stderr, "\r%*s\r", width + 16, "");
     std::fflush(stderr);
     return true;
@@ -125,7 +128,8 @@ class ProgressBar {
 void add_options(CLI::App& app, Args& a) {
   app.footer(std::string("\nInputs: OBJ, PLY (ascii/binary), OFF, STL. The low-poly must have UVs.\n"
                          "Maps use the OpenGL convention (green = +bitangent, \"Y+\") unless --green down;\n"
-                         "tangent frames follow MikkTSpace (Blender, glTF, Substance, Unity, Unreal).\n\n") + kExitCodes);
+                         "tangent frames follow MikkTSpace (Blender, glTF, Substance, Unity, Unreal).\n\n") +
+             kExitCodes);
   app.get_formatter()->column_width(34);
   app.add_option("low", a.low, "Low-poly mesh with UVs")->required();
   app.add_option("high", a.high, "High-poly mesh (UVs not needed)")->required();
@@ -135,7 +139,8 @@ void add_options(CLI::App& app, Args& a) {
   app.add_option("--front", a.front,
                  "One ray start distance outside the low-poly for the whole scene, scene units (default: the automatic cage, "
                  "measured per vertex)");
-  app.add_option("--rear", a.rear, "One ray reach inside the low-poly for the whole scene, scene units (default: measured per vertex)");
+  app.add_option("--rear", a.rear,
+                 "One ray reach inside the low-poly for the whole scene, scene units (default: measured per vertex)");
   app.add_option("--cage", a.cage,
                  "Cage mesh with the low-poly's topology: rays go from cage to low-poly and on by --rear (default: measured per "
                  "vertex)");
@@ -147,7 +152,8 @@ void add_options(CLI::App& app, Args& a) {
                  "back faces are skipped in both")
       ->check(CLI::IsMember({"cage-first", "closest"}));
   app.add_option("--space", a.space, "tangent (default) or object")->check(CLI::IsMember({"tangent", "object"}));
-  app.add_option("--green", a.green, "up = OpenGL/Blender/glTF (default), down = DirectX/Unreal")->check(CLI::IsMember({"up", "down"}));
+  app.add_option("--green", a.green, "up = OpenGL/Blender/glTF (default), down = DirectX/Unreal")
+      ->check(CLI::IsMember({"up", "down"}));
   app.add_option("--bitangent", a.bitangent, "pixel = B from interpolated N,T (MikkTSpace, default); vertex = interpolated B")
       ->check(CLI::IsMember({"pixel", "vertex"}));
   app.add_option("--bits", a.bits, "8, 16 or 32 (float); default from the extension")->check(CLI::IsMember({8, 16, 32}));
@@ -169,7 +175,6 @@ void add_options(CLI::App& app, Args& a) {
                "angular error of the float map against them (one stderr line, \"error_estimate\" in --report); costs "
                "about 10% of a 2048^2 1-sample bake (measured on torus_s3 and suz_L4: 0.13-0.31 s, 6-12% of the command)");
   app.set_version_flag("--version", std::string("nmbake ") + NMBAKE_VERSION);
-
 }
 
 // The library's options from the flags: translation only (validate_options checks them).
@@ -223,32 +228,34 @@ void check_outputs(const Args& a, int bits) {
 // One line on how far rays reached, unless --quiet.
 void print_distances(const BakeStats& s) {
   if (s.cage == BakeStats::CageSource::automatic)
-    std::fprintf(stderr,
-                 "nmbake: automatic cage: front %.3g-%.3g (mean %.3g), rear %.3g-%.3g (mean %.3g) per vertex; limited by a neighbouring "
-                 "part at %zu and %zu vertices\n",
-                 s.vertex_front.min, s.vertex_front.max, s.vertex_front.mean, s.vertex_rear.min, s.vertex_rear.max, s.vertex_rear.mean,
-                 s.cage_front_limited, s.cage_rear_limited);
+    std::fprintf(
+        stderr,
+        "nmbake: automatic cage: front %.3g-%.3g (mean %.3g), rear %.3g-%.3g (mean %.3g) per vertex; limited by a neighbouring "
+        "part at %zu and %zu vertices\n",
+        s.vertex_front.min, s.vertex_front.max, s.vertex_front.mean, s.vertex_rear.min, s.vertex_rear.max, s.vertex_rear.mean,
+        s.cage_front_limited, s.cage_rear_limited);
   else if (s.cage == BakeStats::CageSource::file && s.auto_distances)
-    std::fprintf(stderr, "nmbake: rear distances measured per vertex: %.3g-%.3g (mean %.3g)\n", s.vertex_rear.min, s.vertex_rear.max,
-                 s.vertex_rear.mean);
+    std::fprintf(stderr, "nmbake: rear distances measured per vertex: %.3g-%.3g (mean %.3g)\n", s.vertex_rear.min,
+                 s.vertex_rear.max, s.vertex_rear.mean);
   else if (s.auto_distances)
-    std::fprintf(stderr, "nmbake: ray distances measured: --front %.6g --rear %.6g (%.2f%% of probes lie beyond)\n", s.front, s.rear,
-                 100.0 * s.auto_probe_beyond);
+    std::fprintf(stderr, "nmbake: ray distances measured: --front %.6g --rear %.6g (%.2f%% of probes lie beyond)\n", s.front,
+                 s.rear, 100.0 * s.auto_probe_beyond);
 }
 
-ErrorEstimate estimate_error(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& o, const BakeResult& r, int bits) {
-    ErrorEstimateOptions eo;
-    eo.bits = bits;
-    const ErrorEstimate estimate = estimate_bake_error(low, high, cage, o, r, eo);
-    // The estimate compares float values; say what the output's bit depth adds on top.
-    char quant[128] = "float output adds no quantisation";
-    if (bits != 32)
-      std::snprintf(quant, sizeof quant, "%d-bit output adds quantisation of mean %.4f deg, max %.4f deg", bits,
-                    estimate.quantization_mean_deg, estimate.quantization_max_deg);
-    std::fprintf(stderr,
-                 "nmbake: error estimate: mean %.4f deg, p95 %.4f deg, max %.4f deg against %d samples on %zu texels "
-                 "(%.2f s); %s\n",
-                 estimate.mean_deg, estimate.p95_deg, estimate.max_deg, estimate.samples, estimate.texels, estimate.seconds, quant);
+ErrorEstimate estimate_error(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& o, const BakeResult& r,
+                             int bits) {
+  ErrorEstimateOptions eo;
+  eo.bits = bits;
+  const ErrorEstimate estimate = estimate_bake_error(low, high, cage, o, r, eo);
+  // The estimate compares float values; say what the output's bit depth adds on top.
+  char quant[128] = "float output adds no quantisation";
+  if (bits != 32)
+    std::snprintf(quant, sizeof quant, "%d-bit output adds quantisation of mean %.4f deg, max %.4f deg", bits,
+                  estimate.quantization_mean_deg, estimate.quantization_max_deg);
+  std::fprintf(stderr,
+               "nmbake: error estimate: mean %.4f deg, p95 %.4f deg, max %.4f deg against %d samples on %zu texels "
+               "(%.2f s); %s\n",
+               estimate.mean_deg, estimate.p95_deg, estimate.max_deg, estimate.samples, estimate.texels, estimate.seconds, quant);
   return estimate;
 }
 
@@ -256,14 +263,15 @@ ErrorEstimate estimate_error(const Mesh& low, const Mesh& high, const Mesh* cage
 void write_outputs(const Args& a, const BakeOptions& o, const BakeResult& r, const Mesh& low, int bits) {
   WriteOptions wo;
   wo.bits = bits;
-  wo.metadata = {{"nmbake:space", to_string(o.space)},
-                 {"nmbake:green", o.green_down ? "down" : "up"},
-                 {"nmbake:tangent_basis", "mikktspace"},
-                 {"nmbake:bitangent", o.bitangent == BitangentMode::per_vertex ? "vertex" : "pixel"},
-                 {"nmbake:version", NMBAKE_VERSION},
-                 {"ImageDescription", std::string(o.space == NormalSpace::object ? "object-space normal map" : "tangent-space normal map, ") +
-                                          (o.space == NormalSpace::object ? "" : (o.green_down ? "DirectX (Y-)" : "OpenGL (Y+)")) +
-                                          ", baked by nmbake"}};
+  wo.metadata = {
+      {"nmbake:space", to_string(o.space)},
+      {"nmbake:green", o.green_down ? "down" : "up"},
+      {"nmbake:tangent_basis", "mikktspace"},
+      {"nmbake:bitangent", o.bitangent == BitangentMode::per_vertex ? "vertex" : "pixel"},
+      {"nmbake:version", NMBAKE_VERSION},
+      {"ImageDescription",
+       std::string(o.space == NormalSpace::object ? "object-space normal map" : "tangent-space normal map, ") +
+           (o.space == NormalSpace::object ? "" : (o.green_down ? "DirectX (Y-)" : "OpenGL (Y+)")) + ", baked by nmbake"}};
   write_image(a.output, r.map, wo);
   if (!a.miss_mask.empty()) {
     WriteOptions mo;
@@ -281,30 +289,32 @@ void write_outputs(const Args& a, const BakeOptions& o, const BakeResult& r, con
     cage_mesh.uvs = low.uvs;
     cage_mesh.position_index = low.position_index;
     cage_mesh.uv_index = low.uv_index;
-    write_text_atomically(a.save_cage, obj_text(cage_mesh, "nmbake " NMBAKE_VERSION " automatic cage of " + a.low + " for " + a.high));
+    write_text_atomically(a.save_cage,
+                          obj_text(cage_mesh, "nmbake " NMBAKE_VERSION " automatic cage of " + a.low + " for " + a.high));
   }
 }
 
 void write_report(const Args& a, const BakeOptions& o, const RunInfo& run, const BakeStats& s, const ErrorEstimate* estimate) {
-    nlohmann::json report = make_report(o, s, run);
-    if (estimate)
-      report["error_estimate"] = {{"mean_deg", estimate->mean_deg},
-                                  {"p95_deg", estimate->p95_deg},
-                                  {"max_deg", estimate->max_deg},
-                                  {"texels", estimate->texels},
-                                  {"seconds", estimate->seconds}};
-    write_text_atomically(a.report, report.dump(2) + "\n");
+  nlohmann::json report = make_report(o, s, run);
+  if (estimate)
+    report["error_estimate"] = {{"mean_deg", estimate->mean_deg},
+                                {"p95_deg", estimate->p95_deg},
+                                {"max_deg", estimate->max_deg},
+                                {"texels", estimate->texels},
+                                {"seconds", estimate->seconds}};
+  write_text_atomically(a.report, report.dump(2) + "\n");
 }
 
 void print_summary(const Args& a, const BakeOptions& o, const RunInfo& run, const BakeStats& s, int bits) {
-    std::printf(
-        "nmbake: wrote %s (%dx%d, %d-bit, %s%s): samples %d, rays %s, misses %llu (%.2f%%), coverage %.1f%%, "
-        "seconds: load %.2f prepare %.2f bvh %.2f distances %.2f trace %.2f padding %.2f write %.2f total %.2f\n",
-        a.output.c_str(), o.width, o.height, bits, to_string(o.space),
-        o.space == NormalSpace::tangent ? (o.green_down ? ", green down" : ", green up") : "", o.samples, human(double(s.rays)).c_str(),
-        (unsigned long long)s.misses, s.samples_covered ? 100.0 * double(s.misses) / double(s.samples_covered) : 0.0, 100.0 * s.coverage,
-        run.seconds_load, s.seconds_prepare, s.seconds_bvh, s.seconds_distances, s.seconds_trace, s.seconds_padding, run.seconds_write,
-        run.seconds_total);
+  std::printf(
+      "nmbake: wrote %s (%dx%d, %d-bit, %s%s): samples %d, rays %s, misses %llu (%.2f%%), coverage %.1f%%, "
+      "seconds: load %.2f prepare %.2f bvh %.2f distances %.2f trace %.2f padding %.2f write %.2f total %.2f\n",
+      a.output.c_str(), o.width, o.height, bits, to_string(o.space),
+      o.space == NormalSpace::tangent ? (o.green_down ? ", green down" : ", green up") : "", o.samples,
+      human(double(s.rays)).c_str(), (unsigned long long)s.misses,
+      s.samples_covered ? 100.0 * double(s.misses) / double(s.samples_covered) : 0.0, 100.0 * s.coverage, run.seconds_load,
+      s.seconds_prepare, s.seconds_bvh, s.seconds_distances, s.seconds_trace, s.seconds_padding, run.seconds_write,
+      run.seconds_total);
 }
 
 int run(int argc, char** argv) {
@@ -366,7 +376,8 @@ int run(int argc, char** argv) {
   run.seconds_write = std::chrono::duration<double>(Clock::now() - t0).count();
   run.high_topology = topology.get();
   if (!a.quiet)
-    for (const std::string& w : bake_warnings(s, run.high_topology, a.low, a.high)) std::fprintf(stderr, "nmbake: %s\n", w.c_str());
+    for (const std::string& w : bake_warnings(s, run.high_topology, a.low, a.high))
+      std::fprintf(stderr, "nmbake: %s\n", w.c_str());
   run.seconds_total = std::chrono::duration<double>(Clock::now() - start).count();
   run.peak_memory_bytes = peak_memory_bytes();
   run.threads_used = a.threads > 0 ? unsigned(a.threads) : std::max(1u, std::thread::hardware_concurrency());

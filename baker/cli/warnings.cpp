@@ -16,7 +16,8 @@ std::string format(const char* fmt, Args... args) {
 
 }  // namespace
 
-std::vector<std::string> bake_warnings(const BakeStats& s, const MeshTopology& t, const std::string& low, const std::string& high) {
+std::vector<std::string> bake_warnings(const BakeStats& s, const MeshTopology& t, const std::string& low,
+                                       const std::string& high) {
   std::vector<std::string> out;
   if (s.degenerate_uv_triangles)
     out.push_back(format("warning: %s: %zu triangles have zero UV area (they cover no texels and give no tangent)", low.c_str(),
@@ -25,9 +26,10 @@ std::vector<std::string> bake_warnings(const BakeStats& s, const MeshTopology& t
     out.push_back(format("warning: %s: %zu triangles have zero area (their texels take the normal found from a point or a line)",
                          low.c_str(), s.degenerate_3d_triangles));
   if (s.uv_outside_triangles)
-    out.push_back(format("warning: %s: %zu triangles have UVs outside [0,1] (%zu entirely outside, not baked); only the part inside "
-                         "the map is baked, UVs are not wrapped",
-                         low.c_str(), s.uv_outside_triangles, s.uv_outside_entirely_triangles));
+    out.push_back(
+        format("warning: %s: %zu triangles have UVs outside [0,1] (%zu entirely outside, not baked); only the part inside "
+               "the map is baked, UVs are not wrapped",
+               low.c_str(), s.uv_outside_triangles, s.uv_outside_entirely_triangles));
   if (s.overlapping_samples)
     out.push_back(format("warning: %s: UV islands overlap (%llu samples covered twice; the lower face number wins)", low.c_str(),
                          (unsigned long long)s.overlapping_samples));
@@ -35,27 +37,32 @@ std::vector<std::string> bake_warnings(const BakeStats& s, const MeshTopology& t
     out.push_back(format("warning: %.1f%% of samples missed %s and were written flat; check --front/--rear (or --cage)",
                          100.0 * double(s.misses) / double(s.samples_covered), high.c_str()));
   if (s.texels_covered && double(s.texels_facing_away) > kFacingAwayShareWarn * double(s.texels_covered))
-    out.push_back(format("warning: %.1f%% of covered texels point into the low-poly: are the normals or the winding of %s inverted?",
-                         100.0 * double(s.texels_facing_away) / double(s.texels_covered), high.c_str()));
+    out.push_back(
+        format("warning: %.1f%% of covered texels point into the low-poly: are the normals or the winding of %s inverted?",
+               100.0 * double(s.texels_facing_away) / double(s.texels_covered), high.c_str()));
   if (s.high_facing == BakeStats::HighFacing::inverted)
-    out.push_back(format("warning: %s: its faces look inverted (%.0f%% of the surfaces nearest the low-poly face into it): their fronts "
-                         "were taken the other way round%s",
-                         high.c_str(), 100.0 * s.backface_probe_share,
-                         s.high_normals_computed ? " and the computed normals turned outwards"
-                                                 : "; the file's normals are kept, so the map points into the surface"));
+    out.push_back(
+        format("warning: %s: its faces look inverted (%.0f%% of the surfaces nearest the low-poly face into it): their fronts "
+               "were taken the other way round%s",
+               high.c_str(), 100.0 * s.backface_probe_share,
+               s.high_normals_computed ? " and the computed normals turned outwards"
+                                       : "; the file's normals are kept, so the map points into the surface"));
   else if (s.high_facing == BakeStats::HighFacing::mixed)
-    out.push_back(format("warning: %s: some of its parts look inverted (%.0f%% of the surfaces nearest the low-poly face into it): "
-                         "back faces are kept for this bake, as with --keep-backfaces",
-                         high.c_str(), 100.0 * s.backface_probe_share));
+    out.push_back(
+        format("warning: %s: some of its parts look inverted (%.0f%% of the surfaces nearest the low-poly face into it): "
+               "back faces are kept for this bake, as with --keep-backfaces",
+               high.c_str(), 100.0 * s.backface_probe_share));
   if (s.suspect_share > kSuspectShareWarn)
-    out.push_back(format("warning: %.2f%% of covered texels are suspect (normal tilted over %.0f degrees from the low-poly's, or "
-                         "samples disagreeing), %.0f%% of them in UV u %.3g-%.3g, v %.3g-%.3g; see --suspect-mask",
-                         100.0 * s.suspect_share, kSuspectTiltDeg, 100.0 * s.suspect_region_share, s.suspect_region[0],
-                         s.suspect_region[2], s.suspect_region[1], s.suspect_region[3]));
+    out.push_back(
+        format("warning: %.2f%% of covered texels are suspect (normal tilted over %.0f degrees from the low-poly's, or "
+               "samples disagreeing), %.0f%% of them in UV u %.3g-%.3g, v %.3g-%.3g; see --suspect-mask",
+               100.0 * s.suspect_share, kSuspectTiltDeg, 100.0 * s.suspect_region_share, s.suspect_region[0], s.suspect_region[2],
+               s.suspect_region[1], s.suspect_region[3]));
   if (s.coordinate_spacing > kCoordinateSpacingWarn)
-    out.push_back(format("warning: coordinates reach %.3g, far from the origin for a scene this size: float precision there is "
-                         "%.2g of the scene diagonal (above %.0e the map degrades measurably); move the meshes near the origin",
-                         s.largest_coordinate, s.coordinate_spacing, kCoordinateSpacingWarn));
+    out.push_back(
+        format("warning: coordinates reach %.3g, far from the origin for a scene this size: float precision there is "
+               "%.2g of the scene diagonal (above %.0e the map degrades measurably); move the meshes near the origin",
+               s.largest_coordinate, s.coordinate_spacing, kCoordinateSpacingWarn));
   std::string topo;
   auto add = [&](std::size_t n, const char* what) {
     if (!n) return;
@@ -63,8 +70,9 @@ std::vector<std::string> bake_warnings(const BakeStats& s, const MeshTopology& t
   };
   add(t.non_manifold_edges, "non-manifold edges");
   add(t.isolated_vertices, "isolated vertices (ignored)");
-  add(t.inconsistent_winding_faces, s.high_normals_computed ? "faces wound against their neighbours (turned before computing normals)"
-                                                            : "faces wound against their neighbours (the file's normals are used)");
+  add(t.inconsistent_winding_faces, s.high_normals_computed
+                                        ? "faces wound against their neighbours (turned before computing normals)"
+                                        : "faces wound against their neighbours (the file's normals are used)");
   add(t.duplicate_faces, "duplicate faces (counted once in computed normals)");
   if (!topo.empty()) out.push_back("warning: " + high + ": " + topo);
   return out;

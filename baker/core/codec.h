@@ -62,8 +62,8 @@ struct Frame {
 // The per-pixel frame at barycentrics `bary` from the corners' normals, tangents and tangent signs
 // (tangent.w): N and T interpolated, sign interpolated like them, B = sign * cross(N, T).
 template <typename T>
-[[gnu::always_inline]] inline void per_pixel_frame(Frame<T>& f, const T bary[3], const Vec3<T> normal[3], const Vec3<T> tangent[3],
-                                                   const T sign_w[3], const T& zero) {
+[[gnu::always_inline]] inline void per_pixel_frame(Frame<T>& f, const T bary[3], const Vec3<T> normal[3],
+                                                   const Vec3<T> tangent[3], const T sign_w[3], const T& zero) {
   interpolate(f.n, bary, normal, zero);
   interpolate(f.t, bary, tangent, zero);
   T sign = zero;

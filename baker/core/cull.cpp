@@ -6,8 +6,7 @@
 
 namespace nmbake {
 
-std::vector<std::uint32_t> triangles_near(const std::vector<Box>& regions, double margin,
-                                          const std::vector<glm::vec3>& positions,
+std::vector<std::uint32_t> triangles_near(const std::vector<Box>& regions, double margin, const std::vector<glm::vec3>& positions,
                                           const std::vector<std::uint32_t>& indices,
                                           const std::vector<std::uint32_t>* candidates) {
   const std::size_t tris = indices.size() / 3;

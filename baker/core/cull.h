@@ -21,8 +21,7 @@ struct Box {
 // The high-poly triangles (index triples into `positions`) whose bounding box overlaps some box of
 // `regions` grown by `margin` on every side, in increasing order. `candidates`, when not null,
 // limits the answer to those triangles (themselves in increasing order).
-std::vector<std::uint32_t> triangles_near(const std::vector<Box>& regions, double margin,
-                                          const std::vector<glm::vec3>& positions,
+std::vector<std::uint32_t> triangles_near(const std::vector<Box>& regions, double margin, const std::vector<glm::vec3>& positions,
                                           const std::vector<std::uint32_t>& indices,
                                           const std::vector<std::uint32_t>* candidates = nullptr);
 

@@ -45,9 +45,7 @@ struct Image {
   Pixels pixels;  // width * height * channels, row-major from the top row
 
   Image() = default;
-  Image(int w, int h, int c, float fill = 0.0f) : Image(w, h, c, Unset{}) {
-    std::fill(pixels.begin(), pixels.end(), fill);
-  }
+  Image(int w, int h, int c, float fill = 0.0f) : Image(w, h, c, Unset{}) { std::fill(pixels.begin(), pixels.end(), fill); }
   // Pixels left unset, for a caller that writes every one before reading any: a large map is not
   // written twice (the memory comes from the system zeroed anyway).
   struct Unset {};
@@ -66,9 +64,7 @@ struct Image {
   }
 
   float* at(int x, int y) { return &pixels[(static_cast<std::size_t>(y) * width + x) * channels]; }
-  const float* at(int x, int y) const {
-    return &pixels[(static_cast<std::size_t>(y) * width + x) * channels];
-  }
+  const float* at(int x, int y) const { return &pixels[(static_cast<std::size_t>(y) * width + x) * channels]; }
 
  private:
   // A map of a few MiB or more is written once, texel by texel: backed by 2 MiB pages where the

@@ -34,18 +34,14 @@ struct Mesh {
   bool has_normals() const { return !normal_index.empty(); }
   bool has_uvs() const { return !uv_index.empty(); }
 
-  glm::vec3 corner_position(std::size_t tri, int corner) const {
-    return positions[position_index[3 * tri + corner]];
-  }
+  glm::vec3 corner_position(std::size_t tri, int corner) const { return positions[position_index[3 * tri + corner]]; }
   glm::vec2 corner_uv(std::size_t tri, int corner) const { return uvs[uv_index[3 * tri + corner]]; }
-  glm::vec3 corner_normal(std::size_t tri, int corner) const {
-    return normals[normal_index[3 * tri + corner]];
-  }
+  glm::vec3 corner_normal(std::size_t tri, int corner) const { return normals[normal_index[3 * tri + corner]]; }
 };
 
 // What loading found and repaired, for the report.
 struct MeshLoadInfo {
-  std::size_t file_faces = 0;           // faces as written in the file
+  std::size_t file_faces = 0;             // faces as written in the file
   std::size_t polygons_triangulated = 0;  // faces with more than 3 corners, fanned into triangles
   std::size_t normals_renormalized = 0;   // file normals that were not unit length
   std::size_t zero_normals = 0;           // file normals of length ~0 (replaced by computed ones)

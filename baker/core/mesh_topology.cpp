@@ -26,10 +26,10 @@ struct PosKeyHash {
 // Everything the checks and the normals share: welded corners, duplicate faces, and the faces to
 // turn so that every piece has one winding.
 struct Analysis {
-  std::vector<std::uint32_t> weld;     // per position
-  std::vector<std::uint32_t> corner;   // per corner: welded vertex
-  std::vector<std::uint8_t> skip;      // per triangle: duplicate or collapsed (two corners welded)
-  std::vector<std::uint8_t> flip;      // per triangle: wound against its piece's majority
+  std::vector<std::uint32_t> weld;    // per position
+  std::vector<std::uint32_t> corner;  // per corner: welded vertex
+  std::vector<std::uint8_t> skip;     // per triangle: duplicate or collapsed (two corners welded)
+  std::vector<std::uint8_t> flip;     // per triangle: wound against its piece's majority
   MeshTopology topo;
 };
 
@@ -90,7 +90,8 @@ Analysis analyze(const Mesh& m) {
       edges.push_back({(lo << 32) | hi, std::uint32_t(t), p < q ? 1u : 0u});
     }
   }
-  std::sort(edges.begin(), edges.end(), [](const Edge& x, const Edge& y) { return x.key < y.key || (x.key == y.key && x.face < y.face); });
+  std::sort(edges.begin(), edges.end(),
+            [](const Edge& x, const Edge& y) { return x.key < y.key || (x.key == y.key && x.face < y.face); });
   // Manifold edges link two faces; `same` marks a pair running the edge the same way (one of the
   // two is wound against the other).
   std::vector<std::uint32_t> adj_start(tris + 1, 0);
@@ -104,7 +105,8 @@ Analysis analyze(const Mesh& m) {
     const std::size_t n = j - i;
     if (n == 1) ++a.topo.boundary_edges;
     else if (n > 2) ++a.topo.non_manifold_edges;
-    else if (edges[i].face != edges[i + 1].face) links.push_back({edges[i].face, edges[i + 1].face, edges[i].forward == edges[i + 1].forward});
+    else if (edges[i].face != edges[i + 1].face)
+      links.push_back({edges[i].face, edges[i + 1].face, edges[i].forward == edges[i + 1].forward});
     i = j;
   }
   for (const Link& l : links) ++adj_start[l.a + 1], ++adj_start[l.b + 1];

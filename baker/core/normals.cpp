@@ -6,8 +6,9 @@
 
 namespace nmbake {
 
-std::vector<glm::dvec3> angle_weighted_sums(const Mesh& mesh, const std::vector<std::uint32_t>* corner_vertex, std::size_t vertices,
-                                            const std::vector<std::uint8_t>* skip, const std::vector<std::uint8_t>* flip) {
+std::vector<glm::dvec3> angle_weighted_sums(const Mesh& mesh, const std::vector<std::uint32_t>* corner_vertex,
+                                            std::size_t vertices, const std::vector<std::uint8_t>* skip,
+                                            const std::vector<std::uint8_t>* flip) {
   std::vector<glm::dvec3> sum(vertices, glm::dvec3(0.0));
   for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
     if (skip && (*skip)[t]) continue;

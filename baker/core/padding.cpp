@@ -64,7 +64,8 @@ std::size_t pad_islands(Image& image, const std::vector<std::uint8_t>& covered, 
   const int w = image.width, h = image.height;
   const std::size_t n = std::size_t(w) * h;
   // Nothing to fill from, or nothing to fill: skip the distance transform.
-  const std::size_t covered_count = std::size_t(std::count_if(covered.begin(), covered.end(), [](std::uint8_t c) { return c != 0; }));
+  const std::size_t covered_count =
+      std::size_t(std::count_if(covered.begin(), covered.end(), [](std::uint8_t c) { return c != 0; }));
   if (covered_count == 0 || covered_count == n) return 0;
   if (threads <= 0) threads = std::max(1, int(std::thread::hardware_concurrency()));
   // Both passes split into independent parts (columns, then rows) shared out to the threads; each

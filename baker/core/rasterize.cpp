@@ -58,17 +58,16 @@ std::vector<std::int32_t> rasterize_texel_triangles(const Mesh& mesh, int width,
   std::vector<std::int32_t> owner(std::size_t(width) * height, -1);
   std::size_t overlapped = 0;
   for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
-    const TexelTriangle tri = setup_texel_triangle(mesh.corner_uv(t, 0), mesh.corner_uv(t, 1), mesh.corner_uv(t, 2), width, height);
+    const TexelTriangle tri =
+        setup_texel_triangle(mesh.corner_uv(t, 0), mesh.corner_uv(t, 1), mesh.corner_uv(t, 2), width, height);
     if (!tri.valid()) continue;
     for (int y = tri.ymin; y <= tri.ymax; ++y)
       for (int x = tri.xmin; x <= tri.xmax; ++x) {
         double bary[3];
         if (!covers(tri, sample_point(x, y, 0.5, 0.5), bary)) continue;
         std::int32_t& o = owner[std::size_t(y) * width + x];
-        if (o < 0)
-          o = std::int32_t(t);
-        else
-          ++overlapped;
+        if (o < 0) o = std::int32_t(t);
+        else ++overlapped;
       }
   }
   if (overlaps) *overlaps = overlapped;

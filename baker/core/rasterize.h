@@ -21,13 +21,13 @@ namespace nmbake {
 
 // Edge setup of one triangle in texel space (x right, y down, in texels).
 struct TexelTriangle {
-  glm::dvec2 p[3];        // corners in texel space
-  double area2 = 0.0;     // twice the signed area in texel space (0: degenerate, covers nothing)
+  glm::dvec2 p[3];     // corners in texel space
+  double area2 = 0.0;  // twice the signed area in texel space (0: degenerate, covers nothing)
   // Edge k (corners k, k+1, opposite corner k+2) from its lexicographically smaller end `a` along
   // `d`, and the signed value of the opposite corner (`side`) in that edge function.
   glm::dvec2 edge_a[3], edge_d[3];
   double edge_side[3] = {0, 0, 0};
-  double edge_inv_side[3] = {0, 0, 0};  // 1 / edge_side: the barycentric weights multiply by it
+  double edge_inv_side[3] = {0, 0, 0};           // 1 / edge_side: the barycentric weights multiply by it
   int xmin = 0, xmax = -1, ymin = 0, ymax = -1;  // inclusive texel bounding box, clipped to image
   bool valid() const { return area2 != 0.0; }
 };
@@ -77,7 +77,6 @@ inline glm::dvec2 sample_point(int x, int y, double ox, double oy) { return {x +
 
 // Per texel (row-major from the top), the index of the triangle covering its centre, or -1.
 // `overlaps` (optional) receives the number of texel centres covered by more than one triangle.
-std::vector<std::int32_t> rasterize_texel_triangles(const Mesh& mesh, int width, int height,
-                                                    std::size_t* overlaps = nullptr);
+std::vector<std::int32_t> rasterize_texel_triangles(const Mesh& mesh, int width, int height, std::size_t* overlaps = nullptr);
 
 }  // namespace nmbake

@@ -42,7 +42,8 @@ struct TriInfo {
 };
 
 glm::dvec3 any_orthogonal(const glm::dvec3& n) {
-  const glm::dvec3 a = std::abs(n.x) < 0.6 ? glm::dvec3(1, 0, 0) : (std::abs(n.y) < 0.6 ? glm::dvec3(0, 1, 0) : glm::dvec3(0, 0, 1));
+  const glm::dvec3 a =
+      std::abs(n.x) < 0.6 ? glm::dvec3(1, 0, 0) : (std::abs(n.y) < 0.6 ? glm::dvec3(0, 1, 0) : glm::dvec3(0, 0, 1));
   const glm::dvec3 t = a - glm::dot(a, n) * n;
   const double len = glm::length(t);
   return len > 0.0 ? t / len : glm::dvec3(1, 0, 0);

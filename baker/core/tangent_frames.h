@@ -30,8 +30,8 @@ enum class BitangentMode {
 };
 
 struct TangentFrames {
-  std::vector<glm::vec3> normal;   // per corner (3 per triangle), unit length, object space
-  std::vector<glm::vec4> tangent;  // per corner: xyz unit and orthogonal to normal, w = +1 or -1
+  std::vector<glm::vec3> normal;            // per corner (3 per triangle), unit length, object space
+  std::vector<glm::vec4> tangent;           // per corner: xyz unit and orthogonal to normal, w = +1 or -1
   std::size_t degenerate_uv_triangles = 0;  // zero UV area: no tangent contribution
   std::size_t degenerate_3d_triangles = 0;  // zero 3D area: no tangent contribution
   std::size_t corners_without_tangent = 0;  // given an arbitrary tangent orthogonal to N

@@ -30,8 +30,7 @@ constexpr FormatInfo kFormats[] = {
 namespace image_io_detail {
 std::string lower_extension(const std::string& path) {
   std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return ext;
 }
 }  // namespace image_io_detail
@@ -55,9 +54,7 @@ int default_bits_for(const std::string& path) {
 void check_output_format(const std::string& path, int bits) {
   const std::string ext = image_io_detail::lower_extension(path);
   const FormatInfo* f = find_format(ext);
-  if (!f)
-    throw UsageError(path + ": unsupported image format '" + ext +
-                     "' (use .png, .tif, .tiff or .exr)");
+  if (!f) throw UsageError(path + ": unsupported image format '" + ext + "' (use .png, .tif, .tiff or .exr)");
   if (bits == 0) return;
   bool ok = (bits == 8 && f->bits8) || (bits == 16 && f->bits16) || (bits == 32 && f->bits32);
   if (!ok) {
@@ -65,8 +62,7 @@ void check_output_format(const std::string& path, int bits) {
     if (f->bits8) can += "8";
     if (f->bits16) can += std::string(can.empty() ? "" : ", ") + "16";
     if (f->bits32) can += std::string(can.empty() ? "" : ", ") + "32";
-    throw UsageError(path + ": " + ext + " cannot hold " + std::to_string(bits) +
-                     "-bit values (supported: " + can + ")");
+    throw UsageError(path + ": " + ext + " cannot hold " + std::to_string(bits) + "-bit values (supported: " + can + ")");
   }
 }
 

@@ -54,8 +54,8 @@ std::vector<T> quantize(const Floats& values, double scale) {
 
 std::string temp_path_for(const fs::path& target) {
   static std::atomic<unsigned> counter{0};
-  std::string name = "." + target.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
-                     std::to_string(counter++) + target.extension().string();
+  std::string name = "." + target.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) +
+                     target.extension().string();
   return (target.parent_path() / name).string();
 }
 
@@ -87,8 +87,8 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
   check_output_format(path, bits);
   assert(image.pixels.size() == static_cast<std::size_t>(image.width) * image.height * image.channels);
   if (image.width <= 0 || image.height <= 0 || image.channels <= 0)
-    fail_write(path, "empty image (" + std::to_string(image.width) + "x" +
-                         std::to_string(image.height) + "x" + std::to_string(image.channels) + ")");
+    fail_write(path, "empty image (" + std::to_string(image.width) + "x" + std::to_string(image.height) + "x" +
+                         std::to_string(image.channels) + ")");
 
   // Check the folder first: OpenImageIO would only name the temporary file.
   const fs::path target(path);
@@ -180,9 +180,7 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
 }
 
 Image read_image(const std::string& path) {
-  auto fail = [&](const std::string& reason) -> Image {
-    throw InputError(path + ": cannot read image: " + reason);
-  };
+  auto fail = [&](const std::string& reason) -> Image { throw InputError(path + ": cannot read image: " + reason); };
   std::error_code ec;
   if (!fs::exists(path, ec)) return fail("no such file");
   if (fs::is_directory(path, ec)) return fail("it is a folder");
@@ -195,24 +193,22 @@ Image read_image(const std::string& path) {
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.deep) return fail("deep images are not supported");
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth != 1)
-    return fail("unsupported size " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
-                "x" + std::to_string(spec.depth) + " with " + std::to_string(spec.nchannels) +
-                " channels");
+    return fail("unsupported size " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + "x" +
+                std::to_string(spec.depth) + " with " + std::to_string(spec.nchannels) + " channels");
   const double count = double(spec.width) * spec.height * spec.nchannels;
   if (count > double(std::numeric_limits<std::int32_t>::max()))
-    throw ResourceError(path + ": image too large (" + std::to_string(spec.width) + "x" +
-                        std::to_string(spec.height) + "x" + std::to_string(spec.nchannels) + ")");
+    throw ResourceError(path + ": image too large (" + std::to_string(spec.width) + "x" + std::to_string(spec.height) + "x" +
+                        std::to_string(spec.nchannels) + ")");
 
   Image image;
   try {
     image = Image(spec.width, spec.height, spec.nchannels);
   } catch (const std::bad_alloc&) {
-    throw ResourceError(path + ": out of memory reading a " + std::to_string(spec.width) + "x" +
-                        std::to_string(spec.height) + " image");
+    throw ResourceError(path + ": out of memory reading a " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                        " image");
   }
   // The TIFF reader reports a truncated strip through has_error() yet returns true.
-  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data()) ||
-      in->has_error())
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data()) || in->has_error())
     return fail(one_line(in->geterror()));
   in->close();
   return image;

@@ -23,7 +23,7 @@ int default_bits_for(const std::string& path);
 void check_output_format(const std::string& path, int bits);
 
 struct WriteOptions {
-  int bits = 0;  // 8, 16 or 32 (float); 0 = default_bits_for(path)
+  int bits = 0;                                               // 8, 16 or 32 (float); 0 = default_bits_for(path)
   std::vector<std::pair<std::string, std::string>> metadata;  // written as string attributes
 };
 

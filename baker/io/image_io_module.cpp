@@ -31,9 +31,7 @@ const ImageIoModule kModule = {
     [](const std::string& path, const Image& image, const WriteOptions& options, std::string* error) {
       return guarded(error, [&] { write_image(path, image, options); });
     },
-    [](const std::string& path, Image* image, std::string* error) {
-      return guarded(error, [&] { *image = read_image(path); });
-    },
+    [](const std::string& path, Image* image, std::string* error) { return guarded(error, [&] { *image = read_image(path); }); },
     [](const std::string& path, std::map<std::string, std::string>* metadata, std::string* error) {
       return guarded(error, [&] { *metadata = read_image_metadata(path); });
     },

@@ -192,8 +192,7 @@ Mesh parse_bytes(const std::string& path, std::string_view bytes, const LoadOpti
 
 }  // namespace
 
-Mesh load_mesh_from_memory(const std::string& name, std::string_view bytes, const LoadOptions& options,
-                           MeshLoadInfo* info) {
+Mesh load_mesh_from_memory(const std::string& name, std::string_view bytes, const LoadOptions& options, MeshLoadInfo* info) {
   MeshLoadInfo local_info;
   MeshLoadInfo& out_info = info ? *info : local_info;
   out_info = MeshLoadInfo{};
@@ -238,8 +237,7 @@ std::string obj_text(const Mesh& mesh, const std::string& comment) {
     for (int c = 0; c < 3; ++c) {
       if (mesh.has_uvs())
         std::snprintf(line, sizeof line, " %u/%u", mesh.position_index[3 * t + c] + 1, mesh.uv_index[3 * t + c] + 1);
-      else
-        std::snprintf(line, sizeof line, " %u", mesh.position_index[3 * t + c] + 1);
+      else std::snprintf(line, sizeof line, " %u", mesh.position_index[3 * t + c] + 1);
       out += line;
     }
     out += "\n";

@@ -39,9 +39,7 @@ struct ParsedMesh {
 };
 
 // Throws InputError("<path>: <problem>").
-[[noreturn]] inline void fail(const std::string& path, const std::string& problem) {
-  throw InputError(path + ": " + problem);
-}
+[[noreturn]] inline void fail(const std::string& path, const std::string& problem) { throw InputError(path + ": " + problem); }
 
 ParsedMesh parse_obj(const std::string& path, std::string_view text);
 ParsedMesh parse_ply(const std::string& path, std::string_view bytes);

@@ -38,9 +38,7 @@ class ObjParser {
   void check_forward_references() const;
 
  private:
-  [[noreturn]] void fail_line(const std::string& problem) const {
-    fail(path_, "line " + std::to_string(line_) + ": " + problem);
-  }
+  [[noreturn]] void fail_line(const std::string& problem) const { fail(path_, "line " + std::to_string(line_) + ": " + problem); }
   float read_value(std::string_view line, std::size_t& pos, Attribute element, bool required, bool& present) const;
   void parse_vertex(std::string_view line, std::size_t pos);
   void parse_uv(std::string_view line, std::size_t pos);
@@ -60,8 +58,7 @@ class ObjParser {
 };
 
 // One number of a v, vt or vn statement; `element` names it in messages.
-float ObjParser::read_value(std::string_view line, std::size_t& pos, Attribute element, bool required,
-                            bool& present) const {
+float ObjParser::read_value(std::string_view line, std::size_t& pos, Attribute element, bool required, bool& present) const {
   auto name = [&] {
     return std::string(kAttributeNames[element]) + " " + std::to_string(attribute_count(out_.mesh, element) + 1);
   };
@@ -120,8 +117,8 @@ std::uint32_t ObjParser::resolve_index(std::string_view text, Attribute attribut
   long long count = static_cast<long long>(attribute_count(out_.mesh, attribute));
   if (value < 0) {
     if (-value > count)
-      fail_line(std::string("face refers to ") + name + " " + std::to_string(value) + " but only " +
-                std::to_string(count) + " precede it");
+      fail_line(std::string("face refers to ") + name + " " + std::to_string(value) + " but only " + std::to_string(count) +
+                " precede it");
     return static_cast<std::uint32_t>(count + value);
   }
   if (value > max_index_[attribute]) {
@@ -129,8 +126,7 @@ std::uint32_t ObjParser::resolve_index(std::string_view text, Attribute attribut
     max_index_line_[attribute] = line_;
   }
   if (value > UINT32_MAX)
-    fail_line(std::string("face refers to ") + name + " " + std::to_string(value) + " but the file has " +
-              std::to_string(count));
+    fail_line(std::string("face refers to ") + name + " " + std::to_string(value) + " but the file has " + std::to_string(count));
   return static_cast<std::uint32_t>(value - 1);
 }
 

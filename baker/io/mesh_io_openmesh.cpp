@@ -241,16 +241,14 @@ bool is_off_magic(std::string_view token) {
 
 // Validates an ASCII OFF file and returns it in the plain shape OpenMesh's reader needs: the magic
 // alone on the first line, the counts on the second, then one vertex or face per line, no comments.
-std::string check_off(const std::string& path, std::string_view text, std::size_t& vertex_count,
-                      std::size_t& face_count) {
+std::string check_off(const std::string& path, std::string_view text, std::size_t& vertex_count, std::size_t& face_count) {
   LineCursor lines(text);
   std::string_view line;
   if (!lines.next(line)) fail(path, "no faces");
   std::size_t p = 0;
   std::string_view magic = next_token(line, p);
   if (!is_off_magic(magic)) fail(path, "not an OFF file (it does not start with 'OFF')");
-  if (magic.find_first_of("4n") != std::string_view::npos)
-    fail(path, quote(magic) + " (4D or n-D OFF) is not supported");
+  if (magic.find_first_of("4n") != std::string_view::npos) fail(path, quote(magic) + " (4D or n-D OFF) is not supported");
   std::string_view word = next_token(line, p);
   if (word == "BINARY") fail(path, "binary OFF is not supported; save it as ASCII OFF or as PLY");
 
@@ -269,8 +267,7 @@ std::string check_off(const std::string& path, std::string_view text, std::size_
   vertex_count = static_cast<std::size_t>(counts[0]);
   face_count = static_cast<std::size_t>(counts[1]);
 
-  std::string clean =
-      std::string(magic) + "\n" + std::to_string(vertex_count) + " " + std::to_string(face_count) + " 0\n";
+  std::string clean = std::string(magic) + "\n" + std::to_string(vertex_count) + " " + std::to_string(face_count) + " 0\n";
   auto at_line = [&] { return "line " + std::to_string(lines.line_number()) + ": "; };
   for (std::size_t v = 0; v < vertex_count; ++v) {
     if (!lines.next(line))
@@ -287,8 +284,7 @@ std::string check_off(const std::string& path, std::string_view text, std::size_
     clean.append(line).push_back('\n');
   }
   for (std::size_t f = 0; f < face_count; ++f) {
-    if (!lines.next(line))
-      fail(path, "truncated: file ends in face " + std::to_string(f) + " of " + std::to_string(face_count));
+    if (!lines.next(line)) fail(path, "truncated: file ends in face " + std::to_string(f) + " of " + std::to_string(face_count));
     const std::string face = "face " + std::to_string(f);
     std::size_t q = 0;
     std::string_view token = next_token(line, q);
@@ -411,8 +407,7 @@ ParsedMesh parse_stl(const std::string& path, std::string_view bytes) {
                      [&](FlatImporter& importer) { return OpenMesh::IO::STLReader().read(stream, importer, options); });
   // OpenMesh welds coincident vertices and drops facets left with a repeated corner.
   if (out.file_faces > facets)
-    fail(path,
-         "OpenMesh read " + std::to_string(out.file_faces) + " facets but the file has " + std::to_string(facets));
+    fail(path, "OpenMesh read " + std::to_string(out.file_faces) + " facets but the file has " + std::to_string(facets));
   out.degenerate_faces_dropped = facets - out.file_faces;
   out.file_faces = facets;
   return out;

@@ -66,12 +66,11 @@ bool parse_scalar_name(std::string_view name, Scalar& t) {
     const char* text;
     Scalar type;
   };
-  static const Name names[] = {{"char", Scalar::int8},      {"int8", Scalar::int8},       {"uchar", Scalar::uint8},
-                               {"uint8", Scalar::uint8},    {"short", Scalar::int16},     {"int16", Scalar::int16},
-                               {"ushort", Scalar::uint16},  {"uint16", Scalar::uint16},   {"int", Scalar::int32},
-                               {"int32", Scalar::int32},    {"uint", Scalar::uint32},     {"uint32", Scalar::uint32},
-                               {"float", Scalar::float32},  {"float32", Scalar::float32}, {"double", Scalar::float64},
-                               {"float64", Scalar::float64}};
+  static const Name names[] = {
+      {"char", Scalar::int8},     {"int8", Scalar::int8},       {"uchar", Scalar::uint8},    {"uint8", Scalar::uint8},
+      {"short", Scalar::int16},   {"int16", Scalar::int16},     {"ushort", Scalar::uint16},  {"uint16", Scalar::uint16},
+      {"int", Scalar::int32},     {"int32", Scalar::int32},     {"uint", Scalar::uint32},    {"uint32", Scalar::uint32},
+      {"float", Scalar::float32}, {"float32", Scalar::float32}, {"double", Scalar::float64}, {"float64", Scalar::float64}};
   for (const Name& n : names)
     if (name == n.text) {
       t = n.type;
@@ -130,8 +129,7 @@ Header parse_header(const std::string& path, std::string_view bytes) {
       if (type == "list") {
         property.is_list = true;
         std::string_view count_type = next_token(line, p);
-        if (!parse_scalar_name(count_type, property.count_type))
-          header_fail("unknown list count type " + quote(count_type));
+        if (!parse_scalar_name(count_type, property.count_type)) header_fail("unknown list count type " + quote(count_type));
         if (!is_integer_type(property.count_type)) header_fail("list count type must be an integer type");
         type = next_token(line, p);
       }
@@ -154,10 +152,8 @@ std::uint64_t min_instance_bytes(const Element& element, Encoding encoding, unsi
   std::uint64_t bytes = 0;
   for (const Property& p : element.properties) {
     unsigned items = p.is_list ? list_items : 1;
-    if (encoding == Encoding::ascii)
-      bytes += 2 * (items + (p.is_list ? 1u : 0u));  // a digit and a separator per value
-    else
-      bytes += (p.is_list ? scalar_size(p.count_type) : 0) + std::uint64_t(items) * scalar_size(p.type);
+    if (encoding == Encoding::ascii) bytes += 2 * (items + (p.is_list ? 1u : 0u));  // a digit and a separator per value
+    else bytes += (p.is_list ? scalar_size(p.count_type) : 0) + std::uint64_t(items) * scalar_size(p.type);
   }
   return bytes;
 }
@@ -188,8 +184,7 @@ Role vertex_role(const std::string& name, const Element& vertex) {
   if (name == "ny") return kNy;
   if (name == "nz") return kNz;
   // The first complete UV pair in this order wins.
-  static const char* const pairs[][2] = {
-      {"s", "t"}, {"u", "v"}, {"texture_u", "texture_v"}, {"texture_s", "texture_t"}};
+  static const char* const pairs[][2] = {{"s", "t"}, {"u", "v"}, {"texture_u", "texture_v"}, {"texture_s", "texture_t"}};
   for (const auto& pair : pairs) {
     if (!has(pair[0]) || !has(pair[1])) continue;
     if (name == pair[0]) return kU;
@@ -241,8 +236,7 @@ class DataReader {
       : path_(path),
         encoding_(header.encoding),
         data_(bytes.substr(header.data_offset)),
-        swap_(header.encoding != Encoding::ascii &&
-              (header.encoding == Encoding::binary_little_endian) != kHostLittleEndian) {}
+        swap_(header.encoding != Encoding::ascii && (header.encoding == Encoding::binary_little_endian) != kHostLittleEndian) {}
 
   void start(const Element& element, std::uint64_t index) {
     element_ = &element;
@@ -293,8 +287,8 @@ class DataReader {
     return value;
   }
   [[noreturn, gnu::noinline]] void truncated() const {
-    fail(path_, "truncated: file ends in " + element_->name + " " + std::to_string(index_) + " of " +
-                    std::to_string(element_->count));
+    fail(path_,
+         "truncated: file ends in " + element_->name + " " + std::to_string(index_) + " of " + std::to_string(element_->count));
   }
   const std::string& path_;
   Encoding encoding_;
@@ -377,8 +371,7 @@ void read_vertex(DataReader& reader, const Element& e, const Layout& layout, std
       default: break;
     }
   }
-  if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-    reader.fail_here("has a non-finite coordinate");
+  if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) reader.fail_here("has a non-finite coordinate");
   if (!std::isfinite(n.x) || !std::isfinite(n.y) || !std::isfinite(n.z)) reader.fail_here("has a non-finite normal");
   if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) reader.fail_here("has a non-finite texture coordinate");
   m.positions[i] = p;
@@ -440,10 +433,8 @@ class FaceReader {
       }
     }
     ++out_.file_faces;
-    if (has_uvs)
-      ++out_.faces_with_uvs;
-    else if (out_.first_face_without_uvs.empty())
-      out_.first_face_without_uvs = "face " + std::to_string(face);
+    if (has_uvs) ++out_.faces_with_uvs;
+    else if (out_.first_face_without_uvs.empty()) out_.first_face_without_uvs = "face " + std::to_string(face);
     if (layout_.normals) ++out_.faces_with_normals;
     add_polygon(out_, corners_.data(), n, face);
   }
@@ -502,8 +493,7 @@ ParsedMesh parse_ply(const std::string& path, std::string_view bytes) {
       } else if (is_face) {
         faces.read(reader, e, i);
       } else {
-        for (const Property& prop : e.properties)
-          reader.skip(prop.type, prop.is_list ? reader.read_list_count(prop) : 1);
+        for (const Property& prop : e.properties) reader.skip(prop.type, prop.is_list ? reader.read_list_count(prop) : 1);
       }
     }
     if ((is_vertex || is_face) && --needed == 0) break;  // nothing after them matters

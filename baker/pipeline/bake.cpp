@@ -66,7 +66,8 @@ class OutputAllocation {
       : thread_([&opt, &result, &disagree, this] {
           try {
             const std::size_t texels = std::size_t(opt.width) * std::size_t(opt.height);
-            result.map = Image(opt.width, opt.height, 3, Image::Unset{});  // the trace writes the covered texels, padding the rest
+            result.map =
+                Image(opt.width, opt.height, 3, Image::Unset{});  // the trace writes the covered texels, padding the rest
             result.map.fault_in();
             result.coverage.assign(texels, 0);
             if (opt.miss_mask) result.miss_mask = Image(opt.width, opt.height, 1, 0.0f);
@@ -122,7 +123,8 @@ raycast::BuildQuality bvh_quality_for(const BakeOptions& o, std::size_t triangle
 std::uint64_t estimate_bake_bytes(const BakeOptions& o) {
   const std::uint64_t texels = std::uint64_t(std::max(o.width, 0)) * std::uint64_t(std::max(o.height, 0));
   // map (3 floats) + coverage (1 byte) + padding transform (double + int) + optional miss mask.
-  std::uint64_t per_texel = 12 + 1 + (o.padding > 0 ? 12 : 0) + (o.miss_mask ? 4 : 0) + (o.suspect_mask ? 4 : 0) + (o.samples > 1 ? 1 : 0);
+  std::uint64_t per_texel =
+      12 + 1 + (o.padding > 0 ? 12 : 0) + (o.miss_mask ? 4 : 0) + (o.suspect_mask ? 4 : 0) + (o.samples > 1 ? 1 : 0);
   return texels * per_texel;
 }
 
@@ -152,7 +154,8 @@ void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const Ba
   t0 = Clock::now();
   std::vector<std::uint32_t> kept;  // increasing; empty: all
   if (opt.cull_far)
-    kept = select_reachable(s, high, mode.probing ? mode.reach * 1.01 + 1e-6 * s.diagonal : ray_margin(s, mode.any_cage, opt.front, opt.rear));
+    kept = select_reachable(
+        s, high, mode.probing ? mode.reach * 1.01 + 1e-6 * s.diagonal : ray_margin(s, mode.any_cage, opt.front, opt.rear));
   HighScene& scene = in.scene;
   build_high_scene(scene, s, high, kept, bvh_quality_for(opt, kept.empty() ? high.triangle_count() : kept.size()), opt.threads);
   st.seconds_bvh = seconds_since(t0);
@@ -185,7 +188,9 @@ void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const Ba
 // with the smaller.
 int tile_side(const BakeOptions& opt) { return opt.samples <= 4 ? 2 * kTile : kTile; }
 
-int thread_count(const BakeOptions& opt) { return opt.threads > 0 ? opt.threads : std::max(1, int(std::thread::hardware_concurrency())); }
+int thread_count(const BakeOptions& opt) {
+  return opt.threads > 0 ? opt.threads : std::max(1, int(std::thread::hardware_concurrency()));
+}
 
 }  // namespace
 
@@ -202,7 +207,8 @@ void validate_options(const BakeOptions& o) {
   if (o.threads < 0 || o.threads > kMaxThreads)
     throw UsageError("--threads must be between 0 and " + std::to_string(kMaxThreads) + ", got " + std::to_string(o.threads));
   for (const auto& [d, name] : {std::pair{o.front, "--front"}, std::pair{o.rear, "--rear"}})
-    if (!(d < kMaxDistance)) throw UsageError(std::string(name) + " must be a distance >= 0 in scene units");  // NaN, infinite, huge
+    if (!(d < kMaxDistance))
+      throw UsageError(std::string(name) + " must be a distance >= 0 in scene units");  // NaN, infinite, huge
   if (o.space == NormalSpace::object && o.green_down) throw UsageError("--green down applies to tangent-space maps only");
 }
 

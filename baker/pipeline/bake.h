@@ -32,7 +32,7 @@ enum class NormalSpace { tangent, object };
 constexpr int kMaxMapSide = 65536;  // texels per side; larger maps are refused (ResourceError)
 constexpr int kMaxSamples = 1024;   // sample points per texel
 constexpr int kMaxThreads = 1024;
-constexpr double kMaxDistance = 1e30;  // --front, --rear: scene units
+constexpr double kMaxDistance = 1e30;            // --front, --rear: scene units
 constexpr double kCoordinateSpacingWarn = 1e-3;  // BakeStats::coordinate_spacing above this: warn
 // BakeStats::backface_probe_share above which the high-poly is taken as inverted, and above which
 // (up to the first) as partly inverted, when back faces are kept.
@@ -46,18 +46,18 @@ constexpr double kSuspectShareWarn = 0.005;
 constexpr double kMixedShare = 0.2;
 
 struct BakeOptions {
-  int width = 2048;   // map width in texels
-  int height = 2048;  // map height in texels
-  int samples = 1;    // sample points per texel; 1 = the texel centre only (no AA loop)
+  int width = 2048;     // map width in texels
+  int height = 2048;    // map height in texels
+  int samples = 1;      // sample points per texel; 1 = the texel centre only (no AA loop)
   float front = -1.0f;  // scene units the ray starts outside the low-poly; < 0 = auto (measured)
   float rear = -1.0f;   // scene units the ray reaches inside the low-poly; < 0 = auto (measured)
   RayPolicy policy = RayPolicy::cage_first;
   NormalSpace space = NormalSpace::tangent;
   bool green_down = false;  // DirectX "Y-" maps: negate the bitangent component
   BitangentMode bitangent = BitangentMode::per_pixel;
-  int padding = 16;     // texels of edge padding around islands; 0 = none
-  int threads = 0;      // worker threads; 0 = all cores
-  bool miss_mask = false;  // fill BakeResult::miss_mask (share of missed samples per texel)
+  int padding = 16;           // texels of edge padding around islands; 0 = none
+  int threads = 0;            // worker threads; 0 = all cores
+  bool miss_mask = false;     // fill BakeResult::miss_mask (share of missed samples per texel)
   bool suspect_mask = false;  // fill BakeResult::suspect_mask (1 for suspect texels, BakeStats::suspect_texels)
   // Leave high-poly triangles out of the BVH when they lie farther from the low-poly (and cage)
   // than any ray reaches (cull.h). The map is the same either way; off only for comparison.
@@ -76,10 +76,10 @@ struct BakeOptions {
 };
 
 struct BakeStats {
-  float front = 0.0f, rear = 0.0f;  // distances used (scene units)
-  glm::dvec3 centre{0.0};           // subtracted from every coordinate before tracing (bounding-box centre)
-  bool auto_distances = false;      // front/rear were measured, not given
-  double auto_probe_beyond = 0.0;   // share of probe points farther than the chosen distances
+  float front = 0.0f, rear = 0.0f;               // distances used (scene units)
+  glm::dvec3 centre{0.0};                        // subtracted from every coordinate before tracing (bounding-box centre)
+  bool auto_distances = false;                   // front/rear were measured, not given
+  double auto_probe_beyond = 0.0;                // share of probe points farther than the chosen distances
   std::uint64_t rays = 0, hits = 0, misses = 0;  // misses/hits count samples, rays count casts
   std::uint64_t samples_covered = 0;
   std::uint64_t overlapping_samples = 0;  // samples covered by more than one UV triangle
@@ -89,12 +89,12 @@ struct BakeStats {
   // outside the low-poly), over all hits.
   double hit_distance_min = 0.0, hit_distance_mean = 0.0, hit_distance_max = 0.0;
   std::size_t low_triangles = 0, high_triangles = 0;
-  std::size_t high_triangles_culled = 0;  // left out of the BVH: out of every ray's reach
+  std::size_t high_triangles_culled = 0;                              // left out of the BVH: out of every ray's reach
   raycast::BuildQuality bvh_quality = raycast::BuildQuality::medium;  // of the BVH traced (bvh_quality_for)
   std::size_t degenerate_uv_triangles = 0, degenerate_3d_triangles = 0, corners_without_tangent = 0;
-  std::size_t uv_outside_triangles = 0;  // low-poly triangles with a UV outside [0,1]
+  std::size_t uv_outside_triangles = 0;           // low-poly triangles with a UV outside [0,1]
   std::size_t uv_outside_entirely_triangles = 0;  // of those, UV bounding box outside [0,1]^2: not baked
-  std::size_t high_faces_reoriented = 0;  // computed high-poly normals: faces turned to their piece's winding
+  std::size_t high_faces_reoriented = 0;          // computed high-poly normals: faces turned to their piece's winding
   // Float spacing at the largest (referenced) coordinate of the inputs, relative to the scene
   // diagonal: the precision the meshes themselves carry. Above kCoordinateSpacingWarn the map
   // degrades measurably (data/stability/README.md, case 5).
@@ -145,9 +145,9 @@ struct BakeStats {
 };
 
 struct BakeResult {
-  Image map;                          // RGB, encoded c = n * 0.5 + 0.5
-  Image miss_mask;                    // 1 channel, share of missed samples (only with options.miss_mask)
-  Image suspect_mask;                 // 1 channel, 1 for suspect texels, else 0 (only with options.suspect_mask)
+  Image map;                           // RGB, encoded c = n * 0.5 + 0.5
+  Image miss_mask;                     // 1 channel, share of missed samples (only with options.miss_mask)
+  Image suspect_mask;                  // 1 channel, 1 for suspect texels, else 0 (only with options.suspect_mask)
   std::vector<std::uint8_t> coverage;  // per texel: 1 = covered by the UV layout
   BakeStats stats;
   // The automatic cage (BakeStats::CageSource::automatic): per low-poly position, object space as

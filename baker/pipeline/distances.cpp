@@ -51,8 +51,8 @@ std::pair<double, double> probe_scene(const ReachMode& mode, const BakeOptions& 
   if (mode.probing || !opt.keep_backfaces) {
     const std::size_t tris = low_tris.size();
     const std::size_t stride = std::max<std::size_t>(1, tris / (mode.probing ? 50000 : 5000));
-    static const double probe_bary[4][3] = {{1 / 3.0, 1 / 3.0, 1 / 3.0}, {4 / 6.0, 1 / 6.0, 1 / 6.0},
-                                            {1 / 6.0, 4 / 6.0, 1 / 6.0}, {1 / 6.0, 1 / 6.0, 4 / 6.0}};
+    static const double probe_bary[4][3] = {
+        {1 / 3.0, 1 / 3.0, 1 / 3.0}, {4 / 6.0, 1 / 6.0, 1 / 6.0}, {1 / 6.0, 4 / 6.0, 1 / 6.0}, {1 / 6.0, 1 / 6.0, 4 / 6.0}};
     std::vector<raycast::Ray> rays;
     for (std::size_t t = 0; t < tris; t += stride)
       for (const auto& b : probe_bary) {
@@ -97,10 +97,8 @@ std::pair<double, double> probe_scene(const ReachMode& mode, const BakeOptions& 
       const raycast::Hit &o = hits[2 * i], &in = hits[2 * i + 1];
       const bool o_ok = o.hit() && !(st.backfaces_skipped && is_back[2 * i] == back_is);
       const bool in_ok = in.hit() && !(st.backfaces_skipped && is_back[2 * i + 1] == back_is);
-      if (o_ok && (!in_ok || o.t <= in.t))
-        outside.push_back(o.t);
-      else if (in_ok)
-        inside.push_back(in.t);
+      if (o_ok && (!in_ok || o.t <= in.t)) outside.push_back(o.t);
+      else if (in_ok) inside.push_back(in.t);
     }
     if (mode.probing) {
       st.auto_distances = true;
@@ -147,9 +145,9 @@ void measure_reach(const ReachMode& mode, const Mesh& low, const BakeOptions& op
   if (st.high_facing == BakeStats::HighFacing::inverted) turn_inverted_high(s, h, st.high_normals_computed);
   if (mode.local_rear) {
     // Per-vertex distances (after the facing decision: the probes judge faces by it).
-    const LocalDistances ld = measure_local_distances({&s.low_pos, &low.position_index, &s.ray_normal},
-                                                      {&*h.scene, h.positions, h.index, h.facing}, mode.reach, mode.floor,
-                                                      global_front, global_rear, kNeedSlope, kLimitSlope, threads);
+    const LocalDistances ld =
+        measure_local_distances({&s.low_pos, &low.position_index, &s.ray_normal}, {&*h.scene, h.positions, h.index, h.facing},
+                                mode.reach, mode.floor, global_front, global_rear, kNeedSlope, kLimitSlope, threads);
     st.auto_distances = true;
     st.cage_front_limited = mode.auto_cage ? ld.front_limited : 0;
     st.cage_rear_limited = ld.rear_limited;
@@ -169,8 +167,8 @@ void measure_reach(const ReachMode& mode, const Mesh& low, const BakeOptions& op
     st.rear = float(st.vertex_rear.max);
   }
   st.cage = mode.file_cage   ? BakeStats::CageSource::file
-             : mode.auto_cage ? BakeStats::CageSource::automatic
-                              : BakeStats::CageSource::none;
+            : mode.auto_cage ? BakeStats::CageSource::automatic
+                             : BakeStats::CageSource::none;
   if (mode.any_cage) set_cage_reach(s, low, st.rear, result.vertex_rear, result.vertex_search);
   if (mode.file_cage && st.front < 0.0f) st.front = 0.0f;
 }

@@ -17,17 +17,17 @@
 namespace nmbake {
 
 struct ErrorEstimateOptions {
-  std::size_t texels = 4096;  // covered texels re-baked (all of them when fewer are covered)
-  int samples = 64;           // samples per re-baked texel; at least 4x the bake's, at most kMaxSamples
+  std::size_t texels = 4096;   // covered texels re-baked (all of them when fewer are covered)
+  int samples = 64;            // samples per re-baked texel; at least 4x the bake's, at most kMaxSamples
   std::uint64_t seed = 12111;  // texel choice (fixed: the same bake gives the same estimate)
   int bits = 32;               // output bit depth: 8, 16, or 32 (float, no quantisation)
 };
 
 struct ErrorEstimate {
   double mean_deg = 0, p95_deg = 0, max_deg = 0;  // bake against the re-bake, over `texels`
-  std::size_t texels = 0;                          // texels compared
-  int samples = 0;                                 // samples per texel of the re-bake
-  double seconds = 0;                              // wall time of the estimate
+  std::size_t texels = 0;                         // texels compared
+  int samples = 0;                                // samples per texel of the re-bake
+  double seconds = 0;                             // wall time of the estimate
   // Angle between the float map and its values rounded to `bits` (0 for float output).
   double quantization_mean_deg = 0, quantization_max_deg = 0;
 };

@@ -50,7 +50,8 @@ void pad_map(const BakeOptions& opt, const std::vector<std::uint8_t>& disagree, 
     if (!result.coverage[i])
       for (int c = 0; c < 3; ++c) result.map.pixels[3 * i + c] = flat[c];
   if (opt.space == NormalSpace::tangent)
-    for (std::size_t i = 0; i < result.coverage.size(); ++i) st.texels_facing_away += result.coverage[i] && result.map.pixels[3 * i + 2] < 0.5f;
+    for (std::size_t i = 0; i < result.coverage.size(); ++i)
+      st.texels_facing_away += result.coverage[i] && result.map.pixels[3 * i + 2] < 0.5f;
   find_suspects(opt, disagree, result);
   st.texels_padded = pad_islands(result.map, result.coverage, opt.padding, threads);
 }

@@ -27,8 +27,8 @@ std::vector<glm::vec3> recentre(const std::vector<glm::vec3>& pts, const glm::dv
   return out;
 }
 
-std::vector<glm::vec3> position_averaged_normals(const Mesh& low, const TangentFrames& frames, const std::vector<std::uint32_t>& weld,
-                                                 std::size_t np) {
+std::vector<glm::vec3> position_averaged_normals(const Mesh& low, const TangentFrames& frames,
+                                                 const std::vector<std::uint32_t>& weld, std::size_t np) {
   // A position whose corners all use one normal keeps it bit for bit; one with several gets the
   // normalized mean over its corners (a normal shared by more faces weighs more).
   std::vector<glm::vec3> out(np, glm::vec3(0, 0, 1));
@@ -72,26 +72,26 @@ std::vector<std::int8_t> triangle_facing(const std::vector<glm::vec3>& pos, cons
                                          const std::vector<glm::vec3>& corner_normals) {
   std::vector<std::int8_t> out(index.size() / 3);
   parallel_chunks(0, out.size(), 65536, [&](std::size_t t0, std::size_t t1) {
-  for (std::size_t t = t0; t < t1; ++t) {
-    const glm::vec3 p0 = pos[index[3 * t]], p1 = pos[index[3 * t + 1]], p2 = pos[index[3 * t + 2]];
-    const glm::vec3* c = &corner_normals[3 * t];
-    glm::vec3 f = glm::cross(p1 - p0, p2 - p0);
-    const int sign = glm::dot(f, c[0] + c[1] + c[2]) < 0.0f ? -1 : 1;
-    const float f2 = glm::dot(f, f);
-    double lean = 2.0;  // unknown
-    if (f2 > 0.0f) {
-      f *= float(sign) / std::sqrt(f2);
-      lean = 0.0;
-      for (int k = 0; k < 3 && lean < 1.0; ++k) {
-        const float n2 = glm::dot(c[k], c[k]);
-        // The sine of the angle from the face, rounded up by a little for the float arithmetic;
-        // a normal past 90 degrees (or of no length) leaves it unknown.
-        if (!(n2 > 0.0f) || !(glm::dot(c[k], f) > 0.0f)) lean = 2.0;
-        else lean = std::max(lean, double(glm::length(glm::cross(c[k], f)) / std::sqrt(n2)) + 1e-4);
+    for (std::size_t t = t0; t < t1; ++t) {
+      const glm::vec3 p0 = pos[index[3 * t]], p1 = pos[index[3 * t + 1]], p2 = pos[index[3 * t + 2]];
+      const glm::vec3* c = &corner_normals[3 * t];
+      glm::vec3 f = glm::cross(p1 - p0, p2 - p0);
+      const int sign = glm::dot(f, c[0] + c[1] + c[2]) < 0.0f ? -1 : 1;
+      const float f2 = glm::dot(f, f);
+      double lean = 2.0;  // unknown
+      if (f2 > 0.0f) {
+        f *= float(sign) / std::sqrt(f2);
+        lean = 0.0;
+        for (int k = 0; k < 3 && lean < 1.0; ++k) {
+          const float n2 = glm::dot(c[k], c[k]);
+          // The sine of the angle from the face, rounded up by a little for the float arithmetic;
+          // a normal past 90 degrees (or of no length) leaves it unknown.
+          if (!(n2 > 0.0f) || !(glm::dot(c[k], f) > 0.0f)) lean = 2.0;
+          else lean = std::max(lean, double(glm::length(glm::cross(c[k], f)) / std::sqrt(n2)) + 1e-4);
+        }
       }
+      out[t] = raycast::facing_code(sign, lean);
     }
-    out[t] = raycast::facing_code(sign, lean);
-  }
   });
   return out;
 }
@@ -111,7 +111,8 @@ void check_cage_encloses(const Prepared& s, const Mesh& cage) {
   }
   if (inside > outside)
     throw InputError(cage.source + ": the cage lies inside the low-poly (" + std::to_string(inside) + " of " +
-                     std::to_string(inside + outside) + " moved vertices are moved inwards along the normals); a cage must enclose it");
+                     std::to_string(inside + outside) +
+                     " moved vertices are moved inwards along the normals); a cage must enclose it");
 }
 
 }  // namespace

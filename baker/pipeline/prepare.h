@@ -28,7 +28,7 @@ struct Prepared {
   glm::dvec3 centre{0.0};
   double diagonal = 0.0;
   std::vector<glm::vec3> low_pos, cage_pos, high_pos;
-  std::vector<glm::vec3> ray_normal;  // per low-poly position: mean of its corners' normals
+  std::vector<glm::vec3> ray_normal;           // per low-poly position: mean of its corners' normals
   std::vector<glm::vec3> high_corner_normals;  // 3 per high-poly triangle: one cache line per hit
   // Per high-poly triangle: the side its normals point to, +1 that of cross(p1 - p0, p2 - p0)
   // (raycast::HitRule::facing).

@@ -34,5 +34,4 @@ glm::dvec3 shade_sample(const Prepared& s, const HighScene& scene, std::size_t t
   return opt.space == NormalSpace::tangent ? encode_tangent_normal(frame, nh) : nh;
 }
 
-
 }  // namespace nmbake

@@ -29,7 +29,8 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
   const int W = opt.width, H = opt.height;
   BakeStats scratch;
   Prepared s = prepare(low, high, cage, scratch);
-  if (!cage && !baked.cage_positions.empty()) attach_cage(s, baked.cage_positions, low.position_index);  // the bake's automatic cage
+  if (!cage && !baked.cage_positions.empty())
+    attach_cage(s, baked.cage_positions, low.position_index);  // the bake's automatic cage
   const bool any_cage = !s.cage_tris.empty();
   if (any_cage) set_cage_reach(s, low, st.rear, baked.vertex_rear, baked.vertex_search);
   // Few rays: a quick BVH build pays off more than a fast one to trace. All triangles: culling

@@ -11,7 +11,7 @@
 namespace nmbake {
 
 struct TileBins {
-  int side = 16;              // texels per tile side
+  int side = 16;  // texels per tile side
   int tiles_x = 0, tiles_y = 0;
   std::vector<TexelTriangle> texel_tris;  // per low-poly triangle (setup_texel_triangle)
   // The triangles of tile i (y * tiles_x + x) are tris[start[i]] .. tris[start[i + 1] - 1], in

@@ -15,7 +15,6 @@ namespace nmbake {
 
 namespace {
 
-
 constexpr std::size_t kTilesPerGrab = 4;  // consecutive tiles a trace thread takes at once
 // Tangent components this close to zero are written as exactly 0: a flat result is then
 // (128,128,255) and not a coin flip between 127 and 128 decided by float noise.
@@ -169,8 +168,11 @@ class TileTracer {
     const TileBins& bins = sh_.bins;
     const int tx0 = rect.x0, ty0 = rect.y0, tw = rect.w, th = rect.h;
     std::fill(sample_tri_.begin(), sample_tri_.end(), -1);
-    const SampleSlots slots{sample_tri_.data(), {sb_[0], sb_[1], sb_[2]}, {rays_.origin(0), rays_.origin(1), rays_.origin(2)},
-                            {rays_.direction(0), rays_.direction(1), rays_.direction(2)}, sample_fallback_.data()};
+    const SampleSlots slots{sample_tri_.data(),
+                            {sb_[0], sb_[1], sb_[2]},
+                            {rays_.origin(0), rays_.origin(1), rays_.origin(2)},
+                            {rays_.direction(0), rays_.direction(1), rays_.direction(2)},
+                            sample_fallback_.data()};
     const DefaultRays default_ray_setup{default_rays_ ? sh_.s.low_tris.data() : nullptr, sh_.setup.front};
     for (std::uint32_t bi = bins.start[tile]; bi < bins.start[tile + 1]; ++bi) {
       const std::uint32_t t = bins.tris[bi];
@@ -179,12 +181,16 @@ class TileTracer {
       const int y0 = std::max(tt.ymin, ty0), y1 = std::min(tt.ymax, ty0 + th - 1);
       if (x1 < x0 || y1 < y0) continue;
       for (std::size_t k = 0; k < sh_.offsets.size(); ++k)
-        ts_.overlaps += cover_rect(tt, std::int32_t(t), x0, x1, y0, y1, sh_.offsets[k].x, sh_.offsets[k].y, default_ray_setup, slots,
-                                   (k * std::size_t(side_) + std::size_t(y0 - ty0)) * std::size_t(side_) + std::size_t(x0 - tx0),
-                                   std::size_t(side_));
+        ts_.overlaps += cover_rect(
+            tt, std::int32_t(t), x0, x1, y0, y1, sh_.offsets[k].x, sh_.offsets[k].y, default_ray_setup, slots,
+            (k * std::size_t(side_) + std::size_t(y0 - ty0)) * std::size_t(side_) + std::size_t(x0 - tx0), std::size_t(side_));
     }
-    const CoveredSamples covered{sample_tri_.data(), {sb_[0], sb_[1], sb_[2]}, sample_texel_.data(), {slots.org[0], slots.org[1], slots.org[2]},
-                                 {slots.dir[0], slots.dir[1], slots.dir[2]}, sample_fallback_.data()};
+    const CoveredSamples covered{sample_tri_.data(),
+                                 {sb_[0], sb_[1], sb_[2]},
+                                 sample_texel_.data(),
+                                 {slots.org[0], slots.org[1], slots.org[2]},
+                                 {slots.dir[0], slots.dir[1], slots.dir[2]},
+                                 sample_fallback_.data()};
     return compact_samples(slots, slot_count_, tile_texels_, default_rays_, covered);
   }
 
@@ -196,7 +202,8 @@ class TileTracer {
       for (std::size_t r = 0; r < sample_count; ++r) {
         const double b[3] = {sb_[0][r], sb_[1][r], sb_[2][r]};
         const std::size_t tri = std::size_t(sample_tri_[r]);
-        rays_.set(r, inward_ray(cage_ray(sh_.s.low_tris[tri], sh_.s.cage_tris[tri], b, setup.diagonal), &signed_base_[r], &prefer_lo_[r]));
+        rays_.set(r, inward_ray(cage_ray(sh_.s.low_tris[tri], sh_.s.cage_tris[tri], b, setup.diagonal), &signed_base_[r],
+                                &prefer_lo_[r]));
         prefer_hi_[r] = std::numeric_limits<float>::infinity();
       }
       return;
@@ -263,14 +270,18 @@ class TileTracer {
     const bool one_ray = sh_.rays_per_sample == 1;
     std::fill(acc_.begin(), acc_.end(), 0.0);
     if (sh_.batched && sample_count) {
-      const ShadeSamples in{sample_tri_.data(), {sb_[0], sb_[1], sb_[2]}, one_ray ? hits_.triangle : chosen_tri_.data(),
-                            one_ray ? hits_.u : chosen_u_.data(), one_ray ? hits_.v : chosen_v_.data()};
+      const ShadeSamples in{sample_tri_.data(),
+                            {sb_[0], sb_[1], sb_[2]},
+                            one_ray ? hits_.triangle : chosen_tri_.data(),
+                            one_ray ? hits_.u : chosen_u_.data(),
+                            one_ray ? hits_.v : chosen_v_.data()};
       encode_hits_per_pixel(sh_.s.low_tris.data(), sh_.scene.normals, in, sample_count, value_c_, one_at_a_time_.data());
     }
     for (std::size_t r = 0; r < sample_count; ++r) {
       if (!one_at_a_time_[r]) continue;
       const double b[3] = {sb_[0][r], sb_[1][r], sb_[2][r]};
-      const glm::dvec3 v = shade_sample(sh_.s, sh_.scene, std::size_t(sample_tri_[r]), b, rays_.hit(one_ray ? r : chosen_[r]), sh_.opt);
+      const glm::dvec3 v =
+          shade_sample(sh_.s, sh_.scene, std::size_t(sample_tri_[r]), b, rays_.hit(one_ray ? r : chosen_[r]), sh_.opt);
       for (int c = 0; c < 3; ++c) value_c_[c][r] = v[c];
     }
     accumulate_samples(value_c_, sample_texel_.data(), sample_count, sums_);
@@ -286,18 +297,21 @@ class TileTracer {
         for (int x = 0; x < tw; ++x) {
           const std::size_t i = std::size_t(y) * std::size_t(side_) + std::size_t(x);
           const double n = sums_.count[i];
-          const double len2 = sums_.sum[0][i] * sums_.sum[0][i] + sums_.sum[1][i] * sums_.sum[1][i] + sums_.sum[2][i] * sums_.sum[2][i];
+          const double len2 =
+              sums_.sum[0][i] * sums_.sum[0][i] + sums_.sum[1][i] * sums_.sum[1][i] + sums_.sum[2][i] * sums_.sum[2][i];
           if (n > 1.0 && len2 < kSuspectAgreement * kSuspectAgreement * n * n)
             out.disagree[std::size_t(ty0 + y) * std::size_t(W) + std::size_t(tx0 + x)] = 1;
         }
     const bool flip_y = sh_.opt.space == NormalSpace::tangent && sh_.opt.green_down;
     for (int y = 0; y < th; ++y) {
-      const std::size_t first = std::size_t(y) * std::size_t(side_), gi = std::size_t(ty0 + y) * std::size_t(W) + std::size_t(tx0);
+      const std::size_t first = std::size_t(y) * std::size_t(side_),
+                        gi = std::size_t(ty0 + y) * std::size_t(W) + std::size_t(tx0);
       write_texel_row(sums_, first, tw, flip_y, kSnap, out.map.at(tx0, ty0 + y), &out.coverage[gi]);
       if (sh_.opt.miss_mask)
         for (int x = 0; x < tw; ++x)
           if (sums_.count[first + std::size_t(x)] > 0.0)
-            out.miss_mask.pixels[gi + std::size_t(x)] = float(miss_count_[first + std::size_t(x)]) / float(sums_.count[first + std::size_t(x)]);
+            out.miss_mask.pixels[gi + std::size_t(x)] =
+                float(miss_count_[first + std::size_t(x)]) / float(sums_.count[first + std::size_t(x)]);
     }
   }
 
@@ -324,7 +338,7 @@ class TileTracer {
   std::vector<double> value_;
   double* value_c_[3];
   std::vector<std::uint8_t> one_at_a_time_;  // per covered sample: shaded by shade_sample
-  std::vector<double> acc_;  // per texel of the tile: x, y, z sums and covered samples, as arrays
+  std::vector<double> acc_;                  // per texel of the tile: x, y, z sums and covered samples, as arrays
   TexelSums sums_;
   std::vector<std::uint32_t> miss_count_;
 };

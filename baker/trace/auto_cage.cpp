@@ -54,8 +54,8 @@ void ease(std::vector<double>& value, const std::vector<std::vector<std::pair<st
 
 }  // namespace
 
-LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& high, double reach, double floor, double front_base,
-                                       double rear_base, double need_slope, double limit_slope, int threads) {
+LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& high, double reach, double floor,
+                                       double front_base, double rear_base, double need_slope, double limit_slope, int threads) {
   const std::vector<glm::vec3>& pos = *low.positions;
   const std::vector<std::uint32_t>& index = *low.index;
   const std::vector<glm::vec3>& rn = *low.ray_normals;
@@ -78,8 +78,8 @@ LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& h
     }
   }
   const std::size_t stride = std::max<std::size_t>(1, tris / 50000);
-  static const double bary[4][3] = {{1 / 3.0, 1 / 3.0, 1 / 3.0}, {4 / 6.0, 1 / 6.0, 1 / 6.0}, {1 / 6.0, 4 / 6.0, 1 / 6.0},
-                                    {1 / 6.0, 1 / 6.0, 4 / 6.0}};
+  static const double bary[4][3] = {
+      {1 / 3.0, 1 / 3.0, 1 / 3.0}, {4 / 6.0, 1 / 6.0, 1 / 6.0}, {1 / 6.0, 4 / 6.0, 1 / 6.0}, {1 / 6.0, 1 / 6.0, 4 / 6.0}};
   for (std::size_t t = 0; t < tris; t += stride) {
     const std::uint32_t* c = &index[3 * t];
     const glm::dvec3 p0(pos[c[0]]), p1(pos[c[1]]), p2(pos[c[2]]);
@@ -98,7 +98,8 @@ LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& h
   std::vector<std::int8_t> low_facing(tris, 1);
   for (std::size_t t = 0; t < tris; ++t) {
     const glm::dvec3 p0(pos[index[3 * t]]), p1(pos[index[3 * t + 1]]), p2(pos[index[3 * t + 2]]);
-    const glm::dvec3 n = glm::dvec3(corner_normals[3 * t]) + glm::dvec3(corner_normals[3 * t + 1]) + glm::dvec3(corner_normals[3 * t + 2]);
+    const glm::dvec3 n =
+        glm::dvec3(corner_normals[3 * t]) + glm::dvec3(corner_normals[3 * t + 1]) + glm::dvec3(corner_normals[3 * t + 2]);
     if (glm::dot(glm::cross(p1 - p0, p2 - p0), n) < 0.0) low_facing[t] = -1;
   }
   const raycast::Scene self(&pos[0].x, pos.size(), index.data(), tris, raycast::BuildQuality::low, threads);

@@ -68,7 +68,7 @@ struct LocalDistances {
 // farther. `need_slope`: how much a need falls per unit of length along an edge (a bulge's need
 // covers its surroundings as far as it is tall with 1); `limit_slope`: how much a limit rises (the
 // cage's tilt where a neighbouring part limits it stays within atan(limit_slope)).
-LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& high, double reach, double floor, double front_base,
-                                       double rear_base, double need_slope, double limit_slope, int threads);
+LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& high, double reach, double floor,
+                                       double front_base, double rear_base, double need_slope, double limit_slope, int threads);
 
 }  // namespace nmbake

@@ -18,8 +18,8 @@ namespace {
 // on one low-poly triangle, whose data is then loaded once and broadcast instead of gathered.
 template <bool same_triangle>
 [[gnu::always_inline]] inline void encode_block(const LowTriangle* low, const glm::vec3* high_corner_normals,
-                                                const ShadeSamples& in, std::size_t i, std::size_t count,
-                                                double* const value[3], std::uint8_t* degenerate) {
+                                                const ShadeSamples& in, std::size_t i, std::size_t count, double* const value[3],
+                                                std::uint8_t* degenerate) {
   const V zero = {0.0, 0.0, 0.0, 0.0};
   const bool full = i + kLanes <= count;
   std::size_t at[kLanes];
@@ -38,10 +38,8 @@ template <bool same_triangle>
   V3 n[3], t[3], hn[3];
 #pragma GCC unroll 3
   for (int c = 0; c < 3; ++c) {
-    if (full)
-      std::memcpy(&b[c], &in.b[c][i], sizeof(V));
-    else
-      gather(b[c], [&](int k) { return in.b[c][at[k]]; });
+    if (full) std::memcpy(&b[c], &in.b[c][i], sizeof(V));
+    else gather(b[c], [&](int k) { return in.b[c][at[k]]; });
     gather(n[c].x, [&](int k) { return lp[k]->n[c].x; });
     gather(n[c].y, [&](int k) { return lp[k]->n[c].y; });
     gather(n[c].z, [&](int k) { return lp[k]->n[c].z; });
@@ -110,16 +108,14 @@ template <bool same_triangle>
 // Two versions, chosen once at load time by the CPU: AVX2 (4 lanes per instruction) and the
 // baseline (2 lanes per SSE2 instruction). Neither uses FMA, so both give the scalar code's bits.
 __attribute__((target_clones("avx2", "default"))) void encode_hits_per_pixel(const LowTriangle* low,
-                                                                              const glm::vec3* high_corner_normals,
-                                                                              const ShadeSamples& samples,
-                                                                              std::size_t count, double* const value[3],
-                                                                              std::uint8_t* degenerate) {
+                                                                             const glm::vec3* high_corner_normals,
+                                                                             const ShadeSamples& samples, std::size_t count,
+                                                                             double* const value[3], std::uint8_t* degenerate) {
   for (std::size_t i = 0; i < count; i += kLanes) {
     const std::int32_t* lt = samples.low_tri;
     if (i + kLanes <= count && lt[i] == lt[i + 1] && lt[i] == lt[i + 2] && lt[i] == lt[i + 3])
       encode_block<true>(low, high_corner_normals, samples, i, count, value, degenerate);
-    else
-      encode_block<false>(low, high_corner_normals, samples, i, count, value, degenerate);
+    else encode_block<false>(low, high_corner_normals, samples, i, count, value, degenerate);
   }
 }
 

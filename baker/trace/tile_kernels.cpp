@@ -44,10 +44,10 @@ namespace {
 
 // Two versions, chosen once at load time by the CPU: AVX2 and the SSE2 baseline. Neither uses FMA,
 // so both give the scalar code's bits.
-__attribute__((target_clones("avx2", "default"))) std::size_t cover_rect(const TexelTriangle& tt, std::int32_t t, int x0,
-                                                                          int x1, int y0, int y1, double ox, double oy,
-                                                                          const DefaultRays& rays, const SampleSlots& slots,
-                                                                          std::size_t first, std::size_t row_stride) {
+__attribute__((target_clones("avx2", "default"))) std::size_t cover_rect(const TexelTriangle& tt, std::int32_t t, int x0, int x1,
+                                                                         int y0, int y1, double ox, double oy,
+                                                                         const DefaultRays& rays, const SampleSlots& slots,
+                                                                         std::size_t first, std::size_t row_stride) {
   std::size_t taken = 0;
   const V zero = {0.0, 0.0, 0.0, 0.0};
   double inv_dy[3];  // for the rows' bounds, which need not be exact
@@ -102,10 +102,8 @@ __attribute__((target_clones("avx2", "default"))) std::size_t cover_rect(const T
       V3 org{zero, zero, zero}, dir{zero, zero, zero};
       unsigned good = 0;
       if (rays.low) default_ray(rays.low[t], double(rays.front), b, org, dir, good);
-      const F of[3] = {__builtin_convertvector(org.x, F), __builtin_convertvector(org.y, F),
-                       __builtin_convertvector(org.z, F)};
-      const F df[3] = {__builtin_convertvector(dir.x, F), __builtin_convertvector(dir.y, F),
-                       __builtin_convertvector(dir.z, F)};
+      const F of[3] = {__builtin_convertvector(org.x, F), __builtin_convertvector(org.y, F), __builtin_convertvector(org.z, F)};
+      const F df[3] = {__builtin_convertvector(dir.x, F), __builtin_convertvector(dir.y, F), __builtin_convertvector(dir.z, F)};
       const std::size_t slot0 = row + std::size_t(x - x0);
       if (m == 0xfu) {
         // The common case, four lanes at once: all four samples covered, their slots free, none
@@ -150,9 +148,9 @@ __attribute__((target_clones("avx2", "default"))) std::size_t cover_rect(const T
   return taken;
 }
 
-__attribute__((target_clones("avx2", "default"))) std::size_t compact_samples(const SampleSlots& slots,
-                                                                               std::size_t slot_count, std::size_t texels,
-                                                                               bool rays, const CoveredSamples& out) {
+__attribute__((target_clones("avx2", "default"))) std::size_t compact_samples(const SampleSlots& slots, std::size_t slot_count,
+                                                                              std::size_t texels, bool rays,
+                                                                              const CoveredSamples& out) {
   std::size_t n = 0;
   // Entry i to entry n <= i, one value at a time (in place, n may equal i).
   const auto copy_one = [&](std::size_t i) {
@@ -205,8 +203,8 @@ __attribute__((target_clones("avx2", "default"))) std::size_t compact_samples(co
 }
 
 __attribute__((target_clones("avx2", "default"))) void accumulate_samples(const double* const value[3],
-                                                                           const std::uint16_t* texel, std::size_t count,
-                                                                           const TexelSums& sums) {
+                                                                          const std::uint16_t* texel, std::size_t count,
+                                                                          const TexelSums& sums) {
   const auto add_one = [&](std::size_t i) {
     const std::size_t t = texel[i];
     for (int c = 0; c < 3; ++c) sums.sum[c][t] += value[c][i];
@@ -236,9 +234,9 @@ __attribute__((target_clones("avx2", "default"))) void accumulate_samples(const 
   for (; i < count; ++i) add_one(i);
 }
 
-__attribute__((target_clones("avx2", "default"))) void write_texel_row(const TexelSums& sums, std::size_t first,
-                                                                        int width, bool flip_y, double snap, float* rgb,
-                                                                        std::uint8_t* covered) {
+__attribute__((target_clones("avx2", "default"))) void write_texel_row(const TexelSums& sums, std::size_t first, int width,
+                                                                       bool flip_y, double snap, float* rgb,
+                                                                       std::uint8_t* covered) {
   const V zero = {0.0, 0.0, 0.0, 0.0};
   for (int x = 0; x < width; x += kLanes) {
     const int n = std::min(kLanes, width - x);

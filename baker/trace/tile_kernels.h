@@ -70,8 +70,7 @@ struct TexelSums {
 
 // For each sample i < count, in order: sums.sum[c][texel[i]] += value[c][i] (c = 0, 1, 2) and
 // sums.count[texel[i]] += 1.
-void accumulate_samples(const double* const value[3], const std::uint16_t* texel, std::size_t count,
-                        const TexelSums& sums);
+void accumulate_samples(const double* const value[3], const std::uint16_t* texel, std::size_t count, const TexelSums& sums);
 
 // Texels first .. first + width - 1 of `sums` (one row): each with a positive count is written as
 // v * 0.5 + 0.5 (float) to rgb[3x], rgb[3x + 1], rgb[3x + 2] with covered[x] = 1, where v is its

@@ -22,14 +22,16 @@ std::vector<KnownTexel> known_texels(const HardAsset& a, int size) {
   const std::vector<std::int32_t> owner = rasterize_texel_triangles(a.low, size, size);
   std::vector<KnownTexel> out;
   for (std::size_t i = 0; i < owner.size(); ++i)
-    if (owner[i] >= 0) out.push_back({std::uint32_t(i), std::uint32_t(owner[i]), {0, 0, 0}, a.low_part[std::size_t(owner[i])], {}});
+    if (owner[i] >= 0)
+      out.push_back({std::uint32_t(i), std::uint32_t(owner[i]), {0, 0, 0}, a.low_part[std::size_t(owner[i])], {}});
   std::vector<std::uint8_t> keep(out.size(), 0);
   parallel_chunks(0, out.size(), 512, [&](std::size_t k0, std::size_t k1) {
     for (std::size_t k = k0; k < k1; ++k) {
       KnownTexel& kt = out[k];
       const std::size_t t = kt.tri;
       const int x = int(kt.texel % std::uint32_t(size)), y = int(kt.texel / std::uint32_t(size));
-      const TexelTriangle tri = setup_texel_triangle(a.low.corner_uv(t, 0), a.low.corner_uv(t, 1), a.low.corner_uv(t, 2), size, size);
+      const TexelTriangle tri =
+          setup_texel_triangle(a.low.corner_uv(t, 0), a.low.corner_uv(t, 1), a.low.corner_uv(t, 2), size, size);
       if (!covers(tri, sample_point(x, y, 0.5, 0.5), kt.b)) continue;
       glm::dvec3 p(0.0), dir(0.0);
       for (int c = 0; c < 3; ++c) {

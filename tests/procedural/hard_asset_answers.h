@@ -29,11 +29,11 @@ struct KnownTexel {
 std::vector<KnownTexel> known_texels(const HardAsset& asset, int size);
 
 struct KnownErrors {
-  std::size_t texels = 0;      // measured: covered in the map, of a part asked for
+  std::size_t texels = 0;  // measured: covered in the map, of a part asked for
   double mean_deg = 0.0, worst_deg = 0.0;
   double over1 = 0.0, over60 = 0.0;  // share of the texels more than 1 (60) degrees off
   std::size_t over60_texels = 0;
-  std::size_t other_surface = 0;     // texels more than 120 degrees off: a surface facing the other way
+  std::size_t other_surface = 0;  // texels more than 120 degrees off: a surface facing the other way
 };
 
 // A tangent-space float map baked from asset.low (result.map, result.coverage; green up,

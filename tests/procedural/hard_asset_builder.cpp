@@ -50,8 +50,7 @@ void fill_disc(Builder& out, const Ring& outer, int rings, double radius,
   }
   const Corner centre = vertex(0.0, 0.0);
   for (std::size_t k = 0; k + 1 < previous.size(); ++k)
-    up ? out.triangle(centre, previous[k], previous[k + 1], part)
-       : out.triangle(centre, previous[k + 1], previous[k], part);
+    up ? out.triangle(centre, previous[k], previous[k + 1], part) : out.triangle(centre, previous[k + 1], previous[k], part);
 }
 
 std::vector<Ring> add_wall(Builder& out, int around, int along, double z0, double z1,
@@ -62,7 +61,8 @@ std::vector<Ring> add_wall(Builder& out, int around, int along, double z0, doubl
     const double z = j == along ? z1 : z0 + (z1 - z0) * j / along;
     std::function<glm::dvec2()> seam;
     if (seam_uv) seam = [&] { return seam_uv(z); };
-    rings.push_back(make_ring(out, around, [&](double theta) { return corner(theta, z); }, seam));
+    rings.push_back(make_ring(
+        out, around, [&](double theta) { return corner(theta, z); }, seam));
     if (j == 0) continue;
     const Ring &lower = rings[std::size_t(j - 1)], &upper = rings[std::size_t(j)];
     bore ? stitch(out, upper, lower, part) : stitch(out, lower, upper, part);
@@ -82,9 +82,8 @@ void add_annulus(Builder& out, const Ring& outer, const Ring& inner, int segment
   Ring previous = outer;
   for (int s = 1; s <= segments; ++s) {
     const double rho = r_outer + (r_inner - r_outer) * s / segments;
-    const Ring ring = s == segments ? inner : make_ring(out, int(outer.size()) - 1, [&](double theta) {
-      return vertex(rho, theta);
-    });
+    const Ring ring =
+        s == segments ? inner : make_ring(out, int(outer.size()) - 1, [&](double theta) { return vertex(rho, theta); });
     up ? stitch(out, previous, ring, part) : stitch(out, ring, previous, part);
     previous = ring;
   }
@@ -98,8 +97,8 @@ std::function<Corner(double, double)> flat_vertex(Builder& out, glm::dvec2 axis,
   };
 }
 
-void add_capped_cylinder(Builder& out, glm::dvec2 axis, double radius, double z0, double z1, int around, int along,
-                         int cap_rings, const std::function<Corner(double theta, double z)>& side,
+void add_capped_cylinder(Builder& out, glm::dvec2 axis, double radius, double z0, double z1, int around, int along, int cap_rings,
+                         const std::function<Corner(double theta, double z)>& side,
                          const std::function<glm::dvec2(double z)>& seam_uv,
                          const std::function<glm::dvec2(bool top, double x, double y)>& cap_uv, int part) {
   const std::vector<Ring> rings = add_wall(out, around, along, z0, z1, side, seam_uv, false, part);

@@ -109,8 +109,8 @@ std::function<Corner(double, double)> flat_vertex(Builder& out, glm::dvec2 axis,
 // A closed cylinder around `axis` from z0 to z1 whose wall, made by side(theta, z), ends in circles
 // of `radius`; flat caps of cap_rings rings with their own normals. cap_uv(top, x, y) gives a cap
 // corner's UV from its position relative to the axis (nullptr: no UVs).
-void add_capped_cylinder(Builder& out, glm::dvec2 axis, double radius, double z0, double z1, int around, int along,
-                         int cap_rings, const std::function<Corner(double theta, double z)>& side,
+void add_capped_cylinder(Builder& out, glm::dvec2 axis, double radius, double z0, double z1, int around, int along, int cap_rings,
+                         const std::function<Corner(double theta, double z)>& side,
                          const std::function<glm::dvec2(double z)>& seam_uv,
                          const std::function<glm::dvec2(bool top, double x, double y)>& cap_uv, int part);
 

@@ -13,10 +13,8 @@ double bisect(const Patch& f, const glm::dvec3& p, const glm::dvec3& dir, double
   for (int it = 0; it < 200 && std::abs(b - a) > 1e-15 + 1e-13 * std::abs(a); ++it) {
     const double m = 0.5 * (a + b), gm = f.implicit(p + m * dir);
     if (gm == 0) return m;
-    if ((gm < 0) == (ga < 0))
-      a = m, ga = gm;
-    else
-      b = m;
+    if ((gm < 0) == (ga < 0)) a = m, ga = gm;
+    else b = m;
   }
   return 0.5 * (a + b);
 }
@@ -47,8 +45,8 @@ SurfacePoint locate_on(const Part& part, const glm::dvec3& p, const glm::dvec3& 
         // On an edge between two patches (a vertex of the high-poly there, rounded to float) the
         // crossings coincide: take the patch the line meets most squarely.
         const bool tie = best.crossed && std::abs(std::abs(s) - std::abs(best.s)) <= kTie;
-        if (best.crossed && !(tie ? std::abs(glm::dot(n, dir)) > std::abs(glm::dot(best.normal, dir))
-                                  : std::abs(s) < std::abs(best.s)))
+        if (best.crossed &&
+            !(tie ? std::abs(glm::dot(n, dir)) > std::abs(glm::dot(best.normal, dir)) : std::abs(s) < std::abs(best.s)))
           continue;
         best = {true, s, x, n};
       }
@@ -74,9 +72,7 @@ void attach_surfaces(HardAsset& asset, std::vector<Part> parts, double max_s) {
     return locate_on((*shared)[std::size_t(part)], p, dir, max_s);
   };
   auto locate = asset.locate;
-  asset.expected_normal = [locate](const glm::dvec3& p, const glm::dvec3& dir, int part) {
-    return locate(p, dir, part).normal;
-  };
+  asset.expected_normal = [locate](const glm::dvec3& p, const glm::dvec3& dir, int part) { return locate(p, dir, part).normal; };
 }
 
 }  // namespace nmbake::procedural::detail

@@ -26,7 +26,7 @@ class Patch {
   virtual double implicit(const glm::dvec3& x) const = 0;
   // Whether a point of the implicit surface belongs to this patch.
   virtual bool contains(const glm::dvec3& x) const = 0;
-  virtual glm::dvec3 normal(const glm::dvec3& x) const = 0;  // unit outward, at a point of the patch
+  virtual glm::dvec3 normal(const glm::dvec3& x) const = 0;   // unit outward, at a point of the patch
   virtual glm::dvec3 closest(const glm::dvec3& p) const = 0;  // the patch point nearest to p
 };
 using Part = std::vector<std::shared_ptr<const Patch>>;
@@ -92,9 +92,7 @@ class RadialSurface final : public Patch {
     return bore_ ? r - rho : rho - r;
   }
   bool contains(const glm::dvec3& x) const override { return x.z >= z0_ - kEdgeSlack && x.z <= z1_ + kEdgeSlack; }
-  glm::dvec3 normal(const glm::dvec3& x) const override {
-    return normal_at(std::atan2(x.y - axis_.y, x.x - axis_.x), x.z);
-  }
+  glm::dvec3 normal(const glm::dvec3& x) const override { return normal_at(std::atan2(x.y - axis_.y, x.x - axis_.x), x.z); }
   glm::dvec3 closest(const glm::dvec3& p) const override {
     auto eval = [&](double theta, double z, glm::dvec3& s, glm::dvec3& su, glm::dvec3& sv) {
       const Jet r = radius(theta, z);

@@ -56,8 +56,8 @@ HardAsset make_close_tubes(double gap, double bulge, int around_low, int along_l
     for (int i = 0; i < kTubes; ++i) {
       const RadialSurface& side = *sides[std::size_t(i)];
       auto corner = [&](double theta, double z) { return out.corner(side.point(theta, z), side.normal_at(theta, z)); };
-      add_capped_cylinder(out, axes[std::size_t(i)], R, z0, z1, around_high, along_high, std::max(1, around_high / 24),
-                          corner, nullptr, nullptr, i);
+      add_capped_cylinder(out, axes[std::size_t(i)], R, z0, z1, around_high, along_high, std::max(1, around_high / 24), corner,
+                          nullptr, nullptr, i);
     }
   }
   {
@@ -130,10 +130,8 @@ HardAsset make_thin_shell(double thickness, int around_low, int rings_low, int a
       Ring ring;
       for (int k = 0; k <= around; ++k) {
         const double theta = 2 * kPi * k / around;
-        if (m == 0 || m == rim_segments)
-          ring.push_back(rim_reuse(outer[m == 0 ? 0 : 1][std::size_t(k)], theta, phi));
-        else
-          ring.push_back(k < around ? rim_corner(theta, phi) : rim_reuse(ring.front(), theta, phi));
+        if (m == 0 || m == rim_segments) ring.push_back(rim_reuse(outer[m == 0 ? 0 : 1][std::size_t(k)], theta, phi));
+        else ring.push_back(k < around ? rim_corner(theta, phi) : rim_reuse(ring.front(), theta, phi));
       }
       band.push_back(ring);
       if (m > 0) stitch(out, band[std::size_t(m)], band[std::size_t(m - 1)], 2);
@@ -164,9 +162,7 @@ HardAsset make_thin_shell(double thickness, int around_low, int rings_low, int a
     auto rim_corner = [&](double theta, double phi) {
       return out.corner(rim->point(theta, phi), TorusRim::normal_at(theta, phi), rim_uv(theta, phi));
     };
-    auto rim_reuse = [&](const Corner& c, double theta, double phi) {
-      return Corner{c.p, c.n, out.uv(rim_uv(theta, phi))};
-    };
+    auto rim_reuse = [&](const Corner& c, double theta, double phi) { return Corner{c.p, c.n, out.uv(rim_uv(theta, phi))}; };
     build(out, around_low, rings_low, 4, face, rim_corner, rim_reuse);
   }
   const double displacement = amplitude + std::max(sagitta(Rd, around_low), sagitta(t2, 8));
@@ -174,7 +170,6 @@ HardAsset make_thin_shell(double thickness, int around_low, int rings_low, int a
   name_meshes(asset);
   return asset;
 }
-
 
 // ---- Rod in a bore ----
 
@@ -198,8 +193,9 @@ HardAsset make_cavity(double gap, int around_low, int along_low, int around_high
     return rod + (-amplitude) * sin2(0.5 * (10.0 * t + (2 * kPi / 0.06) * h)) * ends;
   };
   const glm::dvec2 axis(0.0);
-  const auto outer_wall = std::make_shared<RadialSurface>(axis, -kPipeHalf, kPipeHalf, false,
-                                                          [](double, double) { return Jet{kOuter, 0, 0}; });
+  const auto outer_wall = std::make_shared<RadialSurface>(axis, -kPipeHalf, kPipeHalf, false, [](double, double) {
+    return Jet{kOuter, 0, 0};
+  });
   const auto bore_wall = std::make_shared<RadialSurface>(axis, -kPipeHalf, kPipeHalf, true, bore_radius);
   const auto rod_side = std::make_shared<RadialSurface>(axis, -kRodHalf, kRodHalf, false, rod_radius);
   std::vector<Part> parts = {
@@ -216,9 +212,8 @@ HardAsset make_cavity(double gap, int around_low, int along_low, int around_high
       std::function<glm::dvec2(double, double)> uv;
       if (ring_uv) uv = [&ring_uv, top](double x, double y) { return ring_uv(top, x, y); };
       auto edge_uv = [&](double radius) {
-        return [&uv, radius](double theta) {
-          return uv ? uv(radius * std::cos(theta), radius * std::sin(theta)) : glm::dvec2(0.0);
-        };
+        return
+            [&uv, radius](double theta) { return uv ? uv(radius * std::cos(theta), radius * std::sin(theta)) : glm::dvec2(0.0); };
       };
       const std::uint32_t n = out.normal({0.0, 0.0, top ? 1.0 : -1.0});
       add_annulus(out, edge_ring(out, top ? outer.back() : outer.front(), n, edge_uv(kOuter)),
@@ -240,33 +235,35 @@ HardAsset make_cavity(double gap, int around_low, int along_low, int around_high
                         corner(*rod_side), nullptr, nullptr, 1);
   }
   {
-    const std::vector<Island> islands =
-        pack_islands({{2 * kPi * kOuter, 2 * kPipeHalf}, {2 * kPi * kInner, 2 * kPipeHalf}, {2 * kOuter, 2 * kOuter},
-                      {2 * kOuter, 2 * kOuter}, {2 * kPi * rod, 2 * kRodHalf}, {2 * rod, 2 * rod}, {2 * rod, 2 * rod}});
+    const std::vector<Island> islands = pack_islands({{2 * kPi * kOuter, 2 * kPipeHalf},
+                                                      {2 * kPi * kInner, 2 * kPipeHalf},
+                                                      {2 * kOuter, 2 * kOuter},
+                                                      {2 * kOuter, 2 * kOuter},
+                                                      {2 * kPi * rod, 2 * kRodHalf},
+                                                      {2 * rod, 2 * rod},
+                                                      {2 * rod, 2 * rod}});
     Builder out(asset.low, asset.low_part, true);
     // A plain wall of radius r unrolled into `island`; the bore's runs against theta, so that its
     // UVs keep the winding of faces that face the axis.
     auto plain = [&](double r, bool bore, const Island& island, double z0) {
       return [&out, r, bore, island, z0](double theta, double z) {
         const glm::dvec3 e(std::cos(theta), std::sin(theta), 0.0);
-        return out.corner(glm::dvec3(0, 0, z) + r * e, bore ? -e : e,
-                          island((bore ? 2 * kPi - theta : theta) * r, z - z0));
+        return out.corner(glm::dvec3(0, 0, z) + r * e, bore ? -e : e, island((bore ? 2 * kPi - theta : theta) * r, z - z0));
       };
     };
     auto seam = [&](double r, bool bore, const Island& island, double z0) {
       return [r, bore, island, z0](double z) { return island(bore ? 0.0 : 2 * kPi * r, z - z0); };
     };
-    const auto outer = add_wall(out, around_low, along_low, -kPipeHalf, kPipeHalf,
-                                plain(kOuter, false, islands[0], -kPipeHalf), seam(kOuter, false, islands[0], -kPipeHalf),
-                                false, 0);
-    const auto bore = add_wall(out, around_low, along_low, -kPipeHalf, kPipeHalf,
-                               plain(kInner, true, islands[1], -kPipeHalf), seam(kInner, true, islands[1], -kPipeHalf),
-                               true, 0);
+    const auto outer = add_wall(out, around_low, along_low, -kPipeHalf, kPipeHalf, plain(kOuter, false, islands[0], -kPipeHalf),
+                                seam(kOuter, false, islands[0], -kPipeHalf), false, 0);
+    const auto bore = add_wall(out, around_low, along_low, -kPipeHalf, kPipeHalf, plain(kInner, true, islands[1], -kPipeHalf),
+                               seam(kInner, true, islands[1], -kPipeHalf), true, 0);
     add_end_rings(out, outer, bore, 1,
                   [&](bool top, double x, double y) { return disc_uv(islands[top ? 2 : 3], kOuter, top, x, y); });
-    add_capped_cylinder(out, axis, rod, -kRodHalf, kRodHalf, around_low, along_low, 2,
-                        plain(rod, false, islands[4], -kRodHalf), seam(rod, false, islands[4], -kRodHalf),
-                        [&](bool top, double x, double y) { return disc_uv(islands[top ? 5 : 6], rod, top, x, y); }, 1);
+    add_capped_cylinder(
+        out, axis, rod, -kRodHalf, kRodHalf, around_low, along_low, 2, plain(rod, false, islands[4], -kRodHalf),
+        seam(rod, false, islands[4], -kRodHalf),
+        [&](bool top, double x, double y) { return disc_uv(islands[top ? 5 : 6], rod, top, x, y); }, 1);
   }
   const double displacement = amplitude + sagitta(kOuter, around_low);
   attach_surfaces(asset, std::move(parts), 3 * displacement);

@@ -69,8 +69,8 @@ struct HardAsset {
 // one island per side (unrolled) and per cap. Parts: tube index 0..4 from -x to +x.
 // around_high must be a multiple of 4 and along_high even (vertices on the facing lines and the top).
 // Defaults: 199,680 high triangles.
-HardAsset make_close_tubes(double gap = 0.012, double bulge = 0.04, int around_low = 24, int along_low = 8,
-                           int around_high = 192, int along_high = 96);
+HardAsset make_close_tubes(double gap = 0.012, double bulge = 0.04, int around_low = 24, int along_low = 8, int around_high = 192,
+                           int along_high = 96);
 
 // An "ear": a closed slab over the disc of radius 0.4 in xy, top z = thickness/2 + d_top(x, y),
 // bottom z = -thickness/2 - d_bottom(x, y) (egg-crate on top, diagonal waves below, amplitude
@@ -91,8 +91,7 @@ HardAsset make_thin_shell(double thickness = 0.01, int around_low = 48, int ring
 // wall, a helical groove cut into the rod, so the clearance is never less than `gap`. The bore
 // wall's normals point to the axis. Low-poly: plain cylinders and rings, normals split at the end
 // rings and caps; UVs: one island per wall, ring and cap. Defaults: 111,616 high triangles.
-HardAsset make_cavity(double gap = 0.01, int around_low = 32, int along_low = 4, int around_high = 256,
-                      int along_high = 96);
+HardAsset make_cavity(double gap = 0.01, int around_low = 32, int along_low = 4, int around_high = 256, int along_high = 96);
 
 // A box of half-size `half` whose high-poly has every edge and corner rounded with radius `bevel`
 // (the rounded-box SDF; flat_high quads across each face's flat part, bevel_high across each

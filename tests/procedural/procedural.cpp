@@ -24,12 +24,9 @@ Mesh make_sphere(int nphi, int ntheta, const std::function<double(double, double
     for (int i = 0; i < nphi; ++i) {
       const std::uint32_t a = id(i, j), b = id(i, j + 1), c = id(i + 1, j + 1), d = id(i + 1, j);
       std::vector<std::uint32_t> tri;
-      if (j == 0)
-        tri = {a, b, c};  // a and d are the north pole
-      else if (j == ntheta - 1)
-        tri = {a, b, d};  // b and c are the south pole
-      else
-        tri = {a, b, d, b, c, d};
+      if (j == 0) tri = {a, b, c};                // a and d are the north pole
+      else if (j == ntheta - 1) tri = {a, b, d};  // b and c are the south pole
+      else tri = {a, b, d, b, c, d};
       for (std::uint32_t v : tri) {
         m.position_index.push_back(v);
         m.uv_index.push_back(v);
@@ -40,9 +37,7 @@ Mesh make_sphere(int nphi, int ntheta, const std::function<double(double, double
   return m;
 }
 
-double displaced_sphere_radius(double a, double k, double th, double ph) {
-  return 1.0 + a * std::sin(k * th) * std::sin(k * ph);
-}
+double displaced_sphere_radius(double a, double k, double th, double ph) { return 1.0 + a * std::sin(k * th) * std::sin(k * ph); }
 
 glm::dvec3 displaced_sphere_normal(double a, double k, double th, double ph) {
   const glm::dvec3 er(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th));

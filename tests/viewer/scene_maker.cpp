@@ -72,8 +72,7 @@ void write_bumpy_sphere(const std::string& path, int segments, int rings, double
   for (int i = 0; i <= rings; ++i)
     for (int j = 0; j <= segments; ++j) {
       const glm::dvec3 d = sphere_direction(i, j, segments, rings);
-      const double r =
-          1.0 + amplitude * (std::sin(frequency * d.x) + std::sin(frequency * d.y) + std::sin(frequency * d.z));
+      const double r = 1.0 + amplitude * (std::sin(frequency * d.x) + std::sin(frequency * d.y) + std::sin(frequency * d.z));
       out << "v " << r * d.x << " " << r * d.y << " " << r * d.z << "\n";
     }
   write_faces(out, segments, rings, false);
@@ -96,9 +95,9 @@ namespace {
 
 // The cube's faces as corner quads, counter-clockwise seen from outside.
 constexpr int kCubeFaces[6][4][3] = {
-    {{1, -1, -1}, {1, 1, -1}, {1, 1, 1}, {1, -1, 1}},     {{-1, -1, 1}, {-1, 1, 1}, {-1, 1, -1}, {-1, -1, -1}},
-    {{-1, 1, -1}, {-1, 1, 1}, {1, 1, 1}, {1, 1, -1}},     {{-1, -1, 1}, {-1, -1, -1}, {1, -1, -1}, {1, -1, 1}},
-    {{-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}},     {{1, -1, -1}, {-1, -1, -1}, {-1, 1, -1}, {1, 1, -1}}};
+    {{1, -1, -1}, {1, 1, -1}, {1, 1, 1}, {1, -1, 1}}, {{-1, -1, 1}, {-1, 1, 1}, {-1, 1, -1}, {-1, -1, -1}},
+    {{-1, 1, -1}, {-1, 1, 1}, {1, 1, 1}, {1, 1, -1}}, {{-1, -1, 1}, {-1, -1, -1}, {1, -1, -1}, {1, -1, 1}},
+    {{-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}}, {{1, -1, -1}, {-1, -1, -1}, {-1, 1, -1}, {1, 1, -1}}};
 
 glm::dvec3 cube_corner(int face, int k) {
   return {double(kCubeFaces[face][k][0]), double(kCubeFaces[face][k][1]), double(kCubeFaces[face][k][2])};
@@ -118,7 +117,9 @@ void write_smooth_cube(const std::string& path) {
       out << "v " << p.x << " " << p.y << " " << p.z << "\nvn " << n.x << " " << n.y << " " << n.z << "\nvt "
           << u0 + square[k][0] * su << " " << v0 + square[k][1] * sv << "\n";
     }
-    auto c = [&](int k) { return std::to_string(vertex + k + 1) + "/" + std::to_string(vertex + k + 1) + "/" + std::to_string(vertex + k + 1); };
+    auto c = [&](int k) {
+      return std::to_string(vertex + k + 1) + "/" + std::to_string(vertex + k + 1) + "/" + std::to_string(vertex + k + 1);
+    };
     out << "f " << c(0) << " " << c(1) << " " << c(2) << "\nf " << c(0) << " " << c(2) << " " << c(3) << "\n";
     vertex += 4;
   }
@@ -133,8 +134,8 @@ void write_normal_detail_cube(const std::string& path, int cells) {
     for (int j = 0; j <= cells; ++j)
       for (int i = 0; i <= cells; ++i) {
         const double s = double(i) / cells, t = double(j) / cells;
-        const glm::dvec3 p = (1 - s) * (1 - t) * cube_corner(f, 0) + s * (1 - t) * cube_corner(f, 1) +
-                             s * t * cube_corner(f, 2) + (1 - s) * t * cube_corner(f, 3);
+        const glm::dvec3 p = (1 - s) * (1 - t) * cube_corner(f, 0) + s * (1 - t) * cube_corner(f, 1) + s * t * cube_corner(f, 2) +
+                             (1 - s) * t * cube_corner(f, 3);
         const glm::dvec3 wave(std::sin(5 * p.y + 2 * p.z), std::sin(6 * p.z + p.x), std::sin(5 * p.x + 3 * p.y));
         const glm::dvec3 n = glm::normalize(glm::normalize(p) + 0.3 * wave);
         out << "v " << p.x << " " << p.y << " " << p.z << "\nvn " << n.x << " " << n.y << " " << n.z << "\n";

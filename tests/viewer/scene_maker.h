@@ -11,8 +11,7 @@ void write_uv_sphere(const std::string& path, int segments, int rings);
 
 // A finer sphere displaced radially by amplitude * (sin(f x) + sin(f y) + sin(f z)) at the unit
 // direction (x, y, z) (the "sculpt"), no normals, no UVs.
-void write_bumpy_sphere(const std::string& path, int segments, int rings, double frequency = 9.0,
-                        double amplitude = 0.01);
+void write_bumpy_sphere(const std::string& path, int segments, int rings, double frequency = 9.0, double amplitude = 0.01);
 
 // A tangent-space normal map of `width` x `height` computed analytically from the height field
 // h(u, v) = sin(2 pi 8 u) sin(2 pi 4 v), written as 8-bit PNG (not baked).

@@ -92,8 +92,7 @@ Summary parse_summary(const std::string& out) {
   const std::string last = last_line(out);
   char psnr[32] = {};
   Summary s;
-  EXPECT_EQ(std::sscanf(last.c_str(), "psnr=%31s rmse=%lf within2=%lf", psnr, &s.rmse, &s.within2), 3)
-      << "last line: " << last;
+  EXPECT_EQ(std::sscanf(last.c_str(), "psnr=%31s rmse=%lf within2=%lf", psnr, &s.rmse, &s.within2), 3) << "last line: " << last;
   s.psnr = std::strtod(psnr, nullptr);
   return s;
 }
@@ -153,8 +152,8 @@ void expect_matches_golden(const std::string& actual, const std::string& golden_
   const bool ok = mean <= 0.5 && far_share <= 0.005;
   std::string diff_path = actual.substr(0, actual.size() - 4) + "-diff.png";
   if (!ok) nmbake::write_image(diff_path, diff);
-  EXPECT_TRUE(ok) << actual << " differs from " << golden << ": mean |diff| " << mean << " (limit 0.5), "
-                  << 100.0 * far_share << " % of pixels off by > 16 (limit 0.5 %); difference image x8: " << diff_path
+  EXPECT_TRUE(ok) << actual << " differs from " << golden << ": mean |diff| " << mean << " (limit 0.5), " << 100.0 * far_share
+                  << " % of pixels off by > 16 (limit 0.5 %); difference image x8: " << diff_path
                   << "; if the change is intended, rerun with NMBAKE_REGENERATE=1";
 }
 
@@ -194,8 +193,8 @@ TEST(NmviewGolden, SphereWithoutMap) {
   const std::string dir = scratch_dir();
   const Sphere s = make_sphere_scene(dir);
   const std::string shot = dir + "/sphere_nomap.png";
-  Result r = nmview(dir, quote(s.low) + " " + quote(s.map) + " " + quote(s.high) + " --screenshot " + quote(shot) +
-                             " --size 480x240 --no-map");
+  Result r = nmview(
+      dir, quote(s.low) + " " + quote(s.map) + " " + quote(s.high) + " --screenshot " + quote(shot) + " --size 480x240 --no-map");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   expect_matches_golden(shot, "golden_sphere_nomap.png");
 }
@@ -244,8 +243,8 @@ TEST(NmviewSculpt, TorusDemoMapImprovesAppearance) {
   Result off = nmview(dir, args + " --no-map --screenshot " + quote(dir + "/worst_map_off.png"));
   ASSERT_EQ(off.exit_code, 0) << off.err;
   const Summary without_map = parse_summary(off.out);
-  std::cout << "torus_demo map on:  psnr=" << with_map.psnr << " rmse=" << with_map.rmse
-            << " within2=" << with_map.within2 << "\n"
+  std::cout << "torus_demo map on:  psnr=" << with_map.psnr << " rmse=" << with_map.rmse << " within2=" << with_map.within2
+            << "\n"
             << "torus_demo map off: psnr=" << without_map.psnr << " rmse=" << without_map.rmse
             << " within2=" << without_map.within2 << "\n";
   // Measured with llvmpipe over the interior (pixels both models cover, away from the silhouette):
@@ -274,8 +273,8 @@ TEST(NmviewSculpt, BumpySphereMapImprovesAppearance) {
   Result off = nmview(dir, args + " --no-map --screenshot " + quote(dir + "/worst_map_off.png"));
   ASSERT_EQ(off.exit_code, 0) << off.err;
   const Summary with_map = parse_summary(on.out), without_map = parse_summary(off.out);
-  std::cout << "bumpy sphere map on:  psnr=" << with_map.psnr << " rmse=" << with_map.rmse
-            << " within2=" << with_map.within2 << "\n"
+  std::cout << "bumpy sphere map on:  psnr=" << with_map.psnr << " rmse=" << with_map.rmse << " within2=" << with_map.within2
+            << "\n"
             << "bumpy sphere map off: psnr=" << without_map.psnr << " rmse=" << without_map.rmse
             << " within2=" << without_map.within2 << "\n";
   EXPECT_GE(with_map.psnr, without_map.psnr + 2.0);
@@ -329,8 +328,8 @@ TEST(NmviewDecoding, DetailInTheNormalsIsReproduced) {
 // A map baked with `bake_options` decodes from its metadata as well as the default map; forcing the
 // wrong convention is clearly worse. The same pixels without metadata (as from another baker) are
 // wrong by default and right with `flags`.
-void expect_decoded_like_default(const std::string& name, const std::string& bake_options,
-                                 const std::string& wrong_override, const std::string& flags) {
+void expect_decoded_like_default(const std::string& name, const std::string& bake_options, const std::string& wrong_override,
+                                 const std::string& flags) {
   const NormalCube c = make_normal_cube();
   const Summary reference = compare_cube(c, bake_cube(c, "default.png", ""));
   const std::string map = bake_cube(c, name, bake_options);
@@ -396,25 +395,23 @@ void expect_error(const Result& r, int code, const std::string& fragment) {
 TEST(NmviewErrors, MissingMap) {
   const std::string dir = scratch_dir();
   const Sphere s = make_sphere_scene(dir);
-  expect_error(nmview(dir, quote(s.low) + " " + quote(dir + "/none.png") + " " + quote(s.high) + " --screenshot " +
-                               quote(dir + "/x.png")),
-               2, "none.png");
+  expect_error(
+      nmview(dir, quote(s.low) + " " + quote(dir + "/none.png") + " " + quote(s.high) + " --screenshot " + quote(dir + "/x.png")),
+      2, "none.png");
 }
 
 TEST(NmviewErrors, MapThatIsNotAnImage) {
   const std::string dir = scratch_dir();
   const Sphere s = make_sphere_scene(dir);
   std::ofstream(dir + "/text.png") << "this is not an image\n";
-  expect_error(nmview(dir, quote(s.low) + " " + quote(dir + "/text.png") + " " + quote(s.high) + " --compare"), 2,
-               "text.png");
+  expect_error(nmview(dir, quote(s.low) + " " + quote(dir + "/text.png") + " " + quote(s.high) + " --compare"), 2, "text.png");
 }
 
 TEST(NmviewErrors, GreyMapIsRejected) {
   const std::string dir = scratch_dir();
   const Sphere s = make_sphere_scene(dir);
   nmbake::write_image(dir + "/grey.png", nmbake::Image(16, 16, 1, 0.5f));
-  expect_error(nmview(dir, quote(s.low) + " " + quote(dir + "/grey.png") + " " + quote(s.high) + " --compare"), 2,
-               "needs RGB");
+  expect_error(nmview(dir, quote(s.low) + " " + quote(dir + "/grey.png") + " " + quote(s.high) + " --compare"), 2, "needs RGB");
 }
 
 TEST(NmviewErrors, LowPolyWithoutUvs) {
@@ -426,8 +423,7 @@ TEST(NmviewErrors, LowPolyWithoutUvs) {
 TEST(NmviewErrors, MissingHighPoly) {
   const std::string dir = scratch_dir();
   const Sphere s = make_sphere_scene(dir);
-  expect_error(nmview(dir, quote(s.low) + " " + quote(s.map) + " " + quote(dir + "/nope.ply") + " --compare"), 2,
-               "nope.ply");
+  expect_error(nmview(dir, quote(s.low) + " " + quote(s.map) + " " + quote(dir + "/nope.ply") + " --compare"), 2, "nope.ply");
 }
 
 TEST(NmviewErrors, BadFlags) {

@@ -291,8 +291,8 @@ std::pair<double, double> render_plane(glm::dvec3 t, Light light, bool mirror_v,
   for (std::size_t i = 0; i < map.pixels.size(); ++i) map.pixels[i] = float(n[int(i % 3)] * 0.5 + 0.5);
 
   HeadlessContext context;
-  Renderer renderer(build_low_vertices(plane, frames, glm::vec3(0.0f)), build_high_vertices(plane, glm::vec3(0.0f)),
-                    map, std::sqrt(2.0f), decoding);
+  Renderer renderer(build_low_vertices(plane, frames, glm::vec3(0.0f)), build_high_vertices(plane, glm::vec3(0.0f)), map,
+                    std::sqrt(2.0f), decoding);
   Toggles toggles;
   toggles.map = use_map;
   renderer.render_panes(64, 64, {0.0f, 0.0f, 1.0f}, light, toggles);

@@ -27,8 +27,7 @@ void rotate(Image& img, int x, int y, double deg) {
   const double u[3] = {n[0] / len, n[1] / len, n[2] / len};
   const double al = std::sqrt(u[0] * u[0] + u[1] * u[1]);
   const double axis[3] = {u[1] / al, -u[0] / al, 0.0};
-  const double k[3] = {axis[1] * u[2] - axis[2] * u[1], axis[2] * u[0] - axis[0] * u[2],
-                       axis[0] * u[1] - axis[1] * u[0]};
+  const double k[3] = {axis[1] * u[2] - axis[2] * u[1], axis[2] * u[0] - axis[0] * u[2], axis[0] * u[1] - axis[1] * u[0]};
   const double r = deg * 3.14159265358979323846 / 180, c = std::cos(r), s = std::sin(r);
   encode(p, u[0] * c + k[0] * s, u[1] * c + k[1] * s, u[2] * c + k[2] * s);
 }
