@@ -15,20 +15,11 @@
 
 #include <glm/glm.hpp>
 
+#include "case_meshes.h"
+
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
-struct ObjMesh {
-  std::vector<glm::dvec3> v, vn;
-  std::vector<glm::dvec2> vt;
-  // Per triangle corner: position, uv, normal index (0-based; -1 = none).
-  struct Corner {
-    int v, vt, vn;
-  };
-  std::vector<std::array<Corner, 3>> f;
-  std::string comment;
-};
+using namespace stability;
 
 std::string out_dir;
 
@@ -54,104 +45,6 @@ void write_obj(const std::string& name, const ObjMesh& m) {
   std::printf("wrote %s (%zu vertices, %zu triangles)\n", path.c_str(), m.v.size(), m.f.size());
 }
 
-using Height = std::function<double(double, double)>;
-using Normal = std::function<glm::dvec3(double, double)>;
-
-// A grid of nx x ny quads over [x0,x1] x [y0,y1], z = h(x, y), per-vertex normals n(x, y) (none when
-// n is empty), UVs mapping the rectangle [u0,u1] x [v0,v1] (none when `uvs` is false).
-ObjMesh height_field(int nx, int ny, double x0, double x1, double y0, double y1, const Height& h, const Normal& n,
-                     bool uvs = true, glm::dvec4 uv_rect = {0, 1, 0, 1}) {
-  ObjMesh m;
-  for (int j = 0; j <= ny; ++j)
-    for (int i = 0; i <= nx; ++i) {
-      const double s = double(i) / nx, t = double(j) / ny;
-      const double x = x0 + (x1 - x0) * s, y = y0 + (y1 - y0) * t;
-      m.v.push_back({x, y, h(x, y)});
-      if (n) m.vn.push_back(glm::normalize(n(x, y)));
-      if (uvs) m.vt.push_back({uv_rect[0] + (uv_rect[1] - uv_rect[0]) * s, uv_rect[2] + (uv_rect[3] - uv_rect[2]) * t});
-    }
-  auto id = [&](int i, int j) { return j * (nx + 1) + i; };
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
-      const int a = id(i, j), b = id(i + 1, j), c = id(i + 1, j + 1), d = id(i, j + 1);
-      for (auto tri : {std::array<int, 3>{a, b, c}, std::array<int, 3>{a, c, d}}) {
-        std::array<ObjMesh::Corner, 3> f;
-        for (int k = 0; k < 3; ++k) f[k] = {tri[k], uvs ? tri[k] : -1, n ? tri[k] : -1};
-        m.f.push_back(f);
-      }
-    }
-  return m;
-}
-
-const Normal no_normal;  // empty: a mesh without normals
-
-double zero(double, double) { return 0.0; }
-glm::dvec3 up(double, double) { return {0, 0, 1}; }
-
-// The bump field of the flat cases: z = 0.03 sin(2 pi x) sin(3 pi y) and its analytic normal.
-double bumps(double x, double y) { return 0.03 * std::sin(2 * kPi * x) * std::sin(3 * kPi * y); }
-glm::dvec3 bumps_normal(double x, double y) {
-  const double hx = 0.03 * 2 * kPi * std::cos(2 * kPi * x) * std::sin(3 * kPi * y);
-  const double hy = 0.03 * 3 * kPi * std::sin(2 * kPi * x) * std::cos(3 * kPi * y);
-  return glm::normalize(glm::dvec3(-hx, -hy, 1.0));
-}
-// A dome z = 0.15 - 0.075 (x^2 + y^2) (curved low-poly, non-trivial tangent frames).
-double dome(double x, double y) { return 0.15 - 0.075 * (x * x + y * y); }
-glm::dvec3 dome_normal(double x, double y) { return glm::normalize(glm::dvec3(0.15 * x, 0.15 * y, 1.0)); }
-double dome_bumps(double x, double y) { return dome(x, y) + bumps(x, y); }
-glm::dvec3 dome_bumps_normal(double x, double y) {
-  const double hx = -0.15 * x + 0.03 * 2 * kPi * std::cos(2 * kPi * x) * std::sin(3 * kPi * y);
-  const double hy = -0.15 * y + 0.03 * 3 * kPi * std::sin(2 * kPi * x) * std::cos(3 * kPi * y);
-  return glm::normalize(glm::dvec3(-hx, -hy, 1.0));
-}
-
-// Triangles of a flat mesh from explicit corner lists: positions p (z = 0, normal +Z), uvs t.
-ObjMesh flat_mesh(const std::vector<glm::dvec2>& p, const std::vector<glm::dvec2>& t, const std::vector<std::array<int, 3>>& tris,
-                  const std::vector<std::array<int, 3>>& uv_tris) {
-  ObjMesh m;
-  for (auto q : p) m.v.push_back({q.x, q.y, 0.0});
-  m.vt = t;
-  m.vn.push_back({0, 0, 1});
-  for (std::size_t i = 0; i < tris.size(); ++i) {
-    std::array<ObjMesh::Corner, 3> f;
-    for (int k = 0; k < 3; ++k) f[k] = {tris[i][k], uv_tris[i][k], 0};
-    m.f.push_back(f);
-  }
-  return m;
-}
-
-// A latitude-longitude sphere of radius r with nphi x ntheta quads, radial normals, u = phi / 2 pi,
-// v = 1 - theta / pi.
-ObjMesh sphere(int nphi, int ntheta, double r, bool uvs) {
-  ObjMesh m;
-  for (int j = 0; j <= ntheta; ++j)
-    for (int i = 0; i <= nphi; ++i) {
-      const double th = kPi * j / ntheta, ph = 2 * kPi * (i % nphi) / nphi;
-      const glm::dvec3 d(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th));
-      m.v.push_back(r * d);
-      m.vn.push_back(d);
-      if (uvs) m.vt.push_back({double(i) / nphi, 1.0 - double(j) / ntheta});
-    }
-  auto id = [&](int i, int j) { return j * (nphi + 1) + i; };
-  auto add = [&](int a, int b, int c) {
-    std::array<ObjMesh::Corner, 3> f;
-    const int t[3] = {a, b, c};
-    for (int k = 0; k < 3; ++k) f[k] = {t[k], uvs ? t[k] : -1, t[k]};
-    m.f.push_back(f);
-  };
-  for (int j = 0; j < ntheta; ++j)
-    for (int i = 0; i < nphi; ++i) {
-      const int a = id(i, j), b = id(i, j + 1), c = id(i + 1, j + 1), d = id(i + 1, j);
-      if (j != 0) add(a, b, d);
-      if (j != ntheta - 1) add(b, c, d);
-    }
-  return m;
-}
-
-void transform(ObjMesh& m, double scale, glm::dvec3 offset) {
-  for (auto& p : m.v) p = p * scale + offset;
-}
-
 // Shared high-polys.
 void write_shared_high_polys() {
   ObjMesh m = height_field(32, 32, -1.2, 1.2, -1.2, 1.2, bumps, bumps_normal, false);
@@ -160,8 +53,9 @@ void write_shared_high_polys() {
   m = height_field(32, 32, -1.2, 1.2, -1.2, 1.2, dome_bumps, dome_bumps_normal, false);
   m.comment = "dome z = 0.15 - 0.075 (x^2+y^2) plus the bump field, analytic normals";
   write_obj("dome_bumps_high.obj", m);
-  m = height_field(1, 1, -2, 2, -2, 2, [](double x, double y) { return 0.2 * x + 0.1 * y + 0.05; },
-                   [](double, double) { return glm::dvec3(-0.2, -0.1, 1.0); }, false);
+  m = height_field(
+      1, 1, -2, 2, -2, 2, [](double x, double y) { return 0.2 * x + 0.1 * y + 0.05; },
+      [](double, double) { return glm::dvec3(-0.2, -0.1, 1.0); }, false);
   m.comment = "tilted plane z = 0.2 x + 0.1 y + 0.05, normal (-0.2,-0.1,1)/|.|";
   write_obj("tilted_plane_high.obj", m);
 }
@@ -291,7 +185,8 @@ void write_island_cases() {
   };
   island("island_low.obj", "as is", [](glm::dvec2 t) { return t; });
   island("island_mirrored_low.obj", "mirrored (u -> 1 - u)", [](glm::dvec2 t) { return glm::dvec2(1 - t.x, t.y); });
-  island("island_rot90_low.obj", "rotated 90 degrees ((u,v) -> (1 - v, u))", [](glm::dvec2 t) { return glm::dvec2(1 - t.y, t.x); });
+  island("island_rot90_low.obj", "rotated 90 degrees ((u,v) -> (1 - v, u))",
+         [](glm::dvec2 t) { return glm::dvec2(1 - t.y, t.x); });
   island("island_rot180_low.obj", "rotated 180 degrees", [](glm::dvec2 t) { return glm::dvec2(1 - t.x, 1 - t.y); });
 }
 
@@ -309,8 +204,8 @@ void write_far_and_scaled_cases() {
     transform(low, t.scale, t.offset);
     transform(high, t.scale, t.offset);
     char what[160];
-    std::snprintf(what, sizeof what, "case 5: dome pair scaled by %g and translated by (%g,%g,%g)", t.scale, t.offset.x, t.offset.y,
-                  t.offset.z);
+    std::snprintf(what, sizeof what, "case 5: dome pair scaled by %g and translated by (%g,%g,%g)", t.scale, t.offset.x,
+                  t.offset.y, t.offset.z);
     low.comment = high.comment = what;
     write_obj(std::string(t.name) + "_low.obj", low);
     write_obj(std::string(t.name) + "_high.obj", high);
@@ -371,8 +266,9 @@ void write_ray_cases() {
   }
   // Holes: a 12x12 grid at z = 0.02 with tilted normals and three cells removed.
   {
-    ObjMesh m = height_field(12, 12, -1.2, 1.2, -1.2, 1.2, [](double, double) { return 0.02; },
-                             [](double, double) { return glm::dvec3(0.1, 0.2, 1.0); }, false);
+    ObjMesh m = height_field(
+        12, 12, -1.2, 1.2, -1.2, 1.2, [](double, double) { return 0.02; },
+        [](double, double) { return glm::dvec3(0.1, 0.2, 1.0); }, false);
     std::vector<std::array<ObjMesh::Corner, 3>> kept;
     for (std::size_t t = 0; t < m.f.size(); ++t) {
       const int cell = int(t / 2), i = cell % 12, j = cell / 12;
@@ -397,10 +293,12 @@ void write_ray_cases() {
   }
   // Two layers: z = +0.05 (normal tilted +x) and z = -0.03 (normal tilted +y); and a tie pair at +-0.05.
   for (double lower : {-0.03, -0.05}) {
-    ObjMesh m = height_field(1, 1, -1.5, 1.5, -1.5, 1.5, [](double, double) { return 0.05; },
-                             [](double, double) { return glm::dvec3(0.3, 0, 1); }, false);
-    ObjMesh b = height_field(1, 1, -1.5, 1.5, -1.5, 1.5, [&](double, double) { return lower; },
-                             [](double, double) { return glm::dvec3(0, 0.3, 1); }, false);
+    ObjMesh m = height_field(
+        1, 1, -1.5, 1.5, -1.5, 1.5, [](double, double) { return 0.05; }, [](double, double) { return glm::dvec3(0.3, 0, 1); },
+        false);
+    ObjMesh b = height_field(
+        1, 1, -1.5, 1.5, -1.5, 1.5, [&](double, double) { return lower; }, [](double, double) { return glm::dvec3(0, 0.3, 1); },
+        false);
     const int nv = int(m.v.size()), nn = int(m.vn.size());
     m.v.insert(m.v.end(), b.v.begin(), b.v.end());
     m.vn.insert(m.vn.end(), b.vn.begin(), b.vn.end());
@@ -408,8 +306,9 @@ void write_ray_cases() {
       for (auto& c : f) c.v += nv, c.vn += nn;
       m.f.push_back(f);
     }
-    m.comment = lower == -0.03 ? "case 7: two layers z = 0.05 (normal (0.3,0,1)) and z = -0.03 (normal (0,0.3,1))"
-                               : "case 7: two layers at equal distance, z = +0.05 (normal (0.3,0,1)) and z = -0.05 (normal (0,0.3,1))";
+    m.comment = lower == -0.03
+                    ? "case 7: two layers z = 0.05 (normal (0.3,0,1)) and z = -0.03 (normal (0,0.3,1))"
+                    : "case 7: two layers at equal distance, z = +0.05 (normal (0.3,0,1)) and z = -0.05 (normal (0,0.3,1))";
     write_obj(lower == -0.03 ? "two_layers_high.obj" : "two_layers_tie_high.obj", m);
   }
 }
@@ -449,8 +348,8 @@ void write_hard_edge_cases() {
   for (bool shared : {true, false}) {
     ObjMesh m;
     const glm::dvec2 corner[4] = {{1, -1}, {1, 1}, {-1, 1}, {-1, -1}};
-    for (int s = 0; s < 4; ++s) m.vn.push_back({glm::normalize(corner[s] + corner[(s + 1) % 4]).x,
-                                                glm::normalize(corner[s] + corner[(s + 1) % 4]).y, 0});
+    for (int s = 0; s < 4; ++s)
+      m.vn.push_back({glm::normalize(corner[s] + corner[(s + 1) % 4]).x, glm::normalize(corner[s] + corner[(s + 1) % 4]).y, 0});
     // UVs: 17 columns x 5 rows; positions: shared = 16 columns (column 16 is column 0), else 4 x 5.
     for (int j = 0; j <= 4; ++j)
       for (int c = 0; c <= 16; ++c) m.vt.push_back({c / 16.0, j / 4.0});
@@ -483,8 +382,9 @@ void write_hard_edge_cases() {
           m.f.push_back({a, b, c});
           m.f.push_back({a, c, d});
         }
-    m.comment = shared ? "case 9: square prism sides with hard edges: positions shared, one normal per side, one UV strip"
-                       : "case 9: square prism sides with hard edges, glTF style: every side has its own copies of the edge positions";
+    m.comment =
+        shared ? "case 9: square prism sides with hard edges: positions shared, one normal per side, one UV strip"
+               : "case 9: square prism sides with hard edges, glTF style: every side has its own copies of the edge positions";
     write_obj(shared ? "hard_edges_low.obj" : "hard_edges_split_low.obj", m);
   }
   {
@@ -512,7 +412,8 @@ void write_topology_cases() {
   {
     // Non-manifold: a plane at z = 0.02 plus two fins standing on one of its edges (3 and 4 faces
     // on the edge x = 0).
-    ObjMesh m = height_field(2, 2, -1.2, 1.2, -1.2, 1.2, [](double, double) { return 0.02; }, up, false);
+    ObjMesh m = height_field(
+        2, 2, -1.2, 1.2, -1.2, 1.2, [](double, double) { return 0.02; }, up, false);
     const int nv = int(m.v.size());
     // Vertices of the edge x = 0: ids 1, 4, 7 (y = -1.2, 0, 1.2). Fins rise to z = 0.5 and 0.3.
     for (int j = 0; j < 3; ++j) m.v.push_back({0, -1.2 + 1.2 * j, 0.5});
