@@ -9,6 +9,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -48,26 +49,49 @@ inline bool inset_from_edges(double bary[3]) {
   return true;
 }
 
+// The coverage test, written once over the number type (double for one sample here, four lanes in
+// trace/tile_kernels.cpp). Edge k's value at q is d.x * (q.y - a.y) - d.y * (q.x - a.x); `row` holds
+// the first products (one per edge, shared by a row of samples). A sample is covered by edge k when
+// strictly inside, or on the edge with this triangle on the edge's positive side: of two triangles
+// sharing an edge exactly one covers it. `in` is and-ed with the result (a bool, or a lane mask);
+// w receives the unnormalized barycentric weights.
+template <typename T, typename Mask>
+[[gnu::always_inline]] inline void edge_weights(Mask& in, T w[3], const TexelTriangle& tri, const double row[3], const T& qx,
+                                                const T& zero) {
+  for (int k = 0; k < 3; ++k) {
+    const T e = row[k] - tri.edge_d[k].y * (qx - tri.edge_a[k].x);
+    // e < 0 rejects when the opposite corner is on the positive side, else e >= 0 (a NaN passes
+    // both tests; the sum test rejects it).
+    in &= tri.edge_side[k] > 0.0 ? ((e < zero) == 0) : ((e >= zero) == 0);
+    w[(k + 2) % 3] = e * tri.edge_inv_side[k];
+  }
+}
+// The weights' sum, which must be positive and finite (and-ed into `in`).
+template <typename T, typename Mask>
+[[gnu::always_inline]] inline void weight_sum(Mask& in, T& sum, const T w[3], const T& zero) {
+  sum = w[0] + w[1] + w[2];
+  in &= (sum > zero) & (sum <= DBL_MAX);
+}
+// The barycentrics: the weights times 1 / sum.
+template <typename T>
+[[gnu::always_inline]] inline void normalize_weights(T bary[3], const T w[3], const T& sum) {
+  const T inv_sum = 1.0 / sum;
+  for (int k = 0; k < 3; ++k) bary[k] = w[k] * inv_sum;
+}
+
 // True when sample point q (texel space) is covered; then bary receives the weights of corners
 // 0, 1, 2 (they sum to 1 and are each in [0,1]). A sample on an edge gets weights of at least 1e-5
 // (moved just inside its triangle, so a coincident high-poly cannot tie with the neighbour).
 // Inline: the bake calls it per sample.
 inline bool covers(const TexelTriangle& tri, glm::dvec2 q, double bary[3]) {
   if (tri.area2 == 0.0) return false;
-  double w[3];
-  for (int k = 0; k < 3; ++k) {
-    const glm::dvec2 a = tri.edge_a[k], d = tri.edge_d[k];
-    const double side = tri.edge_side[k];
-    const double e = d.x * (q.y - a.y) - d.y * (q.x - a.x);
-    // Strictly inside, or on the edge and this triangle lies on the edge's positive side: of two
-    // triangles sharing an edge exactly one does.
-    if (side > 0.0 ? e < 0.0 : e >= 0.0) return false;
-    w[(k + 2) % 3] = e * tri.edge_inv_side[k];
-  }
-  const double sum = w[0] + w[1] + w[2];
-  if (!(sum > 0.0) || !std::isfinite(sum)) return false;
-  const double inv_sum = 1.0 / sum;
-  for (int k = 0; k < 3; ++k) bary[k] = w[k] * inv_sum;
+  double row[3], w[3], sum;
+  for (int k = 0; k < 3; ++k) row[k] = tri.edge_d[k].x * (q.y - tri.edge_a[k].y);
+  bool in = true;
+  edge_weights(in, w, tri, row, q.x, 0.0);
+  weight_sum(in, sum, w, 0.0);
+  if (!in) return false;
+  normalize_weights(bary, w, sum);
   inset_from_edges(bary);
   return true;
 }

@@ -15,13 +15,19 @@
 
 namespace nmbake {
 
-inline glm::dvec3 low_point(const LowTriangle& lt, const double b[3]) { return b[0] * lt.p[0] + b[1] * lt.p[1] + b[2] * lt.p[2]; }
+inline glm::dvec3 low_point(const LowTriangle& lt, const double b[3]) {
+  codec::Vec3<double> p;
+  corner_sum(p, lt.p, b);
+  return from_codec(p);
+}
 
+// The ray normal at b (low_point_and_normal, shade_batch.h); where opposite corner normals cancel,
+// the face normal.
 inline glm::dvec3 low_ray_normal(const LowTriangle& lt, const double b[3]) {
-  const glm::dvec3 n = b[0] * lt.ray_n[0] + b[1] * lt.ray_n[1] + b[2] * lt.ray_n[2];
-  const double len2 = glm::dot(n, n);
-  if (len2 > 1e-24) return n * (1.0 / std::sqrt(len2));
-  // Opposite corner normals cancel: fall back to the face normal.
+  codec::Vec3<double> p, n;
+  double len2;
+  low_point_and_normal(p, n, len2, lt, b);
+  if (len2 > 1e-24) return from_codec(n);
   const glm::dvec3 f = glm::cross(lt.p[1] - lt.p[0], lt.p[2] - lt.p[0]);
   const double fl = glm::length(f);
   return fl > 0.0 ? f / fl : glm::dvec3(0, 0, 1);
@@ -89,7 +95,7 @@ inline int sample_rays(const Prepared& s, std::size_t tri, const double b[3], co
     rays[0] = inward_ray(c, signed_base, prefer_lo);
     return 1;
   }
-  const glm::dvec3 p = low_point(lt, b), n = low_ray_normal(lt, b);
+  const glm::dvec3 p = low_point(lt, b), n = low_ray_normal(lt, b);  // the default ray: default_ray (shade_batch.h)
   if (r.closest) {
     signed_base[0] = signed_base[1] = 0.0;
     rays[0] = {glm::vec3(p), 0.0f, glm::vec3(n), r.front};
@@ -97,7 +103,9 @@ inline int sample_rays(const Prepared& s, std::size_t tri, const double b[3], co
     return 2;
   }
   signed_base[0] = r.front;
-  rays[0] = {glm::vec3(p + double(r.front) * n), 0.0f, glm::vec3(-n), r.front + r.rear};
+  codec::Vec3<double> org, dir;
+  default_ray(org, dir, to_codec(p), to_codec(n), double(r.front));
+  rays[0] = {glm::vec3(from_codec(org)), 0.0f, glm::vec3(from_codec(dir)), r.front + r.rear};
   return 1;
 }
 

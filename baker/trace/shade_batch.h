@@ -13,6 +13,8 @@
 
 #include <glm/glm.hpp>
 
+#include "core/codec.h"
+
 namespace nmbake {
 
 // What the trace loop reads of one low-poly triangle: re-centred corner positions, ray normals,
@@ -21,6 +23,35 @@ struct LowTriangle {
   glm::dvec3 p[3], ray_n[3], n[3];
   glm::dvec4 t[3];
 };
+
+// The default rays, written once over the number type (double for one sample in
+// pipeline/rays.h, four lanes in trace/tile_kernels.cpp).
+// r = w0 c0 + w1 c1 + w2 c2, summed left to right (as glm's b[0] * c[0] + b[1] * c[1] + b[2] * c[2]).
+template <typename T>
+[[gnu::always_inline]] inline void corner_sum(codec::Vec3<T>& r, const glm::dvec3 c[3], const T w[3]) {
+  r = {w[0] * c[0].x, w[0] * c[0].y, w[0] * c[0].z};
+  for (int k = 1; k < 3; ++k) r = {r.x + w[k] * c[k].x, r.y + w[k] * c[k].y, r.z + w[k] * c[k].z};
+}
+// At barycentrics w of triangle lt: P, and the ray normal N times 1 / |N|, with len2 = |N|^2 (at
+// most 1e-24: N cannot be trusted, and the caller falls back to the face normal).
+template <typename T>
+[[gnu::always_inline]] inline void low_point_and_normal(codec::Vec3<T>& p, codec::Vec3<T>& n, T& len2, const LowTriangle& lt,
+                                                        const T w[3]) {
+  corner_sum(p, lt.p, w);
+  corner_sum(n, lt.ray_n, w);
+  codec::dot(len2, n, n);
+  T len;
+  codec::Ops<T>::root(len, len2);
+  const T inv = 1.0 / len;
+  n = {n.x * inv, n.y * inv, n.z * inv};
+}
+// The default policy's ray: from P + front N along -N.
+template <typename T>
+[[gnu::always_inline]] inline void default_ray(codec::Vec3<T>& org, codec::Vec3<T>& dir, const codec::Vec3<T>& p,
+                                               const codec::Vec3<T>& n, double front) {
+  org = {p.x + front * n.x, p.y + front * n.y, p.z + front * n.z};
+  dir = {-n.x, -n.y, -n.z};
+}
 
 // Samples to shade, as arrays: per sample, the low-poly triangle and barycentrics, and the hit's
 // high-poly triangle (raycast's no_hit, 0xffffffff, for a miss) with its barycentrics u, v of

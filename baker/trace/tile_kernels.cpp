@@ -13,31 +13,16 @@ using namespace lanes;
 
 namespace {
 
-// P + front N and -N for one triangle at barycentrics w, as sample_rays does (low_point,
-// low_ray_normal: b0 * c0 + b1 * c1 + b2 * c2 summed left to right, N times 1 / |N|). `good`: lanes
-// whose squared normal length exceeds 1e-24 (the others take low_ray_normal's fallback).
-[[gnu::always_inline]] inline void default_ray(const LowTriangle& lt, double front, const V (&w)[3], V3& org, V3& dir,
-                                               unsigned& good) {
+// P + front N and -N for one triangle at barycentrics w: default_ray (shade_batch.h), as
+// sample_rays makes it. `good`: lanes whose squared normal length exceeds 1e-24 (the others take
+// low_ray_normal's fallback).
+[[gnu::always_inline]] inline void default_ray_lanes(const LowTriangle& lt, double front, const V (&w)[3], V3& org, V3& dir,
+                                                     unsigned& good) {
   V3 p, n;
-  for (int c = 0; c < 3; ++c) {
-    const V3 pc = {w[c] * lt.p[c].x, w[c] * lt.p[c].y, w[c] * lt.p[c].z};
-    const V3 nc = {w[c] * lt.ray_n[c].x, w[c] * lt.ray_n[c].y, w[c] * lt.ray_n[c].z};
-    if (c == 0) {
-      p = pc;
-      n = nc;
-    } else {
-      p = {p.x + pc.x, p.y + pc.y, p.z + pc.z};
-      n = {n.x + nc.x, n.y + nc.y, n.z + nc.z};
-    }
-  }
-  V len2, len;
-  dot(len2, n, n);
-  vsqrt(len, len2);
-  const V inv = 1.0 / len;
-  n = {n.x * inv, n.y * inv, n.z * inv};
+  V len2;
+  low_point_and_normal(p, n, len2, lt, w);
   good = bits(len2 > 1e-24);
-  org = {p.x + front * n.x, p.y + front * n.y, p.z + front * n.z};
-  dir = {-n.x, -n.y, -n.z};
+  default_ray(org, dir, p, n, front);
 }
 
 }  // namespace
@@ -85,23 +70,16 @@ __attribute__((target_clones("avx2", "default"))) std::size_t cover_rect(const T
     for (int x = xa; x <= xb; x += kLanes) {
       const V qx = V{double(x), double(x + 1), double(x + 2), double(x + 3)} + ox;
       M in = {x <= xb ? -1 : 0, x + 1 <= xb ? -1 : 0, x + 2 <= xb ? -1 : 0, x + 3 <= xb ? -1 : 0};
-      V w[3];
-      for (int k = 0; k < 3; ++k) {
-        const V e = row_term[k] - tt.edge_d[k].y * (qx - tt.edge_a[k].x);
-        // covers() rejects e < 0 when the opposite corner is on the positive side, else e >= 0
-        // (a NaN passes both tests there; the sum test below rejects it).
-        in &= tt.edge_side[k] > 0.0 ? ~(e < zero) : ~(e >= zero);
-        w[(k + 2) % 3] = e * tt.edge_inv_side[k];
-      }
-      const V sum = w[0] + w[1] + w[2];
-      in &= (sum > zero) & (sum <= DBL_MAX);  // covers(): !(sum > 0) || !isfinite(sum) rejects
+      // covers() (core/rasterize.h), four samples at a time.
+      V w[3], sum, b[3];
+      edge_weights(in, w, tt, row_term, qx, zero);
+      weight_sum(in, sum, w, zero);
       const unsigned m = bits(in);
       if (!m) continue;
-      const V inv_sum = 1.0 / sum;
-      const V b[3] = {w[0] * inv_sum, w[1] * inv_sum, w[2] * inv_sum};
+      normalize_weights(b, w, sum);
       V3 org{zero, zero, zero}, dir{zero, zero, zero};
       unsigned good = 0;
-      if (rays.low) default_ray(rays.low[t], double(rays.front), b, org, dir, good);
+      if (rays.low) default_ray_lanes(rays.low[t], double(rays.front), b, org, dir, good);
       const F of[3] = {__builtin_convertvector(org.x, F), __builtin_convertvector(org.y, F), __builtin_convertvector(org.z, F)};
       const F df[3] = {__builtin_convertvector(dir.x, F), __builtin_convertvector(dir.y, F), __builtin_convertvector(dir.z, F)};
       const std::size_t slot0 = row + std::size_t(x - x0);
