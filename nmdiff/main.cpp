@@ -1,6 +1,8 @@
 // nmdiff: compares two tangent-space normal maps by the angle between their normals.
 // Parses arguments, reads files and wires them to the pure comparison in nmdiff.h.
 #include <cerrno>
+#include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -76,6 +78,7 @@ nlohmann::json to_json(const std::string& a, const std::string& b, const DiffSta
       {"max_mean_deg", o.tolerances.max_mean_deg}, {"max_p99_deg", o.tolerances.max_p99_deg}, {"max_deg", o.tolerances.max_deg}};
   j["skipped"] = {{"mask", s.skipped_mask}, {"alpha", s.skipped_alpha}, {"invalid_a", s.invalid_a}, {"invalid_b", s.invalid_b}};
   j["padding_compared"] = s.padding_compared;
+  j["nonfinite_texels"] = s.nonfinite_texels;
   j["green_a"] = o.green_a == nmbake::diff::GreenAxis::up ? "up" : "down";
   j["green_b"] = o.green_b == nmbake::diff::GreenAxis::up ? "up" : "down";
   j["resample"] = resample;
@@ -101,6 +104,18 @@ struct CommandLine {
   bool ignore_alpha = false;
 };
 
+// A tolerance is a finite number of degrees, at least 0 (NaN would make every comparison pass or
+// fail by accident).
+const CLI::Validator finite_tolerance(
+    [](std::string& text) {
+      char* end = nullptr;
+      const double v = std::strtod(text.c_str(), &end);
+      if (end == text.c_str() || *end != '\0' || !std::isfinite(v) || v < 0.0)
+        return std::string("a tolerance must be a finite number of degrees >= 0, got '") + text + "'";
+      return std::string();
+    },
+    "DEG>=0");
+
 // nmdiff's arguments, bound to the fields of `cl`, and the text of --help.
 void add_arguments(CLI::App& app, CommandLine& cl) {
   diff::DiffOptions& options = cl.options;
@@ -108,13 +123,13 @@ void add_arguments(CLI::App& app, CommandLine& cl) {
   app.add_option("B", cl.path_b, "Reference map (e.g. the golden map)")->required();
   app.add_option("--max-mean", options.tolerances.max_mean_deg, "Tolerance on the mean difference, degrees")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(finite_tolerance);
   app.add_option("--max-p99", options.tolerances.max_p99_deg, "Tolerance on the 99th percentile, degrees")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(finite_tolerance);
   app.add_option("--max-deg", options.tolerances.max_deg, "Tolerance on the largest difference, degrees")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(finite_tolerance);
   app.add_option("--mask", cl.mask_path,
                  "Low-poly mesh (OBJ, PLY, OFF, STL with UVs): compare only texels inside its UV layout, "
                  "rasterized as the baker does, so padding is ignored");
@@ -138,7 +153,7 @@ void add_arguments(CLI::App& app, CommandLine& cl) {
   app.add_option("--heatmap-scale", cl.heatmap_scale,
                  "Difference shown as full yellow, degrees; 0 = max(--max-deg, observed p99)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(finite_tolerance);
   app.add_option("--json", cl.json_path, "Write the statistics as JSON");
   app.footer(
       "Defaults accept 8-bit rounding: a float map against its own 8-bit quantisation differs by at most\n"
@@ -242,7 +257,9 @@ void report(const CommandLine& cl, const Comparison& c) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+// The comparison's exit status, or kError; a closed stdout (nmdiff ... | head -0) is an error like
+// any other failed write, not a SIGPIPE death.
+int run(int argc, char** argv) {
   CommandLine cl;
   if (const std::optional<int> status = parse_command_line(argc, argv, cl)) return *status;
 
@@ -250,6 +267,8 @@ int main(int argc, char** argv) {
     if (!cl.heatmap_path.empty()) nmbake::check_output_format(cl.heatmap_path, 0);
     const Comparison c = compare_files(cl);
     report(cl, c);
+    std::cout.flush();
+    if (!std::cout) throw nmbake::OutputError(std::string("stdout: cannot write: ") + std::strerror(errno));
     return c.stats.within ? kWithin : kOutside;
   } catch (const nmbake::Error& e) {
     std::cerr << "error: " << one_line(e.what()) << "\n";
@@ -259,4 +278,9 @@ int main(int argc, char** argv) {
     std::cerr << "error: " << one_line(e.what()) << "\n";
   }
   return kError;
+}
+
+int main(int argc, char** argv) {
+  std::signal(SIGPIPE, SIG_IGN);
+  return run(argc, argv);
 }

@@ -164,16 +164,19 @@ DiffStats compare_normal_maps(const Image& a, const Image& b_in, const DiffOptio
       continue;
     }
     double na[3], nb[3];
-    if (!decode_normal(pa, options.green_a, na)) {
+    const bool nonfinite = !std::isfinite(pa[0]) || !std::isfinite(pa[1]) || !std::isfinite(pa[2]) || !std::isfinite(pb[0]) ||
+                           !std::isfinite(pb[1]) || !std::isfinite(pb[2]);
+    if (!nonfinite && !decode_normal(pa, options.green_a, na)) {
       ++s.invalid_a;
       continue;
     }
-    if (!decode_normal(pb, options.green_b, nb)) {
+    if (!nonfinite && !decode_normal(pb, options.green_b, nb)) {
       ++s.invalid_b;
       continue;
     }
     if (!in_layout || !covered) ++s.padding_compared;
-    const double d = angle_deg(na, nb);
+    s.nonfinite_texels += nonfinite;
+    const double d = nonfinite ? 180.0 : angle_deg(na, nb);  // a NaN texel is as different as can be
     if (field) field->degrees[i] = static_cast<float>(d);
     if (d > s.max_deg || s.worst_x < 0) {
       s.max_deg = d;
@@ -200,8 +203,15 @@ DiffStats compare_normal_maps(const Image& a, const Image& b_in, const DiffOptio
     s.p99_deg = percentile(angles, 0.99);
   }
   const Tolerances& t = options.tolerances;
-  s.within = s.texels_compared > 0 && s.mean_deg <= t.max_mean_deg && s.p99_deg <= t.max_p99_deg && s.max_deg <= t.max_deg;
+  // A map holding NaN is broken whatever the tolerances.
+  s.within = s.texels_compared > 0 && s.nonfinite_texels == 0 && s.mean_deg <= t.max_mean_deg && s.p99_deg <= t.max_p99_deg &&
+             s.max_deg <= t.max_deg;
   if (s.texels_compared == 0) s.warnings.push_back("no texels compared: nothing is within tolerance");
+  if (s.nonfinite_texels > 0)
+    s.warnings.push_back(
+        std::to_string(s.nonfinite_texels) +
+        " texel(s) hold a value that is not a number (NaN or infinity) in A or B: each counted as a difference of "
+        "180 deg");
   if (s.invalid_a + s.invalid_b > 0)
     s.warnings.push_back(std::to_string(s.invalid_a + s.invalid_b) +
                          " texel(s) decode to a zero vector and were not compared (A: " + std::to_string(s.invalid_a) +

@@ -61,8 +61,11 @@ struct DiffStats {
   std::size_t invalid_a = 0;         // A decodes to a zero or non-finite vector
   std::size_t invalid_b = 0;         // B decodes to a zero or non-finite vector (A valid)
   std::size_t padding_compared = 0;  // compared only because of include_padding
+  // Compared texels with a channel that is not finite (NaN, infinity) in A or B: each counts as a
+  // difference of 180 degrees, never as "not compared", and any makes the maps not within.
+  std::size_t nonfinite_texels = 0;
 
-  bool within = false;                // all three tolerances met and at least one texel compared
+  bool within = false;                // all three tolerances met, at least one texel compared, none not finite
   std::vector<std::string> warnings;  // one line each, e.g. a likely green flip
 };
 

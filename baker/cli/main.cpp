@@ -3,10 +3,12 @@
 
 #include <atomic>
 #include <cctype>
+#include <cerrno>
 #include <chrono>
 #include <climits>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <future>
 #include <iostream>
@@ -14,6 +16,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <tuple>
 
 #include <CLI/CLI.hpp>
 
@@ -47,6 +50,7 @@ struct Args {
   std::string size = "2048";
   int samples = 1;
   double front = -1.0, rear = -1.0;
+  bool front_given = false, rear_given = false;  // set after parsing: a distance given is never "auto"
   std::string policy = "cage-first", space = "tangent", green = "up", bitangent = "pixel";
   int bits = 0;
   int padding = 16;
@@ -181,12 +185,16 @@ void add_options(CLI::App& app, Args& a) {
 BakeOptions bake_options(const Args& a) {
   BakeOptions o;
   parse_size(a.size, o.width, o.height);
-  // A distance given must be one (the library reads a negative one as "measure it").
-  for (const auto& [d, name] : {std::pair{a.front, "--front"}, std::pair{a.rear, "--rear"}})
-    if (d != -1.0 && !(d >= 0.0)) throw UsageError(std::string(name) + " must be a distance >= 0 in scene units");
+  // A distance given must be one, -1 included (the library reads a negative one as "measure it").
+  for (const auto& [given, d, name] : {std::tuple{a.front_given, a.front, "--front"}, std::tuple{a.rear_given, a.rear, "--rear"}})
+    if (given && !(d >= 0.0)) {
+      char got[32];
+      std::snprintf(got, sizeof got, "%g", d);
+      throw UsageError(std::string(name) + " must be a distance >= 0 in scene units, got " + got);
+    }
   o.samples = a.samples;
-  o.front = float(a.front);
-  o.rear = float(a.rear);
+  o.front = a.front_given ? float(a.front) : -1.0f;
+  o.rear = a.rear_given ? float(a.rear) : -1.0f;
   o.policy = a.policy == "closest" ? RayPolicy::closest : RayPolicy::cage_first;
   o.space = a.space == "object" ? NormalSpace::object : NormalSpace::tangent;
   o.green_down = a.green == "down";
@@ -203,7 +211,7 @@ BakeOptions bake_options(const Args& a) {
 // Fails early, before a long bake, on outputs that cannot be written.
 void check_outputs(const Args& a, int bits) {
   if (!a.save_cage.empty()) {
-    if (!a.cage.empty() || a.front != -1.0 || a.rear != -1.0)
+    if (!a.cage.empty() || a.front_given || a.rear_given)
       throw UsageError("--save-cage writes the automatic cage, which is made only without --cage, --front and --rear");
     std::string ext = std::filesystem::path(a.save_cage).extension().string();
     for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
@@ -331,6 +339,8 @@ int run(int argc, char** argv) {
     throw UsageError(e.what());
   }
 
+  a.front_given = app.count("--front") > 0;
+  a.rear_given = app.count("--rear") > 0;
   const auto start = Clock::now();
   BakeOptions o = bake_options(a);
   validate_options(o);  // the library's checks, before a long load
@@ -389,6 +399,8 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // A closed stdout (nmbake ... | head -0) is an error like any other write, not a SIGPIPE death.
+  std::signal(SIGPIPE, SIG_IGN);
   preload_image_io();  // OpenImageIO loads on its own thread while the command line and meshes are read
   int code = 0;
   try {
@@ -405,6 +417,10 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     code = 2;
+  }
+  if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
+    std::fprintf(stderr, "error: stdout: cannot write: %s\n", std::strerror(errno));
+    if (code == 0) code = int(nmbake::ExitCode::output);
   }
   wait_for_image_io();  // never exit while the image library's constructors run
   return code;

@@ -61,6 +61,11 @@ int main(int argc, char** argv) {
   rotate(rotated, 5, 7, 10.0);
   nmbake::write_image(path("a_rot.exr"), rotated);
 
+  // One texel that is not a number (a broken bake): a difference, never "not compared".
+  Image with_nan = a;
+  with_nan.at(3, 4)[0] = std::nanf("");
+  nmbake::write_image(path("a_nan.exr"), with_nan);
+
   Image green_down = a;
   for (std::size_t i = 1; i < green_down.pixels.size(); i += 3) green_down.pixels[i] = 1.0f - green_down.pixels[i];
   nmbake::write_image(path("a_green_down.exr"), green_down);
