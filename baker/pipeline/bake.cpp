@@ -17,7 +17,6 @@
 #include "pipeline/select.h"
 #include "pipeline/tiles.h"
 #include "pipeline/trace.h"
-#include "trace/tile_kernels.h"
 
 namespace nmbake {
 
@@ -31,8 +30,6 @@ double process_cpu_seconds() {
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
   return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
-
-constexpr int kTile = 16;  // texels per tile side (twice that up to 4 samples)
 
 // Options and inputs a bake refuses (bake.h).
 void check_bake_inputs(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt) {
@@ -186,7 +183,7 @@ void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const Ba
 // Tiles of 32 x 32 texels up to 4 samples, else 16 x 16: a triangle's rows within a tile are
 // longer with the larger ones (less set-up per texel), and a tile's samples stay within the cache
 // with the smaller.
-int tile_side(const BakeOptions& opt) { return opt.samples <= 4 ? 2 * kTile : kTile; }
+int tile_side(const BakeOptions& opt) { return opt.samples <= 4 ? 2 * kTileSide : kTileSide; }
 
 int thread_count(const BakeOptions& opt) {
   return opt.threads > 0 ? opt.threads : std::max(1, int(std::thread::hardware_concurrency()));

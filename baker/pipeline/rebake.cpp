@@ -14,10 +14,6 @@
 
 namespace nmbake {
 
-namespace {
-constexpr int kTile = 16;  // texels per tile side
-}  // namespace
-
 // The bake's own preparation, rays and shading (prepare, sample_rays, chosen_hit, shade_sample)
 // for a list of texels; tests/test_error_estimate.cpp checks both agree texel for texel.
 std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt,
@@ -48,7 +44,7 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
   ray_setup.diagonal = s.diagonal;
   const int rays_per_sample = ray_setup.closest ? 2 : 1;
 
-  const TileBins bins = bin_triangles(low, W, H, kTile);
+  const TileBins bins = bin_triangles(low, W, H, kTileSide);
 
   const std::vector<glm::dvec2> offsets = sample_offsets(samples);
   std::vector<std::uint8_t> covered(texels.size(), 0);  // each entry written by one thread only

@@ -10,6 +10,9 @@
 
 namespace nmbake {
 
+// Texels per tile side (the trace doubles it up to 4 samples: tile_side in pipeline/bake.cpp).
+constexpr int kTileSide = 16;
+
 struct TileBins {
   int side = 16;  // texels per tile side
   int tiles_x = 0, tiles_y = 0;
