@@ -46,7 +46,7 @@ std::map<std::string, std::string> read_image_metadata(const std::string& path);
 // does nothing where it is linked. Optional: the functions above load it when first called.
 void preload_image_io();
 
-// Waits until a background load started by preload_image_io() has finished (at once where there
+// Waits until a background load started by preload_image_io() has finished and its thread ended (at once where there
 // is none). Call before the process exits: exiting while the library's static constructors run
 // can abort (one of OpenImageIO's plugins, gdcm, asserts), which turned an early error's exit
 // code 2 into an abort.
