@@ -17,6 +17,7 @@
 #include "core/errors.h"
 #include "io/image_io.h"
 #include "io/mesh_io.h"
+#include "io/text_file.h"
 #include "nmdiff.h"
 
 namespace {
@@ -85,14 +86,6 @@ nlohmann::json to_json(const std::string& a, const std::string& b, const DiffSta
   j["mask"] = mask.empty() ? nlohmann::json(nullptr) : nlohmann::json(mask);
   j["warnings"] = s.warnings;
   return j;
-}
-
-void write_text(const std::string& path, const std::string& text) {
-  std::ofstream f(path, std::ios::binary | std::ios::trunc);
-  if (!f) throw nmbake::OutputError(path + ": cannot write: " + std::strerror(errno));
-  f << text;
-  f.close();
-  if (!f) throw nmbake::OutputError(path + ": cannot write: " + std::strerror(errno));
 }
 
 // The command line as given, and the comparison options it sets.
@@ -251,7 +244,8 @@ void report(const CommandLine& cl, const Comparison& c) {
   for (const std::string& w : c.stats.warnings) std::cerr << "warning: " << w << "\n";
   if (!cl.heatmap_path.empty()) write_heatmap(cl, c);
   if (!cl.json_path.empty())
-    write_text(cl.json_path, to_json(cl.path_a, cl.path_b, c.stats, cl.options, cl.mask_path, cl.resample).dump(2) + "\n");
+    nmbake::write_text_atomically(cl.json_path,
+                                  to_json(cl.path_a, cl.path_b, c.stats, cl.options, cl.mask_path, cl.resample).dump(2) + "\n");
   std::cout << diff::summary_line(c.stats) << std::endl;
 }
 

@@ -25,6 +25,7 @@
 #include "core/errors.h"
 #include "io/image_io.h"
 #include "io/mesh_io.h"
+#include "io/text_file.h"
 #include "cli/report.h"
 #include "cli/warnings.h"
 

@@ -28,9 +28,6 @@ const char* to_string(BitangentMode m);
 
 nlohmann::json make_report(const BakeOptions& options, const BakeStats& stats, const RunInfo& run);
 
-// Writes `text` to a temporary file beside `path` and renames it into place; OutputError on failure.
-void write_text_atomically(const std::string& path, const std::string& text);
-
 // Peak resident memory of this process so far (bytes).
 std::uint64_t peak_memory_bytes();
 
