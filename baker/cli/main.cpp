@@ -27,6 +27,7 @@
 #include "io/mesh_io.h"
 #include "io/text_file.h"
 #include "cli/report.h"
+#include "core/parallel.h"
 #include "cli/warnings.h"
 
 namespace {
@@ -391,7 +392,7 @@ int run(int argc, char** argv) {
       std::fprintf(stderr, "nmbake: %s\n", w.c_str());
   run.seconds_total = std::chrono::duration<double>(Clock::now() - start).count();
   run.peak_memory_bytes = peak_memory_bytes();
-  run.threads_used = a.threads > 0 ? unsigned(a.threads) : std::max(1u, std::thread::hardware_concurrency());
+  run.threads_used = unsigned(worker_threads(a.threads));
   if (!a.report.empty()) write_report(a, o, run, s, a.estimate_error ? &estimate : nullptr);
   if (!a.quiet) print_summary(a, o, run, s, bits);
   return 0;

@@ -6,6 +6,8 @@
 #include <limits>
 #include <thread>
 
+#include "core/parallel.h"
+
 namespace nmbake {
 
 namespace {
@@ -67,7 +69,7 @@ std::size_t pad_islands(Image& image, const std::vector<std::uint8_t>& covered, 
   const std::size_t covered_count =
       std::size_t(std::count_if(covered.begin(), covered.end(), [](std::uint8_t c) { return c != 0; }));
   if (covered_count == 0 || covered_count == n) return 0;
-  if (threads <= 0) threads = std::max(1, int(std::thread::hardware_concurrency()));
+  threads = worker_threads(threads);
   // Both passes split into independent parts (columns, then rows) shared out to the threads; each
   // part's result is the same whichever thread computes it.
   auto parallel = [threads](int parts, auto&& part) {

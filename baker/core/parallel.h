@@ -11,6 +11,11 @@
 
 namespace nmbake {
 
+// The worker threads for a requested count: itself when positive, else all cores (at least 1).
+inline int worker_threads(int requested) {
+  return requested > 0 ? requested : std::max(1, int(std::thread::hardware_concurrency()));
+}
+
 template <typename Fn>
 void run_parallel(int threads, Fn&& worker) {
   std::vector<std::thread> pool;
@@ -21,7 +26,7 @@ void run_parallel(int threads, Fn&& worker) {
 
 template <typename Fn>
 void parallel_chunks(int threads, std::size_t count, std::size_t chunk, Fn&& fn) {
-  if (threads <= 0) threads = std::max(1, int(std::thread::hardware_concurrency()));
+  threads = worker_threads(threads);
   std::atomic<std::size_t> next{0};
   auto work = [&] {
     for (std::size_t i; (i = next.fetch_add(chunk)) < count;) fn(i, std::min(count, i + chunk));

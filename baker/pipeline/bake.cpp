@@ -8,6 +8,7 @@
 #include <exception>
 #include <thread>
 
+#include "core/parallel.h"
 #include "pipeline/bvh.h"
 #include "pipeline/distances.h"
 #include "pipeline/memory_budget.h"
@@ -185,10 +186,6 @@ void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const Ba
 // with the smaller.
 int tile_side(const BakeOptions& opt) { return opt.samples <= 4 ? 2 * kTileSide : kTileSide; }
 
-int thread_count(const BakeOptions& opt) {
-  return opt.threads > 0 ? opt.threads : std::max(1, int(std::thread::hardware_concurrency()));
-}
-
 }  // namespace
 
 void validate_options(const BakeOptions& o) {
@@ -214,7 +211,7 @@ void validate_options(const BakeOptions& o) {
 // caller's (io/).
 BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt) {
   check_bake_inputs(low, high, cage, opt);
-  const int threads = thread_count(opt);
+  const int threads = worker_threads(opt.threads);
   BakeResult result;
   BakeStats& st = result.stats;
   std::vector<std::uint8_t> disagree;  // per texel: its samples disagree (suspect), with several samples
@@ -240,7 +237,7 @@ BakeRays bake_rays(const Mesh& low, const Mesh& high, const Mesh* cage, const Ba
   check_bake_inputs(low, high, cage, opt);
   BakeResult result;
   TraceInputs in;
-  prepare_trace(low, high, cage, opt, thread_count(opt), in, result);
+  prepare_trace(low, high, cage, opt, worker_threads(opt.threads), in, result);
   const TileBins bins = bin_triangles(low, opt.width, opt.height, tile_side(opt));
   return {trace_rays(in.s, in.scene, bins, in.rays, opt), result.stats};
 }

@@ -21,7 +21,7 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
   const BakeStats& st = baked.stats;
   std::vector<glm::dvec3> out(texels.size(), glm::dvec3(0.0));
   if (texels.empty() || low.triangle_count() == 0 || high.triangle_count() == 0 || !low.has_uvs()) return out;
-  const int threads = opt.threads > 0 ? opt.threads : std::max(1, int(std::thread::hardware_concurrency()));
+  const int threads = worker_threads(opt.threads);
   const int W = opt.width, H = opt.height;
   BakeStats scratch;
   Prepared s = prepare(low, high, cage, scratch);
