@@ -113,6 +113,9 @@ const Defect kDefects[] = {
     // Found by the fuzzer (tests/fuzz/corpus/crash_ply_list_count_3e38): an ascii list length
     // beyond 2^64 was cast to an integer (undefined behaviour) before the size check.
     {"huge_list_count_ascii.ply", {"truncated: file ends in face 0 of 1"}},
+    // Issue 21: a number longer than 63 characters was cut to its first 63 and read as 7.
+    {"long_number.obj", {"line 1", "vertex 1", "non-finite"}},
+    {"short_texcoords.off", {"line 5", "vertex 2 has fewer than 2 texture coordinate"}},
 };
 
 std::string defect_test_name(const ::testing::TestParamInfo<Defect>& info) {
@@ -246,6 +249,41 @@ TEST(MeshIo, OffCommentsAndCountsOnTheHeaderLine) {
   ASSERT_EQ(m.positions.size(), 4u);
   EXPECT_EQ(m.positions[2], glm::vec3(1, 1, 0));
   EXPECT_EQ(m.position_index, (std::vector<std::uint32_t>{0, 1, 2, 0, 2, 3, 0, 2, 3}));
+}
+
+// Found by the fuzzer (tests/fuzz/corpus/oom_off_face_trailing_tokens): OpenMesh's reader left
+// what follows a face's indices for the next face's corner count; 2552147483648 made it push 2^32
+// corners (1.6 GB). Face colours and other trailing tokens are now dropped before it reads.
+TEST(MeshIo, OffFaceColoursAndTrailingTokensAreIgnored) {
+  MeshLoadInfo info;
+  Mesh m = load_mesh(data_path("defects/face_colours.off"), {}, &info);
+  EXPECT_EQ(info.file_faces, 3u);
+  ASSERT_EQ(m.positions.size(), 4u);
+  EXPECT_EQ(m.positions[3], glm::vec3(0, 1, 0));
+  EXPECT_EQ(m.position_index, (std::vector<std::uint32_t>{0, 1, 2, 0, 2, 3, 0, 1, 2, 0, 2, 3}));
+}
+
+// OpenMesh's reader learns N and ST from the magic only in a private call, so it read neither.
+TEST(MeshIo, OffNormalsAndTextureCoordinatesAreRead) {
+  MeshLoadInfo info;
+  Mesh m = load_mesh(data_path("defects/normals_colours_texcoords.off"), {true}, &info);
+  ASSERT_TRUE(m.has_uvs());
+  ASSERT_TRUE(m.has_normals());
+  const glm::vec2 uvs[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  for (std::size_t t = 0; t < m.triangle_count(); ++t)
+    for (int c = 0; c < 3; ++c) {
+      const std::uint32_t v = m.position_index[3 * t + c];
+      EXPECT_EQ(m.corner_uv(t, c), uvs[v]) << "vertex " << v;
+      EXPECT_EQ(m.corner_normal(t, c), glm::vec3(0, 0, 1)) << "vertex " << v;  // (0,0,2) renormalized
+    }
+  EXPECT_EQ(info.normals_renormalized, 1u);
+}
+
+TEST(MeshIo, LongNumbersAreParsedWhole) {
+  Mesh m = load_mesh(data_path("defects/long_numbers_in_range.obj"));
+  ASSERT_EQ(m.positions.size(), 3u);
+  EXPECT_EQ(m.positions[0].x, 1.0f);
+  EXPECT_EQ(m.positions[1].x, 0.1f);
 }
 
 TEST(MeshIo, StlDegenerateFacetIsCounted) {

@@ -99,12 +99,10 @@ bool parse_real(std::string_view token, Real& out) {
   auto result = std::from_chars(first, last, out);
   if (first == last || result.ptr != last) return false;
   if (result.ec == std::errc::result_out_of_range) {
-    // from_chars leaves `out` untouched here; strtod tells overflow (inf) from underflow (0).
-    char buffer[64];
-    std::size_t n = std::min<std::size_t>(std::size_t(last - first), sizeof buffer - 1);
-    std::memcpy(buffer, first, n);
-    buffer[n] = '\0';
-    out = static_cast<Real>(std::strtod(buffer, nullptr));
+    // from_chars leaves `out` untouched here; strtod tells overflow (inf) from underflow (0). The
+    // whole token is copied: a fixed buffer cut "7.000...0001e400" to "7.000..." and read 7.
+    const std::string whole(first, last);
+    out = static_cast<Real>(std::strtod(whole.c_str(), nullptr));
     return true;
   }
   return result.ec == std::errc();

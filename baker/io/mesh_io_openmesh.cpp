@@ -239,9 +239,33 @@ bool is_off_magic(std::string_view token) {
   return true;
 }
 
-// Validates an ASCII OFF file and returns it in the plain shape OpenMesh's reader needs: the magic
-// alone on the first line, the counts on the second, then one vertex or face per line, no comments.
-std::string check_off(const std::string& path, std::string_view text, std::size_t& vertex_count, std::size_t& face_count) {
+// Reads `count` finite numbers from `line` at `pos` into `out`, or fails naming the line and vertex.
+void read_numbers(const std::string& path, std::string_view line, std::size_t& pos, int count, const std::string& where,
+                  const char* what, float* out) {
+  for (int i = 0; i < count; ++i) {
+    std::string_view token = next_token(line, pos);
+    if (token.empty()) fail(path, where + " has fewer than " + std::to_string(count) + " " + what);
+    if (!parse_real(token, out[i])) fail(path, where + " has a malformed number " + quote(token));
+    if (!std::isfinite(out[i])) fail(path, where + " has a non-finite " + what);
+  }
+}
+
+// What check_off() reads of an ASCII OFF file.
+struct OffScan {
+  std::string clean;  // what OpenMesh's reader is given
+  std::size_t vertex_count = 0, face_count = 0;
+  std::vector<glm::vec3> normals;  // per vertex, for NOFF
+  std::vector<glm::vec2> uvs;      // per vertex, for STOFF
+};
+
+// Validates an ASCII OFF file and returns it in the plain shape OpenMesh's reader needs: "OFF"
+// alone on the first line, the counts on the second, then one vertex (x y z) or face (corner count
+// and indices) per line, nothing else. OpenMesh reads a face line's indices with operator>> and
+// leaves the rest, so anything after the last index (a face colour, junk) was read as the next
+// face's corner count: a fuzzed file made it push 2^32 corners. It also takes N, ST and C from
+// the magic only in a private call, so normals and texture coordinates are read here.
+OffScan check_off(const std::string& path, std::string_view text) {
+  OffScan scan;
   LineCursor lines(text);
   std::string_view line;
   if (!lines.next(line)) fail(path, "no faces");
@@ -251,6 +275,9 @@ std::string check_off(const std::string& path, std::string_view text, std::size_
   if (magic.find_first_of("4n") != std::string_view::npos) fail(path, quote(magic) + " (4D or n-D OFF) is not supported");
   std::string_view word = next_token(line, p);
   if (word == "BINARY") fail(path, "binary OFF is not supported; save it as ASCII OFF or as PLY");
+  const bool has_texcoords = magic.substr(0, 2) == "ST";
+  const bool has_colours = magic.find('C') != std::string_view::npos;
+  const bool has_normals = magic.find('N') != std::string_view::npos;
 
   // The counts follow on the magic's line or on the next one.
   std::string_view counts_line = line.substr(p - word.size());
@@ -264,27 +291,40 @@ std::string check_off(const std::string& path, std::string_view text, std::size_
     if (c < 0) fail(path, "line " + std::to_string(lines.line_number()) + ": negative count " + std::to_string(c));
   }
   if (counts[0] > UINT32_MAX || counts[1] > INT32_MAX) fail(path, "too many vertices or faces");
-  vertex_count = static_cast<std::size_t>(counts[0]);
-  face_count = static_cast<std::size_t>(counts[1]);
+  scan.vertex_count = static_cast<std::size_t>(counts[0]);
+  scan.face_count = static_cast<std::size_t>(counts[1]);
 
-  std::string clean = std::string(magic) + "\n" + std::to_string(vertex_count) + " " + std::to_string(face_count) + " 0\n";
+  std::string& clean = scan.clean;
+  clean = "OFF\n" + std::to_string(scan.vertex_count) + " " + std::to_string(scan.face_count) + " 0\n";
   auto at_line = [&] { return "line " + std::to_string(lines.line_number()) + ": "; };
-  for (std::size_t v = 0; v < vertex_count; ++v) {
+  for (std::size_t v = 0; v < scan.vertex_count; ++v) {
     if (!lines.next(line))
-      fail(path, "truncated: file ends in vertex " + std::to_string(v) + " of " + std::to_string(vertex_count));
+      fail(path, "truncated: file ends in vertex " + std::to_string(v) + " of " + std::to_string(scan.vertex_count));
+    const std::string where = at_line() + "vertex " + std::to_string(v);
     std::size_t q = 0;
-    for (int axis = 0; axis < 3; ++axis) {
-      std::string_view token = next_token(line, q);
-      float value = 0;
-      if (token.empty()) fail(path, at_line() + "vertex " + std::to_string(v) + " has fewer than 3 coordinates");
-      if (!parse_real(token, value))
-        fail(path, at_line() + "vertex " + std::to_string(v) + " has a malformed number " + quote(token));
-      if (!std::isfinite(value)) fail(path, at_line() + "vertex " + std::to_string(v) + " has a non-finite coordinate");
+    float x[3];
+    read_numbers(path, line, q, 3, where, "coordinate", x);
+    clean.append(line.substr(0, q)).push_back('\n');
+    if (has_normals) {
+      float n[3];
+      read_numbers(path, line, q, 3, where, "normal", n);
+      scan.normals.emplace_back(n[0], n[1], n[2]);
     }
-    clean.append(line).push_back('\n');
+    if (has_texcoords) {
+      // x y z [normal] [colour] s t: after a colour (1 to 4 values) the texture coordinate is last.
+      if (has_colours) {
+        std::vector<std::size_t> token_ends;
+        for (std::size_t r = q; !next_token(line, r).empty();) token_ends.push_back(r);
+        if (token_ends.size() > 2) q = token_ends[token_ends.size() - 3];
+      }
+      float t[2];
+      read_numbers(path, line, q, 2, where, "texture coordinate", t);
+      scan.uvs.emplace_back(t[0], t[1]);
+    }
   }
-  for (std::size_t f = 0; f < face_count; ++f) {
-    if (!lines.next(line)) fail(path, "truncated: file ends in face " + std::to_string(f) + " of " + std::to_string(face_count));
+  for (std::size_t f = 0; f < scan.face_count; ++f) {
+    if (!lines.next(line))
+      fail(path, "truncated: file ends in face " + std::to_string(f) + " of " + std::to_string(scan.face_count));
     const std::string face = "face " + std::to_string(f);
     std::size_t q = 0;
     std::string_view token = next_token(line, q);
@@ -298,11 +338,11 @@ std::string check_off(const std::string& path, std::string_view text, std::size_
       if (!parse_int(token, index)) fail(path, at_line() + face + " has a malformed vertex index " + quote(token));
       if (index < 0 || index >= counts[0])
         fail(path, at_line() + face + " refers to vertex " + std::to_string(index) + " but the file has " +
-                       std::to_string(vertex_count));
+                       std::to_string(scan.vertex_count));
     }
-    clean.append(line).push_back('\n');
+    clean.append(line.substr(0, q)).push_back('\n');  // a face colour, or anything after the indices, is dropped
   }
-  return clean;
+  return scan;
 }
 
 // STL pre-scan --------------------------------------------------------------------------------------
@@ -366,19 +406,26 @@ bool is_binary_stl(std::string_view bytes) {
 ParsedMesh parse_off(const std::string& path, std::string_view text) {
   ParsedMesh out;
   out.format = "off";
-  std::size_t vertex_count = 0, face_count = 0;
-  std::string clean = check_off(path, text, vertex_count, face_count);
-  if (face_count == 0) return out;  // load_mesh reports "no faces"
-  std::istringstream stream(clean);
+  const OffScan scan = check_off(path, text);
+  if (scan.face_count == 0) return out;  // load_mesh reports "no faces"
+  std::istringstream stream(scan.clean);
   read_with_openmesh(path, out, [&](FlatImporter& importer) {
     OpenMesh::IO::Options options;
-    options += OpenMesh::IO::Options::VertexNormal;
-    options += OpenMesh::IO::Options::VertexTexCoord;
     return OpenMesh::IO::OFFReader().read(stream, importer, options);
   });
-  if (out.mesh.positions.size() != vertex_count || out.file_faces != face_count)
-    fail(path, "OpenMesh read " + std::to_string(out.mesh.positions.size()) + " of " + std::to_string(vertex_count) +
-                   " vertices and " + std::to_string(out.file_faces) + " of " + std::to_string(face_count) + " faces");
+  if (out.mesh.positions.size() != scan.vertex_count || out.file_faces != scan.face_count)
+    fail(path, "OpenMesh read " + std::to_string(out.mesh.positions.size()) + " of " + std::to_string(scan.vertex_count) +
+                   " vertices and " + std::to_string(out.file_faces) + " of " + std::to_string(scan.face_count) + " faces");
+  // Every corner indexes its normal and UV by its vertex (FlatImporter::add_face).
+  if (!scan.normals.empty()) {
+    out.mesh.normals = scan.normals;
+    out.faces_with_normals = out.faces;
+  }
+  if (!scan.uvs.empty()) {
+    out.mesh.uvs = scan.uvs;
+    out.faces_with_uvs = out.faces;
+    out.first_face_without_uvs.clear();
+  }
   return out;
 }
 
