@@ -43,7 +43,9 @@ TEST(Stability, TranslatedAndScaledScenesMatchTheOriginal) {
   std::vector<Case> cases;
   cases.push_back({"far_1e5", load_low("far_1e5_low.obj"), load("far_1e5_high.obj"), 10.0f, 0.01});
   cases.push_back({"far_1e6", transformed(low, 1.0, 1e6), transformed(high, 1.0, 1e6), 10.0f, 0.05});
-  cases.push_back({"far_1e7", load_low("far_1e7_low.obj"), load("far_1e7_high.obj"), 10.0f, 1e9});
+  // far_1e7_*.obj carry float values at 1e7 and are refused by load_mesh (test below); the library
+  // is given them in float, as a caller with float meshes would.
+  cases.push_back({"far_1e7", transformed(low, 1.0, 1e7), transformed(high, 1.0, 1e7), 10.0f, 1e9});
   cases.push_back({"scaled_1e-5", load_low("scaled_1e-5_low.obj"), load("scaled_1e-5_high.obj"), 10.0f * 1e-5f, 1e-4});
   cases.push_back({"scaled_1e5", load_low("scaled_1e5_low.obj"), load("scaled_1e5_high.obj"), 10.0f * 1e5f, 1e-4});
   for (double off : {1e3, 1e4, 3e4, 3e5, 3e6})
@@ -69,17 +71,22 @@ TEST(Stability, TranslatedAndScaledScenesMatchTheOriginal) {
   }
 }
 
-TEST(Stability, FarFromOriginWarnsPastTheFloatLimit) {
+// Through the command, files far from the origin are re-centred when loaded (issue 21, item 1;
+// test_far_from_origin.cpp): the 1e5 pair bakes without a precision warning, and the 1e7 pair,
+// whose files carry float values there (steps of 1 on a mesh 142 across), is refused.
+TEST(Stability, FarFromOriginIsRecentredOrRefused) {
   const CliRun ok =
       run_nmbake(data("far_1e5_low.obj") + " " + data("far_1e5_high.obj") + " -o out.png --size 64 --report r.json");
   ASSERT_EQ(ok.code, 0);
   EXPECT_FALSE(contains(ok.err, "float precision")) << ok.err;
+  EXPECT_LT(ok.report["coordinate_spacing"].get<double>(), 1e-6);
   const CliRun far =
       run_nmbake(data("far_1e7_low.obj") + " " + data("far_1e7_high.obj") + " -o out.png --size 64 --report r.json");
-  ASSERT_EQ(far.code, 0);
-  EXPECT_TRUE(contains(far.err, "warning: coordinates reach 1e+07")) << far.err;
-  EXPECT_TRUE(contains(far.err, "float precision")) << far.err;
-  EXPECT_GT(far.report["coordinate_spacing"].get<double>(), 1e-3);
+  EXPECT_EQ(far.code, 2);
+  EXPECT_TRUE(contains(far.err, "far_1e7_low.obj: coordinates reach 1e+07 from the origin")) << far.err;
+  EXPECT_TRUE(contains(far.err, "steps of 1 (saved in float precision)")) << far.err;
+  EXPECT_FALSE(test::exists(far.dir + "/out.png"));
+  EXPECT_TRUE(far.report.is_null());
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -295,6 +295,7 @@ void write_outputs(const Args& a, const BakeOptions& o, const BakeResult& r, con
   }
   if (!a.save_cage.empty()) {
     Mesh cage_mesh;
+    cage_mesh.origin = low.origin;
     cage_mesh.positions = r.cage_positions;
     cage_mesh.uvs = low.uvs;
     cage_mesh.position_index = low.position_index;
@@ -364,9 +365,11 @@ int run(int argc, char** argv) {
   LoadOptions low_opts;
   low_opts.require_uvs = true;
   Mesh low = load_mesh(a.low, low_opts, &run.low_info);
-  Mesh high = load_mesh(a.high, {}, &run.high_info);
+  LoadOptions shared;  // the high-poly and the cage share the low-poly's origin (re-centred when far)
+  shared.origin = low.origin;
+  Mesh high = load_mesh(a.high, shared, &run.high_info);
   Mesh cage;
-  if (!a.cage.empty()) cage = load_mesh(a.cage, {}, &run.cage_info);
+  if (!a.cage.empty()) cage = load_mesh(a.cage, shared, &run.cage_info);
   const Mesh* cage_mesh = a.cage.empty() ? nullptr : &cage;
   run.seconds_load = std::chrono::duration<double>(Clock::now() - t0).count();
   if (g_interrupted) throw Cancelled();

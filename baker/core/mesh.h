@@ -19,6 +19,10 @@ namespace nmbake {
 struct Mesh {
   std::string source;  // file name, used in messages ("low.obj: face 3 ...")
 
+  // Positions are relative to `origin`: a mesh far from the file's origin is loaded re-centred
+  // (the file's coordinates minus origin, taken in double), so that float keeps its precision.
+  // Meshes baked together share one origin (load_mesh's LoadOptions::origin).
+  glm::dvec3 origin{0.0};
   std::vector<glm::vec3> positions;
   std::vector<glm::vec3> normals;  // unit length when present
   std::vector<glm::vec2> uvs;
@@ -39,6 +43,20 @@ struct Mesh {
   glm::vec3 corner_normal(std::size_t tri, int corner) const { return normals[normal_index[3 * tri + corner]]; }
 };
 
+// The mesh moved to another origin: the same points, positions re-expressed in double.
+inline Mesh with_origin(Mesh m, const glm::dvec3& origin) {
+  const glm::dvec3 shift = m.origin - origin;
+  for (glm::vec3& p : m.positions) p = glm::vec3(glm::dvec3(p) + shift);
+  m.origin = origin;
+  return m;
+}
+
+// Whether `high` and `cage` (may be null) share `low`'s origin, as meshes baked together must; the
+// bake entry points move copies of them onto it when they do not.
+inline bool share_origin(const Mesh& low, const Mesh& high, const Mesh* cage) {
+  return high.origin == low.origin && (!cage || cage->origin == low.origin);
+}
+
 // What loading found and repaired, for the report.
 struct MeshLoadInfo {
   std::size_t file_faces = 0;             // faces as written in the file
@@ -53,6 +71,7 @@ struct MeshLoadInfo {
   std::size_t faces_without_normals = 0;     // counted when only some faces had normals
   std::size_t faces_without_uvs = 0;         // counted when only some faces had UVs
   std::size_t degenerate_faces_dropped = 0;  // STL facets whose corners welded together (OpenMesh drops them)
+  double largest_coordinate = 0.0;           // largest |x|, |y| or |z| a face uses, as in the file
 };
 
 }  // namespace nmbake

@@ -7,11 +7,13 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <new>
 #include <string>
 #include <string_view>
@@ -162,6 +164,54 @@ void settle_normals(ParsedMesh& parsed, MeshLoadInfo& info) {
   }
 }
 
+// The step between neighbouring values of type Real at magnitude x.
+template <typename Real>
+double step_at(double x) {
+  const Real r = static_cast<Real>(std::fabs(x));
+  return double(std::nextafter(r, std::numeric_limits<Real>::infinity())) - double(r);
+}
+
+// Refuses positions whose values are too coarse for the mesh's size (kPrecisionLimit), then moves
+// the mesh to its origin (LoadOptions::origin): positions = file's coordinates - origin, in double.
+void place(ParsedMesh& parsed, const std::string& path, const LoadOptions& options, MeshLoadInfo& info) {
+  Mesh& m = parsed.mesh;
+  std::vector<glm::dvec3>& exact = parsed.exact_positions;
+  if (exact.size() != m.positions.size()) exact.assign(m.positions.begin(), m.positions.end());  // STL: float
+  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+  for (std::uint32_t i : m.position_index) {
+    lo = glm::min(lo, exact[i]);
+    hi = glm::max(hi, exact[i]);
+  }
+  double largest = 0.0;
+  for (int k = 0; k < 3; ++k) largest = std::max({largest, std::fabs(lo[k]), std::fabs(hi[k])});
+  const double diagonal = glm::length(hi - lo);
+  info.largest_coordinate = largest;
+  // The values' steps: float's at the largest coordinate when (nearly) every coordinate is a float
+  // value, as when a far mesh was saved from float, else double's.
+  double step = step_at<double>(largest);
+  if (step_at<float>(largest) > kPrecisionLimit * diagonal) {
+    std::size_t float_values = 0;
+    for (const glm::dvec3& p : exact)
+      for (int k = 0; k < 3; ++k) float_values += double(static_cast<float>(p[k])) == p[k];
+    if (double(float_values) >= 0.9 * 3.0 * double(exact.size())) step = step_at<float>(largest);
+  }
+  // Only a far mesh is judged: a mesh collapsed to a point at the origin is degenerate, not imprecise.
+  const bool far = largest > kFarFactor * diagonal;
+  if (far && step > kPrecisionLimit * diagonal) {
+    char problem[400];
+    std::snprintf(problem, sizeof problem,
+                  "coordinates reach %.3g from the origin, where its values move in steps of %.3g (%s) while the mesh is "
+                  "%.3g across: the map would be off by degrees; export it with more digits or move it near the origin",
+                  largest, step, step == step_at<double>(largest) ? "beyond double precision" : "saved in float precision",
+                  diagonal);
+    fail(path, problem);
+  }
+  const glm::dvec3 origin = options.origin ? *options.origin : far ? (lo + hi) * 0.5 : glm::dvec3(0.0);
+  m.origin = origin;
+  if (origin != glm::dvec3(0.0))
+    for (std::size_t i = 0; i < exact.size(); ++i) m.positions[i] = glm::vec3(exact[i] - origin);
+}
+
 Mesh finish_mesh(ParsedMesh parsed, const std::string& path, const LoadOptions& options, MeshLoadInfo& info) {
   if (parsed.faces == 0) fail(path, "no faces");
   info.format = parsed.format;
@@ -170,6 +220,7 @@ Mesh finish_mesh(ParsedMesh parsed, const std::string& path, const LoadOptions& 
   info.degenerate_faces_dropped = parsed.degenerate_faces_dropped;
   settle_uvs(parsed, path, options, info);
   settle_normals(parsed, info);
+  place(parsed, path, options, info);
   parsed.mesh.source = path;
   return std::move(parsed.mesh);
 }
@@ -225,7 +276,12 @@ std::string obj_text(const Mesh& mesh, const std::string& comment) {
   std::string out = "# " + comment + "\n";
   char line[160];
   for (const glm::vec3& p : mesh.positions) {
-    std::snprintf(line, sizeof line, "v %.9g %.9g %.9g\n", double(p.x), double(p.y), double(p.z));
+    if (mesh.origin == glm::dvec3(0.0)) {
+      std::snprintf(line, sizeof line, "v %.9g %.9g %.9g\n", double(p.x), double(p.y), double(p.z));
+    } else {
+      const glm::dvec3 q = glm::dvec3(p) + mesh.origin;  // back where the file had it, in double
+      std::snprintf(line, sizeof line, "v %.17g %.17g %.17g\n", q.x, q.y, q.z);
+    }
     out += line;
   }
   for (const glm::vec2& t : mesh.uvs) {

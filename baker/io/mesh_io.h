@@ -6,6 +6,7 @@
 // range (8000 vertices)". Polygons are fanned into triangles. Nothing is rescaled.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -15,7 +16,21 @@ namespace nmbake {
 
 struct LoadOptions {
   bool require_uvs = false;  // throw "<file>: face N has no UVs" when any face lacks them
+  // The point subtracted (in double) from the file's coordinates: Mesh::origin. Unset: the centre
+  // of the mesh's bounds when the mesh lies farther from the file's origin than kFarFactor times
+  // its size, else (0,0,0). Meshes baked together must share one: load the low-poly first and
+  // pass its origin for the high-poly and the cage.
+  std::optional<glm::dvec3> origin = std::nullopt;
 };
+
+// A mesh whose largest coordinate exceeds kFarFactor times its bounding-box diagonal is loaded
+// re-centred (float would lose more than 4 bits of its precision there).
+constexpr double kFarFactor = 16.0;
+
+// Positions whose values carry steps coarser than kPrecisionLimit of the mesh's diagonal (a far
+// mesh saved in float precision, or beyond double's reach) are refused: the map would be off by
+// degrees (the same bound as kCoordinateSpacingWarn for positions given to the library).
+constexpr double kPrecisionLimit = 1e-3;
 
 // Reads `path`. Throws InputError on a missing, empty, unreadable or invalid file (no faces,
 // non-finite coordinates, indices out of range, truncated binary data, ...).

@@ -15,6 +15,7 @@
 #include <cstring>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "core/errors.h"
 #include "core/mesh.h"
@@ -26,6 +27,9 @@ namespace nmbake::mesh_io_detail {
 // A reader that knows up front the file has no UVs (normals) turns the slots off.
 struct ParsedMesh {
   Mesh mesh;
+  // The positions as the file has them, in double, from readers whose values may carry more than
+  // float (OBJ, PLY, OFF); empty for STL. mesh.positions holds them rounded to float.
+  std::vector<glm::dvec3> exact_positions;
   bool corner_uvs = true;
   bool corner_normals = true;
   std::string format;  // see MeshLoadInfo::format

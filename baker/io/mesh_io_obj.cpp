@@ -39,7 +39,8 @@ class ObjParser {
 
  private:
   [[noreturn]] void fail_line(const std::string& problem) const { fail(path_, "line " + std::to_string(line_) + ": " + problem); }
-  float read_value(std::string_view line, std::size_t& pos, Attribute element, bool required, bool& present) const;
+  template <typename Real>
+  Real read_value(std::string_view line, std::size_t& pos, Attribute element, bool required, bool& present) const;
   void parse_vertex(std::string_view line, std::size_t pos);
   void parse_uv(std::string_view line, std::size_t pos);
   void parse_normal(std::string_view line, std::size_t pos);
@@ -58,7 +59,8 @@ class ObjParser {
 };
 
 // One number of a v, vt or vn statement; `element` names it in messages.
-float ObjParser::read_value(std::string_view line, std::size_t& pos, Attribute element, bool required, bool& present) const {
+template <typename Real>
+Real ObjParser::read_value(std::string_view line, std::size_t& pos, Attribute element, bool required, bool& present) const {
   auto name = [&] {
     return std::string(kAttributeNames[element]) + " " + std::to_string(attribute_count(out_.mesh, element) + 1);
   };
@@ -66,29 +68,31 @@ float ObjParser::read_value(std::string_view line, std::size_t& pos, Attribute e
   present = !token.empty() && token[0] != '#';
   if (!present) {
     if (required) fail_line(name() + " has too few values");
-    return 0.0f;
+    return Real(0);
   }
-  float value = 0.0f;
+  Real value = 0;
   if (!parse_real(token, value)) fail_line(name() + " has a malformed number " + quote(token));
   return value;
 }
 
 void ObjParser::parse_vertex(std::string_view line, std::size_t pos) {
   bool present = false;
-  glm::vec3 p;
-  for (int i = 0; i < 3; ++i) p[i] = read_value(line, pos, kPosition, true, present);
+  glm::dvec3 exact;  // in double: a mesh far from the origin is re-centred before rounding to float
+  for (int i = 0; i < 3; ++i) exact[i] = read_value<double>(line, pos, kPosition, true, present);
+  const glm::vec3 p(exact);
   auto& positions = out_.mesh.positions;
   if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
     fail_line("vertex " + std::to_string(positions.size() + 1) + " has a non-finite coordinate");
   if (positions.size() >= UINT32_MAX) fail_line("more than 2^32-1 vertices");
   positions.push_back(p);
+  out_.exact_positions.push_back(exact);
 }
 
 void ObjParser::parse_uv(std::string_view line, std::size_t pos) {
   bool present = false;
   glm::vec2 uv;
-  uv.x = read_value(line, pos, kUv, true, present);
-  uv.y = read_value(line, pos, kUv, false, present);  // 1D textures omit v
+  uv.x = read_value<float>(line, pos, kUv, true, present);
+  uv.y = read_value<float>(line, pos, kUv, false, present);  // 1D textures omit v
   auto& uvs = out_.mesh.uvs;
   if (!std::isfinite(uv.x) || !std::isfinite(uv.y))
     fail_line("texture coordinate " + std::to_string(uvs.size() + 1) + " has a non-finite value");
@@ -99,7 +103,7 @@ void ObjParser::parse_uv(std::string_view line, std::size_t pos) {
 void ObjParser::parse_normal(std::string_view line, std::size_t pos) {
   bool present = false;
   glm::vec3 n;
-  for (int i = 0; i < 3; ++i) n[i] = read_value(line, pos, kNormal, true, present);
+  for (int i = 0; i < 3; ++i) n[i] = read_value<float>(line, pos, kNormal, true, present);
   auto& normals = out_.mesh.normals;
   if (!std::isfinite(n.x) || !std::isfinite(n.y) || !std::isfinite(n.z))
     fail_line("normal " + std::to_string(normals.size() + 1) + " has a non-finite component");

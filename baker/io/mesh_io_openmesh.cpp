@@ -240,13 +240,14 @@ bool is_off_magic(std::string_view token) {
 }
 
 // Reads `count` finite numbers from `line` at `pos` into `out`, or fails naming the line and vertex.
+template <typename Real>
 void read_numbers(const std::string& path, std::string_view line, std::size_t& pos, int count, const std::string& where,
-                  const char* what, float* out) {
+                  const char* what, Real* out) {
   for (int i = 0; i < count; ++i) {
     std::string_view token = next_token(line, pos);
     if (token.empty()) fail(path, where + " has fewer than " + std::to_string(count) + " " + what);
     if (!parse_real(token, out[i])) fail(path, where + " has a malformed number " + quote(token));
-    if (!std::isfinite(out[i])) fail(path, where + " has a non-finite " + what);
+    if (!std::isfinite(out[i]) || !std::isfinite(static_cast<float>(out[i]))) fail(path, where + " has a non-finite " + what);
   }
 }
 
@@ -254,8 +255,9 @@ void read_numbers(const std::string& path, std::string_view line, std::size_t& p
 struct OffScan {
   std::string clean;  // what OpenMesh's reader is given
   std::size_t vertex_count = 0, face_count = 0;
-  std::vector<glm::vec3> normals;  // per vertex, for NOFF
-  std::vector<glm::vec2> uvs;      // per vertex, for STOFF
+  std::vector<glm::dvec3> positions;  // in double (OpenMesh reads float)
+  std::vector<glm::vec3> normals;     // per vertex, for NOFF
+  std::vector<glm::vec2> uvs;         // per vertex, for STOFF
 };
 
 // Validates an ASCII OFF file and returns it in the plain shape OpenMesh's reader needs: "OFF"
@@ -302,8 +304,9 @@ OffScan check_off(const std::string& path, std::string_view text) {
       fail(path, "truncated: file ends in vertex " + std::to_string(v) + " of " + std::to_string(scan.vertex_count));
     const std::string where = at_line() + "vertex " + std::to_string(v);
     std::size_t q = 0;
-    float x[3];
+    double x[3];
     read_numbers(path, line, q, 3, where, "coordinate", x);
+    scan.positions.emplace_back(x[0], x[1], x[2]);
     clean.append(line.substr(0, q)).push_back('\n');
     if (has_normals) {
       float n[3];
@@ -416,6 +419,7 @@ ParsedMesh parse_off(const std::string& path, std::string_view text) {
   if (out.mesh.positions.size() != scan.vertex_count || out.file_faces != scan.face_count)
     fail(path, "OpenMesh read " + std::to_string(out.mesh.positions.size()) + " of " + std::to_string(scan.vertex_count) +
                    " vertices and " + std::to_string(out.file_faces) + " of " + std::to_string(scan.face_count) + " faces");
+  out.exact_positions = scan.positions;
   // Every corner indexes its normal and UV by its vertex (FlatImporter::add_face).
   if (!scan.normals.empty()) {
     out.mesh.normals = scan.normals;

@@ -346,8 +346,10 @@ Layout assign_roles(const std::string& path, Header& header) {
   return layout;
 }
 
-void read_vertex(DataReader& reader, const Element& e, const Layout& layout, std::uint64_t i, Mesh& m) {
-  glm::vec3 p(0), n(0);
+void read_vertex(DataReader& reader, const Element& e, const Layout& layout, std::uint64_t i, ParsedMesh& out) {
+  Mesh& m = out.mesh;
+  glm::dvec3 exact(0);  // in double: a mesh far from the origin is re-centred before rounding to float
+  glm::vec3 n(0);
   glm::vec2 uv(0);
   for (const Property& prop : e.properties) {
     if (prop.is_list) {
@@ -358,11 +360,12 @@ void read_vertex(DataReader& reader, const Element& e, const Layout& layout, std
       reader.skip(prop.type, 1);
       continue;
     }
-    float value = static_cast<float>(reader.read(prop.type));
+    const double exact_value = reader.read(prop.type);
+    const float value = static_cast<float>(exact_value);
     switch (prop.role) {
-      case kX: p.x = value; break;
-      case kY: p.y = value; break;
-      case kZ: p.z = value; break;
+      case kX: exact.x = exact_value; break;
+      case kY: exact.y = exact_value; break;
+      case kZ: exact.z = exact_value; break;
       case kNx: n.x = value; break;
       case kNy: n.y = value; break;
       case kNz: n.z = value; break;
@@ -371,10 +374,12 @@ void read_vertex(DataReader& reader, const Element& e, const Layout& layout, std
       default: break;
     }
   }
+  const glm::vec3 p(exact);
   if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) reader.fail_here("has a non-finite coordinate");
   if (!std::isfinite(n.x) || !std::isfinite(n.y) || !std::isfinite(n.z)) reader.fail_here("has a non-finite normal");
   if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) reader.fail_here("has a non-finite texture coordinate");
   m.positions[i] = p;
+  out.exact_positions[i] = exact;
   if (layout.normals) m.normals[i] = n;
   if (layout.vertex_uvs) m.uvs[i] = uv;
 }
@@ -474,6 +479,7 @@ ParsedMesh parse_ply(const std::string& path, std::string_view bytes) {
   if (vertex.count > UINT32_MAX) fail(path, "more than 2^32-1 vertices");
   Mesh& m = out.mesh;
   m.positions.resize(vertex.count);
+  out.exact_positions.resize(vertex.count);
   if (layout.normals) m.normals.resize(vertex.count);
   if (layout.vertex_uvs) m.uvs.resize(vertex.count);
   out.corner_uvs = layout.vertex_uvs || layout.face_texcoords;
@@ -489,7 +495,7 @@ ParsedMesh parse_ply(const std::string& path, std::string_view bytes) {
     for (std::uint64_t i = 0; i < e.count; ++i) {
       reader.start(e, i);
       if (is_vertex) {
-        read_vertex(reader, e, layout, i, m);
+        read_vertex(reader, e, layout, i, out);
       } else if (is_face) {
         faces.read(reader, e, i);
       } else {

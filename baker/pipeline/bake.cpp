@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <optional>
 #include <thread>
 
 #include "core/parallel.h"
@@ -210,6 +211,10 @@ void validate_options(const BakeOptions& o) {
 // selection once they are known), rasterize, trace and shade, pad. Loading and writing are the
 // caller's (io/).
 BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt) {
+  if (!share_origin(low, high, cage)) {  // loaded each on its own (nmbake loads them on one origin)
+    const std::optional<Mesh> moved_cage = cage ? std::optional<Mesh>(with_origin(*cage, low.origin)) : std::nullopt;
+    return bake_normal_map(low, with_origin(high, low.origin), moved_cage ? &*moved_cage : nullptr, opt);
+  }
   check_bake_inputs(low, high, cage, opt);
   const int threads = worker_threads(opt.threads);
   BakeResult result;
@@ -234,6 +239,10 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
 }
 
 BakeRays bake_rays(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt) {
+  if (!share_origin(low, high, cage)) {
+    const std::optional<Mesh> moved_cage = cage ? std::optional<Mesh>(with_origin(*cage, low.origin)) : std::nullopt;
+    return bake_rays(low, with_origin(high, low.origin), moved_cage ? &*moved_cage : nullptr, opt);
+  }
   check_bake_inputs(low, high, cage, opt);
   BakeResult result;
   TraceInputs in;

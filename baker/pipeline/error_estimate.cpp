@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <random>
 
 namespace nmbake {
@@ -33,6 +34,10 @@ float quantize(float c, int bits) {
 
 ErrorEstimate estimate_bake_error(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& options,
                                   const BakeResult& result, const ErrorEstimateOptions& eo) {
+  if (!share_origin(low, high, cage)) {  // as bake_normal_map does
+    const std::optional<Mesh> moved_cage = cage ? std::optional<Mesh>(with_origin(*cage, low.origin)) : std::nullopt;
+    return estimate_bake_error(low, with_origin(high, low.origin), moved_cage ? &*moved_cage : nullptr, options, result, eo);
+  }
   const auto t0 = std::chrono::steady_clock::now();
   ErrorEstimate e;
   e.samples = std::min(kMaxSamples, std::max(eo.samples, 4 * options.samples));
