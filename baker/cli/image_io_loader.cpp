@@ -14,6 +14,7 @@
 #include <future>
 #include <mutex>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -26,7 +27,8 @@ namespace {
 
 struct Loaded {
   const ImageIoModule* module = nullptr;
-  std::string error;  // why it could not be loaded
+  std::string error;    // why it could not be loaded
+  bool memory = false;  // for want of memory (ulimit -v): exit 4, not the caller's code
 };
 
 // Where the module may be, in the order looked at: next to the executable (the build tree's baker/
@@ -66,6 +68,7 @@ Loaded load() {
   if (!handle) {
     const char* why = ::dlerror();
     l.error = "cannot load the image library module " + path + ": " + (why ? why : "unknown error");
+    l.memory = why && (std::strstr(why, "Cannot allocate memory") || std::strstr(why, "failed to map segment"));
     return l;
   }
   using Entry = const ImageIoModule* (*)();
@@ -87,18 +90,31 @@ std::shared_future<Loaded> g_loaded;
 // about once in a few hundred runs under load). main() joins it (wait_for_image_io).
 std::thread g_loader;
 
+std::packaged_task<Loaded()> g_task;
+
+// Never throws: it runs before main()'s error handling. Without memory for the task, g_loaded stays
+// empty (module() reports it); without a thread (EAGAIN under ulimit), the load runs here.
 void start() {
   std::call_once(g_started, [] {
-    std::packaged_task<Loaded()> task(load);
-    g_loaded = task.get_future().share();
-    g_loader = std::thread(std::move(task));
+    try {
+      g_task = std::packaged_task<Loaded()>(load);
+      g_loaded = g_task.get_future().share();
+      try {
+        g_loader = std::thread([] { g_task(); });
+      } catch (const std::system_error&) {
+        g_task();
+      }
+    } catch (const std::exception&) {
+      g_loaded = {};
+    }
   });
 }
 
 const ImageIoModule& module(const std::string& path, ExitCode failure) {
   start();
+  if (!g_loaded.valid()) throw ResourceError(path + ": out of memory loading the image library");
   const Loaded& l = g_loaded.get();
-  if (!l.module) throw Error(failure, path + ": " + l.error);
+  if (!l.module) throw Error(l.memory ? ExitCode::memory : failure, path + ": " + l.error);
   return *l.module;
 }
 
@@ -121,6 +137,7 @@ void wait_for_image_io() {
 
 std::string image_io_problem() {
   start();
+  if (!g_loaded.valid()) return "out of memory loading the image library";
   if (g_loaded.wait_for(std::chrono::seconds(0)) == std::future_status::ready && !g_loaded.get().module)
     return g_loaded.get().error;
   std::string error;

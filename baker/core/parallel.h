@@ -1,11 +1,14 @@
-// worker(id) on `threads` threads, ids 0 .. threads - 1 (0: the caller's), joined before return.
-// A loop over [0, count) in chunks shared out to `threads` threads (the caller's among them):
+// run_parallel: worker(id) on `threads` threads, ids 0 .. threads - 1 (0: the caller's), joined
+// before return.
+// parallel_chunks: a loop over [0, count) in chunks shared out to `threads` threads (the caller's among them):
 // fn(begin, end) for each chunk, in no particular order. threads <= 0: all cores.
 #pragma once
 
 #include <algorithm>
 #include <atomic>
 #include <cstddef>
+#include <exception>
+#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -16,25 +19,47 @@ inline int worker_threads(int requested) {
   return requested > 0 ? requested : std::max(1, int(std::thread::hardware_concurrency()));
 }
 
+// Runs fn(id) for ids [0, count) on the caller's thread and up to count - 1 new ones, joined before
+// return. An exception in any of them (std::bad_alloc under a memory limit) is rethrown here once
+// all have ended, not std::terminate; ids whose thread could not be started (EAGAIN under
+// ulimit) run on the caller's thread.
+template <typename Fn>
+void run_on_threads(int count, Fn&& fn) {
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  auto guarded = [&](int id) {
+    try {
+      fn(id);
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(error_mutex);
+      if (!error) error = std::current_exception();
+    }
+  };
+  std::vector<std::thread> pool;
+  int started = 1;
+  try {
+    pool.reserve(std::size_t(std::max(0, count - 1)));
+    for (; started < count; ++started) pool.emplace_back(guarded, started);
+  } catch (...) {
+  }
+  guarded(0);
+  for (int id = started; id < count; ++id) guarded(id);
+  for (auto& t : pool) t.join();
+  if (error) std::rethrow_exception(error);
+}
+
 template <typename Fn>
 void run_parallel(int threads, Fn&& worker) {
-  std::vector<std::thread> pool;
-  for (int i = 1; i < threads; ++i) pool.emplace_back(worker, i);
-  worker(0);
-  for (auto& t : pool) t.join();
+  run_on_threads(threads, worker);
 }
 
 template <typename Fn>
 void parallel_chunks(int threads, std::size_t count, std::size_t chunk, Fn&& fn) {
   threads = worker_threads(threads);
   std::atomic<std::size_t> next{0};
-  auto work = [&] {
+  run_on_threads(threads, [&](int) {
     for (std::size_t i; (i = next.fetch_add(chunk)) < count;) fn(i, std::min(count, i + chunk));
-  };
-  std::vector<std::thread> pool;
-  for (int i = 1; i < threads; ++i) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
+  });
 }
 
 }  // namespace nmbake

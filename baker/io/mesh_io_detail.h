@@ -56,16 +56,40 @@ bool is_binary_stl(std::string_view bytes);
 // (position, uv, normal) indices of one corner.
 using Corner = std::array<std::uint32_t, 3>;
 
-// Appends the fan (0,i,i+1) of a polygon's `n` corners as triangles of file face `face`.
+// Polygons with more corners than this are not fanned (below).
+constexpr std::size_t kMaxFanCorners = 64;
+
+// Appends a polygon's `n` corners as triangles of file face `face`: the fan (0,i,i+1) as Blender and
+// most tools cut it, up to kMaxFanCorners; beyond, corners are cut off in passes (every second
+// corner of what is left, each with its two neighbours), so triangles halve in number and double in
+// size from pass to pass. A fan of n corners is n thin triangles spanning the polygon, whose boxes
+// all overlap: every ray met all of them (a one-million-corner disc took minutes at 64^2); the
+// passes give boxes that overlap about log n deep. Both cover a convex polygon exactly.
 inline void add_polygon(ParsedMesh& out, const Corner* corners, std::size_t n, std::uint32_t face) {
   Mesh& m = out.mesh;
-  for (std::size_t i = 1; i + 1 < n; ++i) {
-    for (std::size_t c : {std::size_t(0), i, i + 1}) {
-      m.position_index.push_back(corners[c][0]);
-      if (out.corner_uvs) m.uv_index.push_back(corners[c][1]);
-      if (out.corner_normals) m.normal_index.push_back(corners[c][2]);
+  auto triangle = [&](std::size_t a, std::size_t b, std::size_t c) {
+    for (std::size_t k : {a, b, c}) {
+      m.position_index.push_back(corners[k][0]);
+      if (out.corner_uvs) m.uv_index.push_back(corners[k][1]);
+      if (out.corner_normals) m.normal_index.push_back(corners[k][2]);
     }
     m.source_face.push_back(face);
+  };
+  if (n <= kMaxFanCorners) {
+    for (std::size_t i = 1; i + 1 < n; ++i) triangle(0, i, i + 1);
+  } else {
+    std::vector<std::size_t> left(n), next;
+    for (std::size_t i = 0; i < n; ++i) left[i] = i;
+    while (left.size() >= 3) {
+      next.clear();
+      std::size_t i = 0;
+      for (; i + 2 < left.size(); i += 2) {
+        triangle(left[i], left[i + 1], left[i + 2]);
+        next.push_back(left[i]);
+      }
+      next.insert(next.end(), left.begin() + std::ptrdiff_t(i), left.end());
+      left.swap(next);
+    }
   }
   ++out.faces;
   if (n > 3) ++out.polygons_triangulated;

@@ -5,9 +5,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <exception>
 #include <optional>
+#include <string>
 #include <thread>
+#include <utility>
 
 #include "core/parallel.h"
 #include "pipeline/bvh.h"
@@ -33,6 +36,32 @@ double process_cpu_seconds() {
   return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
+// Refuses coordinates, and ray starts, beyond kMaxCoordinate (exit 2).
+void check_coordinate_range(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt) {
+  auto largest = [](const Mesh& m) {
+    float l = 0.0f;
+    for (const glm::vec3& p : m.positions) l = std::max({l, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+    return double(l);
+  };
+  auto refuse = [](const std::string& what, double value) {
+    char text[300];
+    std::snprintf(text, sizeof text, "%s %.3g from the origin; a bake takes coordinates up to %.0e (scale or move the meshes)",
+                  what.c_str(), value, kMaxCoordinate);
+    throw InputError(text);
+  };
+  const double low_largest = largest(low), cage_largest = cage ? largest(*cage) : 0.0;
+  for (const auto& [m, l] : {std::pair{&low, low_largest}, std::pair{&high, largest(high)}, std::pair{cage, cage_largest}})
+    if (m && l > kMaxCoordinate) refuse(m->source + ": coordinates reach", l);
+  const double front = std::max(0.0f, opt.front), rear = std::max(0.0f, opt.rear);
+  const double starts = std::max(low_largest, cage_largest) + front + rear;
+  if (starts > kMaxCoordinate) {
+    char what[120];
+    std::snprintf(what, sizeof what, "%s %.3g: rays would start or end up to", front >= rear ? "--front" : "--rear",
+                  std::max(front, rear));
+    refuse(what, starts);
+  }
+}
+
 // Options and inputs a bake refuses (bake.h).
 void check_bake_inputs(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt) {
   validate_options(opt);
@@ -44,6 +73,7 @@ void check_bake_inputs(const Mesh& low, const Mesh& high, const Mesh* cage, cons
     throw InputError(cage->source + ": the cage must have the low-poly's topology (" + std::to_string(cage->triangle_count()) +
                      " triangles, " + std::to_string(cage->positions.size()) + " vertices; " + low.source + " has " +
                      std::to_string(low.triangle_count()) + " and " + std::to_string(low.positions.size()) + ")");
+  check_coordinate_range(low, high, cage, opt);
   {
     const std::uint64_t need = estimate_bake_bytes(opt);
     const std::uint64_t avail = opt.memory_limit ? opt.memory_limit : memory_budget_bytes();
@@ -155,6 +185,7 @@ void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const Ba
   if (opt.cull_far)
     kept = select_reachable(
         s, high, mode.probing ? mode.reach * 1.01 + 1e-6 * s.diagonal : ray_margin(s, mode.any_cage, opt.front, opt.rear));
+  st.high_duplicates_skipped = drop_duplicate_floods(s, high, threads, kept);
   HighScene& scene = in.scene;
   build_high_scene(scene, s, high, kept, bvh_quality_for(opt, kept.empty() ? high.triangle_count() : kept.size()), opt.threads);
   st.seconds_bvh = seconds_since(t0);

@@ -32,7 +32,11 @@ enum class NormalSpace { tangent, object };
 constexpr int kMaxMapSide = 65536;  // texels per side; larger maps are refused (ResourceError)
 constexpr int kMaxSamples = 1024;   // sample points per texel
 constexpr int kMaxThreads = 1024;
-constexpr double kMaxDistance = 1e30;            // --front, --rear: scene units
+constexpr double kMaxDistance = 1e30;  // --front, --rear: scene units
+// Largest |coordinate| of a mesh, and of a ray's start (coordinate + --front + --rear), a bake
+// takes: Embree asserts (aborts) on ray origins beyond 1.8e18, and float geometry there has no
+// digits left for a map anyway.
+constexpr double kMaxCoordinate = 1e17;
 constexpr double kCoordinateSpacingWarn = 1e-3;  // BakeStats::coordinate_spacing above this: warn
 // BakeStats::backface_probe_share above which the high-poly is taken as inverted, and above which
 // (up to the first) as partly inverted, when back faces are kept.
@@ -89,7 +93,8 @@ struct BakeStats {
   // outside the low-poly), over all hits.
   double hit_distance_min = 0.0, hit_distance_mean = 0.0, hit_distance_max = 0.0;
   std::size_t low_triangles = 0, high_triangles = 0;
-  std::size_t high_triangles_culled = 0;                              // left out of the BVH: out of every ray's reach
+  std::size_t high_triangles_culled = 0;    // left out of the BVH: out of every ray's reach
+  std::size_t high_duplicates_skipped = 0;  // of those, repeats in a stack of identical triangles (select.h)
   raycast::BuildQuality bvh_quality = raycast::BuildQuality::medium;  // of the BVH traced (bvh_quality_for)
   std::size_t degenerate_uv_triangles = 0, degenerate_3d_triangles = 0, corners_without_tangent = 0;
   std::size_t uv_outside_triangles = 0;           // low-poly triangles with a UV outside [0,1]

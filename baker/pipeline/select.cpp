@@ -1,6 +1,11 @@
 #include "pipeline/select.h"
 
 #include <algorithm>
+#include <array>
+#include <cstdint>
+#include <cstring>
+
+#include "core/parallel.h"
 
 namespace nmbake {
 
@@ -43,6 +48,75 @@ bool narrow_reachable(const Prepared& s, const Mesh& high, double margin, std::v
   if (!(double(nearer.size()) < 0.8 * double(current.size()))) return false;
   kept = std::move(nearer);
   return true;
+}
+
+namespace {
+
+// A triangle's corner positions as bits, rotated to start at the smallest (winding kept).
+using TriangleKey = std::array<std::uint32_t, 9>;
+
+TriangleKey triangle_key(const Prepared& s, const Mesh& high, std::uint32_t t) {
+  std::array<std::array<std::uint32_t, 3>, 3> c;
+  for (int k = 0; k < 3; ++k) std::memcpy(c[k].data(), &s.high_pos[high.position_index[3 * std::size_t(t) + k]], 12);
+  const int first = int(std::min_element(c.begin(), c.end()) - c.begin());
+  TriangleKey key;
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 3; ++j) key[3 * k + j] = c[(first + k) % 3][j];
+  return key;
+}
+
+std::uint64_t key_hash(const TriangleKey& key) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (std::uint32_t b : key) h = (h ^ b) * 1099511628211ull;
+  return h ^ (h >> 31);
+}
+
+}  // namespace
+
+std::size_t drop_duplicate_floods(const Prepared& s, const Mesh& high, int threads, std::vector<std::uint32_t>& kept) {
+  const std::size_t n = kept.empty() ? high.triangle_count() : kept.size();
+  auto triangle = [&](std::size_t i) { return kept.empty() ? std::uint32_t(i) : kept[i]; };
+  // Count triangles per hash bucket: a group of k identical triangles puts k in one bucket.
+  std::size_t buckets = 1024;
+  while (buckets < 2 * n) buckets *= 2;
+  std::vector<std::uint16_t> count(buckets, 0);
+  std::vector<std::uint64_t> hash(n);
+  parallel_chunks(threads, n, 1 << 16, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) hash[i] = key_hash(triangle_key(s, high, triangle(i)));
+  });
+  bool suspects = false;
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint16_t& c = count[hash[i] & (buckets - 1)];
+    if (c < UINT16_MAX) ++c;
+    suspects |= c > kDuplicateFlood;
+  }
+  if (!suspects) return 0;
+  // The triangles of crowded buckets, grouped by key (first triangle first); repeats are left out.
+  struct Suspect {
+    TriangleKey key;
+    std::uint32_t triangle;
+  };
+  std::vector<Suspect> crowded;
+  for (std::size_t i = 0; i < n; ++i)
+    if (count[hash[i] & (buckets - 1)] > kDuplicateFlood) crowded.push_back({triangle_key(s, high, triangle(i)), triangle(i)});
+  std::sort(crowded.begin(), crowded.end(),
+            [](const Suspect& a, const Suspect& b) { return a.key != b.key ? a.key < b.key : a.triangle < b.triangle; });
+  std::vector<std::uint32_t> dropped;
+  for (std::size_t i = 0; i < crowded.size();) {
+    std::size_t j = i + 1;
+    while (j < crowded.size() && crowded[j].key == crowded[i].key) ++j;
+    if (j - i > kDuplicateFlood)
+      for (std::size_t k = i + 1; k < j; ++k) dropped.push_back(crowded[k].triangle);
+    i = j;
+  }
+  if (dropped.empty()) return 0;
+  std::sort(dropped.begin(), dropped.end());
+  std::vector<std::uint32_t> result;
+  result.reserve(n - dropped.size());
+  for (std::size_t i = 0; i < n; ++i)
+    if (!std::binary_search(dropped.begin(), dropped.end(), triangle(i))) result.push_back(triangle(i));
+  kept = std::move(result);
+  return dropped.size();
 }
 
 }  // namespace nmbake
