@@ -37,7 +37,9 @@ Scene load_scene(const std::string& low_path, const std::string& map_path, const
     log << "nmview: warning: " << map_path << ": mean blue " << blue
         << " < 0.5, so most normals point into the surface; is this a tangent-space normal map?\n";
 
-  nmbake::Mesh high = nmbake::load_mesh(high_path);
+  nmbake::LoadOptions high_options;  // on the low-poly's origin (both re-centred when far), as nmbake does
+  high_options.origin = low.origin;
+  nmbake::Mesh high = nmbake::load_mesh(high_path, high_options);
   if (nmbake::ensure_normals(high))
     log << "nmview: " << high_path << " has no normals; using the bake's angle-weighted normals\n";
 
