@@ -2,8 +2,8 @@
 // bare Embree loop over the same rays (same process, same threads), BVH build quality, whole
 // commands on 1M and 4M triangles with peak memory and what the automatic cage and back-face filter
 // cost them, loading against OpenMesh's readers, thread / triangle / texel scaling, and far-geometry
-// culling; every target with its measured value and MET / NOT MET. Everything printed is measured
-// in this run; nothing asserts (not a test).
+// culling, and degenerate floods (duplicate faces, huge polygons); every target with its measured
+// value and MET / NOT MET. Everything printed is measured in this run; nothing asserts (not a test).
 //
 //   bench_bake SHARED_DATA NMBAKE_EXE [--rounds N] [--trace-rounds N] [--quick] [--scratch DIR]
 //
@@ -15,8 +15,8 @@
 // --scratch DIR: where the generated meshes are written once and reused (default
 // $TMPDIR/nmbake-bench); each run's maps and reports go to a subfolder removed at the end.
 //
-// The sections live in bench_tracing.cpp (1, 2), bench_commands.cpp (3, 6) and bench_scaling.cpp
-// (4, 5); this file parses the arguments, prints the machine, generates the scenes (0) and prints
+// The sections live in bench_tracing.cpp (1, 2), bench_commands.cpp (3, 6), bench_scaling.cpp
+// (4, 5) and bench_floods.cpp (7); this file parses the arguments, prints the machine, generates the scenes (0) and prints
 // the targets.
 #include <unistd.h>
 
@@ -179,6 +179,7 @@ int main(int argc, char** argv) {
   run_loading(run, scenes);
   run_scaling(run, scenes, m1_2k);
   run_far_geometry(run, scenes);
+  run_floods(run, scenes);
   print_targets(run, start);
   std::error_code ec;
   fs::remove_all(run.run_dir, ec);

@@ -89,5 +89,6 @@ CommandRun run_whole_commands(BenchRun& run, const Scenes& scenes);             
 void run_loading(BenchRun& run, const Scenes& scenes);                           // 4
 void run_scaling(BenchRun& run, const Scenes& scenes, const CommandRun& m1_2k);  // 5
 void run_far_geometry(BenchRun& run, const Scenes& scenes);                      // 6
+void run_floods(BenchRun& run, const Scenes& scenes);                            // 7 (bench_floods.cpp)
 
 }  // namespace nmbake::bench
