@@ -52,21 +52,13 @@ void ease(std::vector<double>& value, const std::vector<std::vector<std::pair<st
   }
 }
 
-}  // namespace
-
-LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& high, double reach, double floor,
-                                       double front_base, double rear_base, double need_slope, double limit_slope, int threads) {
+// Probes: one at every welded vertex a face uses, and at the centre and near each corner of
+// every triangle (all three corners hear of these: the cage between them must cover them).
+std::vector<Probe> make_probes(const CageBase& low, const std::vector<std::uint32_t>& weld, std::size_t nw) {
   const std::vector<glm::vec3>& pos = *low.positions;
   const std::vector<std::uint32_t>& index = *low.index;
   const std::vector<glm::vec3>& rn = *low.ray_normals;
   const std::size_t tris = index.size() / 3;
-  LocalDistances out;
-  std::size_t nw = 0;
-  const std::vector<std::uint32_t> weld = weld_positions(pos, &nw);
-  out.vertices = nw;
-
-  // Probes: one at every welded vertex a face uses, and at the centre and near each corner of
-  // every triangle (all three corners hear of these: the cage between them must cover them).
   std::vector<Probe> probes;
   {
     std::vector<std::uint8_t> seen(nw, 0);
@@ -89,19 +81,68 @@ LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& h
       probes.push_back({p, unit_or_face(n, p0, p1, p2), {weld[c[0]], weld[c[1]], weld[c[2]]}, 3});
     }
   }
+  return probes;
+}
+
+// Per low-poly triangle: 1 when its winding agrees with its ray normals, else -1.
+std::vector<std::int8_t> facing_of(const CageBase& low) {
+  const std::vector<glm::vec3>& pos = *low.positions;
+  const std::vector<std::uint32_t>& index = *low.index;
+  const std::vector<glm::vec3>& rn = *low.ray_normals;
+  const std::size_t tris = index.size() / 3;
+  std::vector<std::int8_t> facing(tris, 1);
+  for (std::size_t t = 0; t < tris; ++t) {
+    const glm::dvec3 p0(pos[index[3 * t]]), p1(pos[index[3 * t + 1]]), p2(pos[index[3 * t + 2]]);
+    const glm::dvec3 n = glm::dvec3(rn[index[3 * t]]) + glm::dvec3(rn[index[3 * t + 1]]) + glm::dvec3(rn[index[3 * t + 2]]);
+    if (glm::dot(glm::cross(p1 - p0, p2 - p0), n) < 0.0) facing[t] = -1;
+  }
+  return facing;
+}
+
+// Per welded vertex, its neighbours along the low-poly's edges and the edges' lengths.
+using Adjacency = std::vector<std::vector<std::pair<std::uint32_t, double>>>;
+
+Adjacency welded_edges(const std::vector<glm::vec3>& pos, const std::vector<std::uint32_t>& index,
+                       const std::vector<std::uint32_t>& weld, std::size_t nw) {
+  Adjacency adjacent(nw);
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
+  for (std::size_t t = 0; t < index.size() / 3; ++t)
+    for (int c = 0; c < 3; ++c) {
+      std::uint32_t a = weld[index[3 * t + c]], b = weld[index[3 * t + (c + 1) % 3]];
+      if (a == b) continue;
+      if (a > b) std::swap(a, b);
+      edges.push_back({a, b});
+    }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  std::vector<glm::dvec3> wpos(nw);
+  for (std::size_t p = 0; p < pos.size(); ++p) wpos[weld[p]] = glm::dvec3(pos[p]);
+  for (const auto& [a, b] : edges) {
+    const double len = glm::length(wpos[a] - wpos[b]);
+    adjacent[a].push_back({b, len});
+    adjacent[b].push_back({a, len});
+  }
+  return adjacent;
+}
+
+}  // namespace
+
+LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& high, double reach, double floor,
+                                       double front_base, double rear_base, double need_slope, double limit_slope, int threads) {
+  const std::vector<glm::vec3>& pos = *low.positions;
+  const std::vector<std::uint32_t>& index = *low.index;
+  const std::size_t tris = index.size() / 3;
+  LocalDistances out;
+  std::size_t nw = 0;
+  const std::vector<std::uint32_t> weld = weld_positions(pos, &nw);
+  out.vertices = nw;
+
+  const std::vector<Probe> probes = make_probes(low, weld, nw);
   out.probes = probes.size();
 
   // The low-poly itself, for the distance to its next part along the normal: only surfaces that
   // face the probe's start count (the probe's own part, left through its far side, does not).
-  std::vector<glm::vec3> corner_normals(index.size());
-  for (std::size_t c = 0; c < index.size(); ++c) corner_normals[c] = rn[index[c]];
-  std::vector<std::int8_t> low_facing(tris, 1);
-  for (std::size_t t = 0; t < tris; ++t) {
-    const glm::dvec3 p0(pos[index[3 * t]]), p1(pos[index[3 * t + 1]]), p2(pos[index[3 * t + 2]]);
-    const glm::dvec3 n =
-        glm::dvec3(corner_normals[3 * t]) + glm::dvec3(corner_normals[3 * t + 1]) + glm::dvec3(corner_normals[3 * t + 2]);
-    if (glm::dot(glm::cross(p1 - p0, p2 - p0), n) < 0.0) low_facing[t] = -1;
-  }
+  const std::vector<std::int8_t> low_facing = facing_of(low);
   const raycast::Scene self(&pos[0].x, pos.size(), index.data(), tris, raycast::BuildQuality::low, threads);
   raycast::HitRule facing_start;  // an "inward" ray under this rule takes surfaces facing its start
   facing_start.facing = low_facing.data();
@@ -182,26 +223,7 @@ LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& h
   // Neither spikes nor notches: along every edge a need falls by at most need_slope times the
   // edge's length (it reaches as far around as it is tall), and a limit rises by at most
   // limit_slope times it (a neighbouring part's limit fades out gently).
-  std::vector<std::vector<std::pair<std::uint32_t, double>>> adjacent(nw);
-  {
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
-    for (std::size_t t = 0; t < tris; ++t)
-      for (int c = 0; c < 3; ++c) {
-        std::uint32_t a = weld[index[3 * t + c]], b = weld[index[3 * t + (c + 1) % 3]];
-        if (a == b) continue;
-        if (a > b) std::swap(a, b);
-        edges.push_back({a, b});
-      }
-    std::sort(edges.begin(), edges.end());
-    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-    std::vector<glm::dvec3> wpos(nw);
-    for (std::size_t p = 0; p < pos.size(); ++p) wpos[weld[p]] = glm::dvec3(pos[p]);
-    for (const auto& [a, b] : edges) {
-      const double len = glm::length(wpos[a] - wpos[b]);
-      adjacent[a].push_back({b, len});
-      adjacent[b].push_back({a, len});
-    }
-  }
+  const Adjacency adjacent = welded_edges(pos, index, weld, nw);
   ease(front, adjacent, need_slope, true);
   ease(rear, adjacent, need_slope, true);
   ease(front_cap, adjacent, limit_slope, false);
