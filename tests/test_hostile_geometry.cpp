@@ -145,6 +145,42 @@ TEST(HostileGeometry, HugePolygonsAreNotFanned) {
   EXPECT_EQ(load_mesh(dir + "/hexagon.obj").position_index, (std::vector<std::uint32_t>{0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 5}));
 }
 
+// Item 2: the ASCII STL reader read uninitialised memory (random maps, exit 0) in the audit. An
+// ASCII STL of the sample's high-poly bakes exactly as the same triangles in OBJ (both without
+// normals), every time.
+TEST(HostileGeometry, AsciiStlBakesAsTheSameTrianglesInObj) {
+  Mesh high = load_mesh(kHigh);
+  high.normals.clear();
+  high.normal_index.clear();
+  const std::string dir = test::scratch_dir();
+  std::string stl = "solid torus\n";
+  char line[200];
+  for (std::size_t t = 0; t < high.triangle_count(); ++t) {
+    stl += " facet normal 0 0 0\n  outer loop\n";
+    for (int c = 0; c < 3; ++c) {
+      const glm::vec3 p = high.corner_position(t, c);
+      std::snprintf(line, sizeof line, "   vertex %.9g %.9g %.9g\n", double(p.x), double(p.y), double(p.z));
+      stl += line;
+    }
+    stl += "  endloop\n endfacet\n";
+  }
+  stl += "endsolid torus\n";
+  write_text(dir + "/high.stl", stl);
+  write_text(dir + "/high.obj", obj_text(high, "torus high, no normals"));
+  LoadOptions low_options;
+  low_options.require_uvs = true;
+  const Mesh low = load_mesh(kLow, low_options);
+  BakeOptions o;
+  o.width = o.height = 128;
+  const BakeResult from_obj = bake_normal_map(low, load_mesh(dir + "/high.obj"), nullptr, o);
+  for (int run = 0; run < 3; ++run) {
+    const Mesh from_file = load_mesh(dir + "/high.stl");
+    EXPECT_EQ(from_file.triangle_count(), high.triangle_count());
+    const BakeResult from_stl = bake_normal_map(low, from_file, nullptr, o);
+    EXPECT_TRUE(from_stl.map.pixels == from_obj.map.pixels) << "run " << run;
+  }
+}
+
 // Item 6: with a cage, --policy closest is honoured. A tilted strap floats between the cage
 // (0.5 above the low-poly) and the surface (0.05 above): cage-first rays meet the strap first,
 // closest ones take the surface nearer the low-poly.
