@@ -7,6 +7,7 @@
 #include <cstring>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <new>
 #include <optional>
 #include <string>
@@ -26,7 +27,7 @@ namespace diff = nmbake::diff;
 using diff::DiffStats;
 
 // Exit status, as documented in --help.
-constexpr int kWithin = 0, kOutside = 1, kError = 2;
+constexpr int kWithin = 0, kOutside = 1, kError = 2, kMemory = 4;
 
 std::string one_line(std::string s) {
   for (char& c : s)
@@ -58,8 +59,16 @@ void print_summary(const std::string& a, const std::string& b, const DiffStats& 
             << (s.within ? "within" : "OUTSIDE") << "\n";
 }
 
+// What the maps' metadata says of their conventions (nmbake:green, nmbake:space), "" when absent.
+struct Conventions {
+  std::string green_a, green_b, space_a, space_b;
+  bool green_from_metadata = false;  // both maps said their green and no --green-a/-b was given
+};
+
+nlohmann::json or_null(const std::string& s) { return s.empty() ? nlohmann::json(nullptr) : nlohmann::json(s); }
+
 nlohmann::json to_json(const std::string& a, const std::string& b, const DiffStats& s, const nmbake::diff::DiffOptions& o,
-                       const std::string& mask, const std::string& resample) {
+                       const std::string& mask, const std::string& resample, const Conventions& seen) {
   nlohmann::json j;
   j["a"] = a;
   j["b"] = b;
@@ -82,6 +91,11 @@ nlohmann::json to_json(const std::string& a, const std::string& b, const DiffSta
   j["nonfinite_texels"] = s.nonfinite_texels;
   j["green_a"] = o.green_a == nmbake::diff::GreenAxis::up ? "up" : "down";
   j["green_b"] = o.green_b == nmbake::diff::GreenAxis::up ? "up" : "down";
+  j["green"] = {j["green_a"], j["green_b"]};
+  j["green_flipped"] = o.green_a != o.green_b;  // B's green negated to compare in A's convention
+  j["green_from"] = seen.green_from_metadata ? "metadata" : "options";
+  j["metadata"] = {{"green", {or_null(seen.green_a), or_null(seen.green_b)}},
+                   {"space", {or_null(seen.space_a), or_null(seen.space_b)}}};
   j["resample"] = resample;
   j["mask"] = mask.empty() ? nlohmann::json(nullptr) : nlohmann::json(mask);
   j["warnings"] = s.warnings;
@@ -93,6 +107,7 @@ struct CommandLine {
   diff::DiffOptions options;
   std::string path_a, path_b, heatmap_path, json_path, mask_path;
   std::string green_a = "up", green_b = "up", resample = "none";
+  bool green_given = false;    // --green-a or --green-b was given: the maps' nmbake:green is not used
   double heatmap_scale = 0.0;  // 0 = automatic
   bool ignore_alpha = false;
 };
@@ -129,7 +144,9 @@ void add_arguments(CLI::App& app, CommandLine& cl) {
   app.add_flag("--include-padding", options.include_padding,
                "Also compare texels outside the --mask layout and outside alpha coverage");
   app.add_flag("--ignore-alpha", cl.ignore_alpha, "Do not treat a 4th channel as coverage");
-  app.add_option("--green-a", cl.green_a, "Green convention of A: up (OpenGL Y+) or down (DirectX Y-)")
+  app.add_option("--green-a", cl.green_a,
+                 "Green convention of A: up (OpenGL Y+) or down (DirectX Y-). Without --green-a and --green-b, "
+                 "when both maps carry nmbake:green metadata each is decoded in its own")
       ->capture_default_str()
       ->check(CLI::IsMember({"up", "down"}));
   app.add_option("--green-b", cl.green_b, "Green convention of B: up or down")
@@ -154,8 +171,10 @@ void add_arguments(CLI::App& app, CommandLine& cl) {
       "of nearly equal float maps by at most 0.78 deg (p99 0.45 deg).\n"
       "A warning is printed when the maps look like they differ by a green flip or a red/green swap.\n"
       "The last line of output is: mean=<deg> p99=<deg> max=<deg> texels=<n> within=<0|1>\n"
+      "Maps whose nmbake:space metadata differ (tangent and object space) are refused.\n"
       "Exit status: 0 within tolerance, 1 outside tolerance (or nothing compared),\n"
-      "             2 unreadable or invalid input, unwritable output, or a bad command line.");
+      "             2 unreadable or invalid input, unwritable output, or a bad command line,\n"
+      "             4 out of memory, or a map whose header states more pixels than its file or memory can hold.");
 }
 
 // Sets cl.options from the words given for the green conventions, the resampling and alpha.
@@ -187,6 +206,7 @@ std::optional<int> parse_command_line(int argc, char** argv, CommandLine& cl) {
     std::cerr << "error: " << one_line(e.what()) << " (see nmdiff --help)\n";
     return kError;
   }
+  cl.green_given = app.count("--green-a") + app.count("--green-b") > 0;
   apply_choices(cl);
   return std::nullopt;
 }
@@ -196,7 +216,35 @@ struct Comparison {
   DiffStats stats;
   diff::AngleField field;  // filled only when a heatmap is asked for
   bool resized = false;    // B was resampled onto A's grid
+  Conventions seen;        // what the maps' metadata said
 };
+
+std::string metadata_value(const std::map<std::string, std::string>& metadata, const char* key) {
+  const auto it = metadata.find(key);
+  return it == metadata.end() ? std::string() : it->second;
+}
+
+// The maps' conventions from their metadata. A tangent-space map against an object-space one is
+// refused: their normals are in different frames. When both say their green and no option does,
+// each map is decoded in its own (B's green flipped when they differ), said on stderr.
+Conventions read_conventions(CommandLine& cl) {
+  const auto meta_a = nmbake::read_image_metadata(cl.path_a), meta_b = nmbake::read_image_metadata(cl.path_b);
+  Conventions seen{metadata_value(meta_a, "nmbake:green"), metadata_value(meta_b, "nmbake:green"),
+                   metadata_value(meta_a, "nmbake:space"), metadata_value(meta_b, "nmbake:space")};
+  if (!seen.space_a.empty() && !seen.space_b.empty() && seen.space_a != seen.space_b)
+    throw nmbake::InputError(cl.path_a + " is a map in " + seen.space_a + " space, " + cl.path_b + " in " + seen.space_b +
+                             " space (nmbake:space metadata): normals in different frames cannot be compared");
+  const auto known = [](const std::string& g) { return g == "up" || g == "down"; };
+  if (cl.green_given || !known(seen.green_a) || !known(seen.green_b)) return seen;
+  seen.green_from_metadata = true;
+  cl.green_a = seen.green_a;
+  cl.green_b = seen.green_b;
+  apply_choices(cl);
+  if (seen.green_a != seen.green_b)
+    std::cerr << "nmdiff: " << cl.path_a << " is green " << seen.green_a << ", " << cl.path_b << " green " << seen.green_b
+              << " (nmbake:green metadata): compared in one convention, B's green flipped\n";
+  return seen;
+}
 
 // Reads both maps and the --mask mesh (setting cl.options.mask) and compares the maps.
 Comparison compare_files(CommandLine& cl) {
@@ -207,6 +255,7 @@ Comparison compare_files(CommandLine& cl) {
   const nmbake::Image b = nmbake::read_image(path_b);
   diff::check_normal_map(a, path_a);
   diff::check_normal_map(b, path_b);
+  c.seen = read_conventions(cl);
   c.resized = a.width != b.width || a.height != b.height;
   if (c.resized && options.resample == diff::Resample::none)
     throw nmbake::InputError("sizes differ: " + path_a + " is " + std::to_string(a.width) + "x" + std::to_string(a.height) +
@@ -244,8 +293,8 @@ void report(const CommandLine& cl, const Comparison& c) {
   for (const std::string& w : c.stats.warnings) std::cerr << "warning: " << w << "\n";
   if (!cl.heatmap_path.empty()) write_heatmap(cl, c);
   if (!cl.json_path.empty())
-    nmbake::write_text_atomically(cl.json_path,
-                                  to_json(cl.path_a, cl.path_b, c.stats, cl.options, cl.mask_path, cl.resample).dump(2) + "\n");
+    nmbake::write_text_atomically(
+        cl.json_path, to_json(cl.path_a, cl.path_b, c.stats, cl.options, cl.mask_path, cl.resample, c.seen).dump(2) + "\n");
   std::cout << diff::summary_line(c.stats) << std::endl;
 }
 
@@ -266,8 +315,10 @@ int run(int argc, char** argv) {
     return c.stats.within ? kWithin : kOutside;
   } catch (const nmbake::Error& e) {
     std::cerr << "error: " << one_line(e.what()) << "\n";
+    if (e.code() == nmbake::ExitCode::memory) return kMemory;
   } catch (const std::bad_alloc&) {
     std::cerr << "error: out of memory\n";
+    return kMemory;
   } catch (const std::exception& e) {
     std::cerr << "error: " << one_line(e.what()) << "\n";
   }

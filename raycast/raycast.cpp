@@ -12,7 +12,10 @@ namespace nmbake::raycast {
 
 namespace {
 
+// Embree's allocation failures (its own, and std::bad_alloc it caught) become OutOfMemory, which
+// the programs report as out of memory (exit 4); anything else is a runtime_error.
 void throw_on_error(void* /*user*/, RTCError code, const char* message) {
+  if (code == RTC_ERROR_OUT_OF_MEMORY) throw OutOfMemory();
   throw std::runtime_error(std::string("embree: error ") + std::to_string(int(code)) + ": " + (message ? message : ""));
 }
 
@@ -27,6 +30,7 @@ RTCBuildQuality to_embree(BuildQuality q) {
 // Embree reports errors through the callback; after a failed call the callback has already thrown,
 // but device creation happens before any callback exists, so check it by hand.
 void check_device(RTCDevice device) {
+  if (!device && rtcGetDeviceError(nullptr) == RTC_ERROR_OUT_OF_MEMORY) throw OutOfMemory();
   if (!device)
     throw std::runtime_error("embree: cannot create a device (error " + std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
 }

@@ -1,9 +1,9 @@
 // Ray casting against a triangle mesh: the only code that talks to Embree.
 //
 // Scene owns an Embree device and scene (RAII, non-copyable); Embree errors become
-// std::runtime_error. Positions are copied into Embree's own buffers, so the caller's arrays may
-// go away after construction. Hit barycentrics follow Embree: the hit point is
-// (1 - u - v) * p0 + u * p1 + v * p2 for triangle (p0, p1, p2).
+// std::runtime_error, except running out of memory, which is OutOfMemory (a std::bad_alloc). Positions are copied into Embree's
+// own buffers, so the caller's arrays may go away after construction. Hit barycentrics follow Embree: the hit point is (1 - u -
+// v) * p0 + u * p1 + v * p2 for triangle (p0, p1, p2).
 #pragma once
 
 #include <algorithm>
@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <new>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -132,6 +133,11 @@ class RayArrays {
   std::vector<float> fields_;  // 8 ray fields, then the hits' t, u, v: count_ each
   std::vector<std::uint32_t> triangle_;
   std::vector<std::uint8_t> flags_;
+};
+
+// Embree could not allocate (RTC_ERROR_OUT_OF_MEMORY, from any call, the BVH build included).
+struct OutOfMemory : std::bad_alloc {
+  const char* what() const noexcept override { return "embree: out of memory"; }
 };
 
 enum class BuildQuality { low, medium, high };

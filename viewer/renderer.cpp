@@ -177,8 +177,9 @@ Renderer::Renderer(const LowVertices& low, const HighVertices& high, const nmbak
   GLint max_samples = 1;
   glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
   samples_ = std::clamp(max_samples, 1, 4);
-  if (GLenum error = glGetError(); error != GL_NO_ERROR)
-    fail("OpenGL error " + std::to_string(error) + " while uploading the meshes (out of GPU memory?)");
+  if (GLenum error = glGetError(); error == GL_OUT_OF_MEMORY)
+    throw nmbake::ResourceError("out of memory uploading the meshes to OpenGL (GL_OUT_OF_MEMORY)");
+  else if (error != GL_NO_ERROR) fail("OpenGL error " + std::to_string(error) + " while uploading the meshes");
 }
 
 Renderer::~Renderer() {

@@ -9,12 +9,14 @@
 #include <csignal>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <future>
 #include <iostream>
 #include <new>
 #include <sstream>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <tuple>
 
@@ -26,6 +28,7 @@
 #include "io/image_io.h"
 #include "io/mesh_io.h"
 #include "io/text_file.h"
+#include "cli/outputs.h"
 #include "cli/report.h"
 #include "core/parallel.h"
 #include "cli/warnings.h"
@@ -35,17 +38,43 @@ namespace {
 using namespace nmbake;
 using Clock = std::chrono::steady_clock;
 
-std::atomic<bool> g_interrupted{false};
-extern "C" void on_sigint(int) { g_interrupted = true; }
+// The first of SIGINT, SIGTERM and SIGHUP received, or 0. The handler only records it: the bake
+// stops at its next progress call, the writes between two files, and the temporaries are removed
+// on the way out; once the renames of the finished outputs have begun, the run completes.
+std::atomic<int> g_signal{0};
+extern "C" void on_signal(int sig) {
+  int none = 0;
+  g_signal.compare_exchange_strong(none, sig);
+}
+bool interrupted() { return g_signal.load() != 0; }
+
+void install_signal_handlers() {
+  struct sigaction action {};
+  action.sa_handler = on_signal;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = SA_RESTART;
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction old {};
+    // A SIGHUP ignored on entry (nohup) stays ignored.
+    if (sig == SIGHUP && ::sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+    ::sigaction(sig, &action, nullptr);
+  }
+}
+
+const char* signal_name(int sig) { return sig == SIGTERM ? "SIGTERM" : sig == SIGHUP ? "SIGHUP" : "SIGINT"; }
 
 const char* kExitCodes =
     "Exit codes:\n"
     "  0  success\n"
-    "  1  bad command line\n"
+    "  1  bad command line (also: an output is an input or another output)\n"
     "  2  unreadable or invalid input\n"
-    "  3  output could not be written\n"
+    "  3  output could not be written (also: an output is a folder or a special file: device, FIFO, socket)\n"
     "  4  out of memory or refused size\n"
-    "  130 interrupted (no output written)\n";
+    "  5  warnings with --strict (no output written)\n"
+    "  129, 130, 143  interrupted by SIGHUP, SIGINT (Ctrl-C), SIGTERM (no output written)\n"
+    "Every output is written to a temporary file (.NAME.nmbake-tmp.PID) beside it and all are renamed\n"
+    "into place together at the end: on any error or signal every old file stays as it was. An output\n"
+    "that is a symbolic link to a regular file is written through: the link stays, its target changes.\n";
 
 struct Args {
   std::string low, high, output, cage, miss_mask, report, save_cage, suspect_mask;
@@ -57,7 +86,8 @@ struct Args {
   int bits = 0;
   int padding = 16;
   int threads = 0;
-  bool quiet = false;
+  int quiet = 0;  // times --quiet was given
+  bool no_warnings = false, strict = false;
   bool no_cull = false;
   bool keep_backfaces = false;
   bool estimate_error = false;
@@ -86,33 +116,11 @@ std::string human(double v) {
   return buf;
 }
 
-// Whether two paths name one file: by identity where both exist (links, "./"), else by their
-// normalized absolute names.
-bool same_file(const std::string& a, const std::string& b) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec);
-  return fs::weakly_canonical(a, ec) == fs::weakly_canonical(b, ec);
-}
-
-// Fails early, before a long bake, when the output cannot be created where asked.
-void check_output_path(const std::string& path, const char* what) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) throw OutputError(path + ": cannot write " + what + ": it is a directory");
-  fs::path dir = fs::path(path).parent_path();
-  if (dir.empty()) dir = ".";
-  if (!fs::is_directory(dir, ec))
-    throw OutputError(path + ": cannot write " + what + ": folder " + dir.string() + " does not exist");
-  if (::access(dir.c_str(), W_OK) != 0)
-    throw OutputError(path + ": cannot write " + what + ": folder " + dir.string() + " is not writable");
-}
-
 class ProgressBar {
  public:
   explicit ProgressBar(bool enabled) : enabled_(enabled) {}
   bool update(double f) {
-    if (g_interrupted) return false;
+    if (interrupted()) return false;
     if (!enabled_) return true;
     const int pct = int(f * 100.0);
     if (pct == last_) return true;
@@ -175,7 +183,12 @@ void add_options(CLI::App& app, Args& a) {
   app.add_flag("--keep-backfaces", a.keep_backfaces,
                "Take the first hit whatever it faces (default: hits on back faces, the insides of other parts, are passed "
                "over and counted as backface_skips in the report)");
-  app.add_flag("--quiet", a.quiet, "No progress bar and no summary line");
+  app.add_flag("--quiet", a.quiet,
+               "No progress bar, no summary line, no distances line; warnings still print, one line each (twice: "
+               "--quiet --quiet, no warnings either)");
+  app.add_flag("--no-warnings", a.no_warnings, "Do not print warnings (they are still in --report's \"warnings\")");
+  app.add_flag("--strict", a.strict,
+               "Any warning is an error: exit 5, no output written (for CI); warnings of the meshes stop before the bake");
   app.add_flag("--estimate-error", a.estimate_error,
                "Re-bake 4096 random covered texels (fixed seed) with 64 samples (4x --samples if more) and report the "
                "angular error of the float map against them (one stderr line, \"error_estimate\" in --report); costs "
@@ -218,21 +231,17 @@ void check_outputs(const Args& a, int bits) {
     std::string ext = std::filesystem::path(a.save_cage).extension().string();
     for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
     if (ext != ".obj") throw UsageError("--save-cage " + a.save_cage + ": the cage is written as OBJ (.obj)");
-    for (const std::string* in : {&a.low, &a.high, &a.output, &a.report, &a.miss_mask, &a.suspect_mask})
-      if (!in->empty() && same_file(*in, a.save_cage))
-        throw UsageError("--save-cage " + a.save_cage + " is the same file as " + *in + "; nothing written");
-    check_output_path(a.save_cage, "the cage");
   }
-  check_output_path(a.output, "the map");
-  if (!a.miss_mask.empty()) check_output_path(a.miss_mask, "the miss mask");
-  if (!a.report.empty()) check_output_path(a.report, "the report");
+  check_output_files({{"", a.low, "the low-poly"}, {"", a.high, "the high-poly"}, {"--cage", a.cage, "the cage"}},
+                     {{"--output", a.output, "the map"},
+                      {"--miss-mask", a.miss_mask, "the miss mask"},
+                      {"--suspect-mask", a.suspect_mask, "the suspect mask"},
+                      {"--save-cage", a.save_cage, "the cage"},
+                      {"--report", a.report, "the report"}});
   check_output_format(a.output, bits);
   if (const std::string problem = image_io_problem(); !problem.empty()) throw OutputError(a.output + ": " + problem);
   if (!a.miss_mask.empty()) check_output_format(a.miss_mask, default_bits_for(a.miss_mask));
-  if (!a.suspect_mask.empty()) {
-    check_output_path(a.suspect_mask, "the suspect mask");
-    check_output_format(a.suspect_mask, default_bits_for(a.suspect_mask));
-  }
+  if (!a.suspect_mask.empty()) check_output_format(a.suspect_mask, default_bits_for(a.suspect_mask));
 }
 
 // One line on how far rays reached, unless --quiet.
@@ -269,8 +278,11 @@ ErrorEstimate estimate_error(const Mesh& low, const Mesh& high, const Mesh* cage
   return estimate;
 }
 
-// The map, the masks and the cage.
-void write_outputs(const Args& a, const BakeOptions& o, const BakeResult& r, const Mesh& low, int bits) {
+// The map, the masks and the cage, each to its temporary file in `outputs`.
+void write_outputs(OutputSet& outputs, const Args& a, const BakeOptions& o, const BakeResult& r, const Mesh& low, int bits) {
+  auto check_signal = [] {
+    if (interrupted()) throw Cancelled();
+  };
   WriteOptions wo;
   wo.bits = bits;
   wo.metadata = {
@@ -282,30 +294,31 @@ void write_outputs(const Args& a, const BakeOptions& o, const BakeResult& r, con
       {"ImageDescription",
        std::string(o.space == NormalSpace::object ? "object-space normal map" : "tangent-space normal map, ") +
            (o.space == NormalSpace::object ? "" : (o.green_down ? "DirectX (Y-)" : "OpenGL (Y+)")) + ", baked by nmbake"}};
+  wo.temp_path = outputs.add(a.output);
   write_image(a.output, r.map, wo);
-  if (!a.miss_mask.empty()) {
+  for (const auto& [path, image] : {std::pair{&a.miss_mask, &r.miss_mask}, std::pair{&a.suspect_mask, &r.suspect_mask}}) {
+    if (path->empty()) continue;
+    check_signal();
     WriteOptions mo;
-    mo.bits = default_bits_for(a.miss_mask);
-    write_image(a.miss_mask, r.miss_mask, mo);
-  }
-  if (!a.suspect_mask.empty()) {
-    WriteOptions mo;
-    mo.bits = default_bits_for(a.suspect_mask);
-    write_image(a.suspect_mask, r.suspect_mask, mo);
+    mo.bits = default_bits_for(*path);
+    mo.temp_path = outputs.add(*path);
+    write_image(*path, *image, mo);
   }
   if (!a.save_cage.empty()) {
+    check_signal();
     Mesh cage_mesh;
     cage_mesh.origin = low.origin;
     cage_mesh.positions = r.cage_positions;
     cage_mesh.uvs = low.uvs;
     cage_mesh.position_index = low.position_index;
     cage_mesh.uv_index = low.uv_index;
-    write_text_atomically(a.save_cage,
-                          obj_text(cage_mesh, "nmbake " NMBAKE_VERSION " automatic cage of " + a.low + " for " + a.high));
+    write_text_file(a.save_cage, outputs.add(a.save_cage),
+                    obj_text(cage_mesh, "nmbake " NMBAKE_VERSION " automatic cage of " + a.low + " for " + a.high));
   }
 }
 
-void write_report(const Args& a, const BakeOptions& o, const RunInfo& run, const BakeStats& s, const ErrorEstimate* estimate) {
+void write_report(OutputSet& outputs, const Args& a, const BakeOptions& o, const RunInfo& run, const BakeStats& s,
+                  const ErrorEstimate* estimate) {
   nlohmann::json report = make_report(o, s, run);
   if (estimate)
     report["error_estimate"] = {{"mean_deg", estimate->mean_deg},
@@ -313,7 +326,7 @@ void write_report(const Args& a, const BakeOptions& o, const RunInfo& run, const
                                 {"max_deg", estimate->max_deg},
                                 {"texels", estimate->texels},
                                 {"seconds", estimate->seconds}};
-  write_text_atomically(a.report, report.dump(2) + "\n");
+  write_text_file(a.report, outputs.add(a.report), report.dump(2) + "\n");
 }
 
 void print_summary(const Args& a, const BakeOptions& o, const RunInfo& run, const BakeStats& s, int bits) {
@@ -326,6 +339,21 @@ void print_summary(const Args& a, const BakeOptions& o, const RunInfo& run, cons
       s.samples_covered ? 100.0 * double(s.misses) / double(s.samples_covered) : 0.0, 100.0 * s.coverage, run.seconds_load,
       s.seconds_prepare, s.seconds_bvh, s.seconds_distances, s.seconds_trace, s.seconds_padding, run.seconds_write,
       run.seconds_total);
+}
+
+// What the report says of the run besides the bake's counts (the timings come later).
+RunInfo run_info(const Args& a, int argc, char** argv, int bits) {
+  RunInfo run;
+  run.low_path = a.low;
+  run.high_path = a.high;
+  run.cage_path = a.cage;
+  run.output_path = a.output;
+  run.miss_mask_path = a.miss_mask;
+  run.suspect_mask_path = a.suspect_mask;
+  run.bits = bits;
+  run.command.assign(argv, argv + argc);
+  run.started = utc_time_text(report_time());
+  return run;
 }
 
 int run(int argc, char** argv) {
@@ -345,22 +373,16 @@ int run(int argc, char** argv) {
   a.front_given = app.count("--front") > 0;
   a.rear_given = app.count("--rear") > 0;
   const auto start = Clock::now();
+  install_signal_handlers();
   BakeOptions o = bake_options(a);
   validate_options(o);  // the library's checks, before a long load
   const int bits = a.bits ? a.bits : default_bits_for(a.output);
   check_outputs(a, bits);
-  std::signal(SIGINT, on_sigint);
   const bool tty = !a.quiet && ::isatty(STDERR_FILENO);
+  WarningLog warnings(a.quiet < 2 && !a.no_warnings, a.strict);
 
   // Load.
-  RunInfo run;
-  run.low_path = a.low;
-  run.high_path = a.high;
-  run.cage_path = a.cage;
-  run.output_path = a.output;
-  run.miss_mask_path = a.miss_mask;
-  run.suspect_mask_path = a.suspect_mask;
-  run.bits = bits;
+  RunInfo run = run_info(a, argc, argv, bits);
   auto t0 = Clock::now();
   LoadOptions low_opts;
   low_opts.require_uvs = true;
@@ -372,7 +394,11 @@ int run(int argc, char** argv) {
   if (!a.cage.empty()) cage = load_mesh(a.cage, shared, &run.cage_info);
   const Mesh* cage_mesh = a.cage.empty() ? nullptr : &cage;
   run.seconds_load = std::chrono::duration<double>(Clock::now() - t0).count();
-  if (g_interrupted) throw Cancelled();
+  warnings.add(load_warnings(run.low_info, a.low));
+  warnings.add(load_warnings(run.high_info, a.high));
+  if (cage_mesh) warnings.add(load_warnings(run.cage_info, a.cage));
+  warnings.check_strict();  // before a long bake
+  if (interrupted()) throw Cancelled();
 
   ProgressBar bar(tty);
   o.progress = [&](double f) { return bar.update(f); };
@@ -382,21 +408,24 @@ int run(int argc, char** argv) {
   // (about 0.3-0.6 s CPU per 400k triangles; beside the bake they took time from its threads).
   auto topology = std::async(std::launch::async, [&high] { return inspect_topology(high); });
   if (!a.quiet) print_distances(s);
-  if (g_interrupted) throw Cancelled();
+  if (interrupted()) throw Cancelled();
   ErrorEstimate estimate;
   if (a.estimate_error) estimate = estimate_error(low, high, cage_mesh, o, r, bits);
 
+  // Every output to its temporary file, then all renamed into place together.
+  OutputSet outputs;
   t0 = Clock::now();
-  write_outputs(a, o, r, low, bits);
+  write_outputs(outputs, a, o, r, low, bits);
   run.seconds_write = std::chrono::duration<double>(Clock::now() - t0).count();
   run.high_topology = topology.get();
-  if (!a.quiet)
-    for (const std::string& w : bake_warnings(s, run.high_topology, a.low, a.high))
-      std::fprintf(stderr, "nmbake: %s\n", w.c_str());
+  warnings.add(bake_warnings(s, run.high_topology, a.low, a.high));
+  warnings.check_strict();
+  run.warnings = warnings.all();
   run.seconds_total = std::chrono::duration<double>(Clock::now() - start).count();
   run.peak_memory_bytes = peak_memory_bytes();
   run.threads_used = unsigned(worker_threads(a.threads));
-  if (!a.report.empty()) write_report(a, o, run, s, a.estimate_error ? &estimate : nullptr);
+  if (!a.report.empty()) write_report(outputs, a, o, run, s, a.estimate_error ? &estimate : nullptr);
+  outputs.commit(interrupted);
   if (!a.quiet) print_summary(a, o, run, s, bits);
   return 0;
 }
@@ -411,14 +440,21 @@ int main(int argc, char** argv) {
   try {
     code = run(argc, argv);
   } catch (const nmbake::Cancelled&) {
-    std::fprintf(stderr, "error: interrupted; no output written\n");
-    code = 130;
+    const int sig = g_signal.load() ? g_signal.load() : SIGINT;
+    std::fprintf(stderr, "error: interrupted by %s; no output written\n", signal_name(sig));
+    code = 128 + sig;
   } catch (const nmbake::Error& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     code = int(e.code());
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "error: out of memory\n");
     code = int(nmbake::ExitCode::memory);
+  } catch (const std::system_error& e) {
+    // A thread or resource the system would not give (EAGAIN under ulimit -v): out of resources.
+    std::fprintf(stderr, "error: %s\n", e.what());
+    code = e.code() == std::errc::resource_unavailable_try_again || e.code() == std::errc::not_enough_memory
+               ? int(nmbake::ExitCode::memory)
+               : 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     code = 2;

@@ -5,6 +5,7 @@
 
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 
@@ -15,6 +16,24 @@ namespace nmbake {
 const char* to_string(RayPolicy p) { return p == RayPolicy::closest ? "closest" : "cage-first"; }
 const char* to_string(NormalSpace s) { return s == NormalSpace::object ? "object" : "tangent"; }
 const char* to_string(BitangentMode m) { return m == BitangentMode::per_vertex ? "vertex" : "pixel"; }
+
+std::time_t report_time() {
+  const char* epoch = std::getenv("SOURCE_DATE_EPOCH");
+  if (epoch && *epoch) {
+    char* end = nullptr;
+    errno = 0;
+    const long long seconds = std::strtoll(epoch, &end, 10);
+    if (*end == '\0' && errno == 0 && seconds >= 0) return std::time_t(seconds);
+  }
+  return std::time(nullptr);
+}
+
+std::string utc_time_text(std::time_t t) {
+  std::tm utc{};
+  char text[32] = "";
+  if (gmtime_r(&t, &utc)) std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &utc);
+  return text;
+}
 
 std::uint64_t peak_memory_bytes() {
   rusage ru{};
@@ -52,7 +71,11 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
                 {"triangles", triangles},
                 {"polygons_triangulated", info.polygons_triangulated},
                 {"normals_renormalized", info.normals_renormalized},
-                {"zero_normals", info.zero_normals}};
+                {"zero_normals", info.zero_normals},
+                {"normals_dropped", info.normals_dropped},
+                {"faces_without_normals", info.faces_without_normals},
+                {"uvs_dropped", info.uvs_dropped},
+                {"faces_without_uvs", info.faces_without_uvs}};
   };
   json report = {
       {"nmbake_version", NMBAKE_VERSION},
@@ -123,6 +146,10 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
   high["non_manifold_edges"] = t.non_manifold_edges;
   high["inconsistent_winding_faces"] = t.inconsistent_winding_faces;
   high["triangles_culled"] = s.high_triangles_culled;
+  report["version"] = NMBAKE_VERSION;
+  report["command"] = r.command;
+  report["started"] = r.started;
+  report["warnings"] = r.warnings;
   report["bvh_quality"] = s.bvh_quality == raycast::BuildQuality::low      ? "low"
                           : s.bvh_quality == raycast::BuildQuality::medium ? "medium"
                                                                            : "high";

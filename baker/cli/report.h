@@ -2,7 +2,9 @@
 #pragma once
 
 #include <cstdint>
+#include <ctime>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -20,6 +22,9 @@ struct RunInfo {
   double seconds_load = 0, seconds_write = 0, seconds_total = 0;
   std::uint64_t peak_memory_bytes = 0;
   unsigned threads_used = 0;
+  std::vector<std::string> command;   // argv, as given
+  std::string started;                // UTC, "2026-11-25T03:04:05Z" (utc_time_text(report_time()))
+  std::vector<std::string> warnings;  // every warning line, "warning: ..." (printed or not)
 };
 
 const char* to_string(RayPolicy p);
@@ -27,6 +32,13 @@ const char* to_string(NormalSpace s);
 const char* to_string(BitangentMode m);
 
 nlohmann::json make_report(const BakeOptions& options, const BakeStats& stats, const RunInfo& run);
+
+// The time a run started: SOURCE_DATE_EPOCH (seconds since 1970, the reproducible-builds
+// convention) when set to a whole number, else now.
+std::time_t report_time();
+
+// "2026-11-25T03:04:05Z" (ISO 8601, UTC).
+std::string utc_time_text(std::time_t t);
 
 // Peak resident memory of this process so far (bytes).
 std::uint64_t peak_memory_bytes();

@@ -16,6 +16,36 @@ std::string format(const char* fmt, Args... args) {
 
 }  // namespace
 
+std::vector<std::string> load_warnings(const MeshLoadInfo& info, const std::string& path) {
+  std::vector<std::string> out;
+  const char* lost = "all the file's normals were dropped and smooth normals computed (hard edges lost)";
+  if (info.normals_dropped && info.faces_without_normals)
+    out.push_back(format("warning: %s: %zu of %zu faces %s no normals: %s", path.c_str(), info.faces_without_normals,
+                         info.file_faces, info.faces_without_normals == 1 ? "has" : "have", lost));
+  else if (info.normals_dropped)
+    out.push_back(format("warning: %s: %zu %s length 0: %s", path.c_str(), info.zero_normals,
+                         info.zero_normals == 1 ? "normal has" : "normals have", lost));
+  if (info.uvs_dropped)
+    out.push_back(format("warning: %s: %zu of %zu faces %s no UVs: all the file's UVs were dropped", path.c_str(),
+                         info.faces_without_uvs, info.file_faces, info.faces_without_uvs == 1 ? "has" : "have"));
+  return out;
+}
+
+void WarningLog::add(const std::vector<std::string>& warnings) {
+  for (const std::string& w : warnings) {
+    all_.push_back(w);
+    if (print_) std::fprintf(stderr, "nmbake: %s\n", w.c_str());
+  }
+}
+
+void WarningLog::check_strict() const {
+  if (!strict_ || all_.empty()) return;
+  std::string first = all_.front();
+  if (first.rfind("warning: ", 0) == 0) first.erase(0, 9);
+  throw StrictError("--strict: " + std::to_string(all_.size()) + (all_.size() == 1 ? " warning" : " warnings") +
+                    ", the first: " + first + "; nothing written");
+}
+
 std::vector<std::string> bake_warnings(const BakeStats& s, const MeshTopology& t, const std::string& low,
                                        const std::string& high) {
   std::vector<std::string> out;

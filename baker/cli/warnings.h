@@ -6,6 +6,8 @@
 #include <vector>
 
 #include "pipeline/bake.h"
+#include "core/errors.h"
+#include "core/mesh.h"
 #include "core/mesh_topology.h"
 
 namespace nmbake {
@@ -16,5 +18,32 @@ constexpr double kFacingAwayShareWarn = 0.2;
 
 std::vector<std::string> bake_warnings(const BakeStats& stats, const MeshTopology& high_topology, const std::string& low_path,
                                        const std::string& high_path);
+
+// What loading a mesh dropped: the file's normals (or UVs) when only some faces had them, or
+// (normals) one had length 0. `path` names the file.
+std::vector<std::string> load_warnings(const MeshLoadInfo& info, const std::string& path);
+
+// Exit code of --strict when there were warnings: no output written.
+constexpr int kStrictExitCode = 5;
+
+struct StrictError : Error {
+  explicit StrictError(const std::string& what) : Error(static_cast<ExitCode>(kStrictExitCode), what) {}
+};
+
+// Every warning of a run, in order: printed as it comes ("nmbake: warning: ..."; not with
+// `print` false: --quiet --quiet or --no-warnings), kept for the report, and with `strict`
+// (--strict) turned into a StrictError by check_strict().
+class WarningLog {
+ public:
+  WarningLog(bool print, bool strict) : print_(print), strict_(strict) {}
+  void add(const std::vector<std::string>& warnings);
+  // Throws StrictError "--strict: N warnings, the first: ...; nothing written" under --strict.
+  void check_strict() const;
+  const std::vector<std::string>& all() const { return all_; }
+
+ private:
+  bool print_, strict_;
+  std::vector<std::string> all_;
+};
 
 }  // namespace nmbake

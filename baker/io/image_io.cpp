@@ -17,8 +17,11 @@
 #include <new>
 #include <system_error>
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include "core/errors.h"
@@ -52,11 +55,93 @@ std::vector<T> quantize(const Floats& values, double scale) {
   return out;
 }
 
+// A temporary beside `target` for write_image without WriteOptions::temp_path (nmdiff, the tests).
 std::string temp_path_for(const fs::path& target) {
   static std::atomic<unsigned> counter{0};
   std::string name = "." + target.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) +
                      target.extension().string();
   return (target.parent_path() / name).string();
+}
+
+// The encoders' bytes go through this proxy straight to a file descriptor, so that the first
+// system error (ENOSPC, EIO) is known exactly: through stdio, OpenImageIO's PNG writer only says
+// "Write error at position N" once per failed call (a 29 KB message on a full disk). Small writes
+// (libpng writes chunk headers of 4-13 bytes) are gathered in a buffer.
+class FileProxy final : public OIIO::Filesystem::IOProxy {
+ public:
+  FileProxy(const std::string& name, int fd) : IOProxy(name, Write), fd_(fd) { buffer_.reserve(kBuffer); }
+  const char* proxytype() const override { return "nmbake-file"; }
+  void close() override { flush_buffer(); }
+  void flush() const override { const_cast<FileProxy*>(this)->flush_buffer(); }
+  bool seek(int64_t offset) override {
+    if (!flush_buffer() || offset < 0) return false;
+    m_pos = offset;
+    return true;
+  }
+  size_t write(const void* data, size_t size) override {
+    if (error_) return 0;
+    if (buffer_.size() + size > kBuffer && !flush_buffer()) return 0;
+    if (size >= kBuffer) {
+      const size_t n = put(data, size, m_pos);
+      m_pos += int64_t(n);
+      return n;
+    }
+    if (buffer_.empty()) start_ = m_pos;
+    buffer_.insert(buffer_.end(), static_cast<const char*>(data), static_cast<const char*>(data) + size);
+    m_pos += int64_t(size);
+    return size;
+  }
+  size_t pwrite(const void* data, size_t size, int64_t offset) override { return flush_buffer() ? put(data, size, offset) : 0; }
+  size_t read(void* data, size_t size) override {
+    const size_t n = pread(data, size, m_pos);
+    m_pos += int64_t(n);
+    return n;
+  }
+  size_t pread(void* data, size_t size, int64_t offset) override {
+    if (!flush_buffer()) return 0;
+    const ssize_t n = ::pread(fd_, data, size, offset);
+    return n > 0 ? size_t(n) : 0;
+  }
+  size_t size() const override {
+    const_cast<FileProxy*>(this)->flush_buffer();
+    struct stat st {};
+    return ::fstat(fd_, &st) == 0 ? size_t(st.st_size) : 0;
+  }
+  bool flush_buffer() {
+    if (buffer_.empty()) return error_ == 0;
+    const size_t n = put(buffer_.data(), buffer_.size(), start_);
+    const bool ok = n == buffer_.size();
+    buffer_.clear();
+    return ok;
+  }
+  int failure() const { return error_; }  // the first errno of a failed write, or 0
+
+ private:
+  static constexpr size_t kBuffer = 1 << 16;
+  size_t put(const void* data, size_t size, int64_t offset) {
+    size_t done = 0;
+    while (done < size && !error_) {
+      const ssize_t n = ::pwrite(fd_, static_cast<const char*>(data) + done, size - done, offset + int64_t(done));
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) error_ = n < 0 ? errno : EIO;
+      else done += size_t(n);
+    }
+    return done;
+  }
+  int fd_;
+  int error_ = 0;
+  int64_t start_ = 0;  // the file position of buffer_[0]
+  std::vector<char> buffer_;
+};
+
+// The first message of an OpenImageIO error (it repeats one per failed call), on one line.
+std::string first_message(const std::string& text) {
+  const std::size_t start = text.find_first_not_of("\r\n");
+  std::string s = one_line(start == std::string::npos ? text : text.substr(start, text.find_first_of("\r\n", start) - start));
+  const std::size_t repeat = s.find("  ");
+  if (repeat != std::string::npos) s.resize(repeat);
+  if (s.size() > 240) s = s.substr(0, 240) + "...";
+  return s;
 }
 
 // The EXR and TIFF writers stamp the current time into "DateTime", so two identical bakes differ
@@ -144,101 +229,49 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
 
   // Create with the real path so the writer is chosen by its extension.
   auto out = OIIO::ImageOutput::create(path);
-  if (!out) fail_write(path, one_line(OIIO::geterror()));
+  if (!out) fail_write(path, first_message(OIIO::geterror()));
 
-  const std::string temp = temp_path_for(target);
-  auto discard = [&](const std::string& reason) {
-    std::error_code ignored;
-    fs::remove(temp, ignored);
-    fail_write(path, reason);
+  const std::string temp = options.temp_path.empty() ? temp_path_for(target) : options.temp_path;
+  const int fd = ::open(temp.c_str(), O_RDWR | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0666);
+  if (fd < 0) fail_write(path, std::strerror(errno));
+  FileProxy proxy(temp, fd);
+  // The first failure's reason: the system's for a failed write, else OpenImageIO's.
+  auto discard = [&](const std::string& message, int err) {
+    if (!err) err = proxy.failure();
+    out.reset();  // before the proxy it writes to
+    ::close(fd);
+    ::unlink(temp.c_str());
+    fail_write(path, err ? std::string(std::strerror(err)) : first_message(message));
   };
-  if (!out->open(temp, spec)) {
-    std::string reason = one_line(out->geterror());
-    out.reset();
-    discard(reason);
-  }
-  if (!out->write_image(given, data) || out->has_error()) {
-    std::string reason = one_line(out->geterror());
+  out->set_ioproxy(&proxy);
+  if (!out->open(temp, spec)) discard(out->geterror(), 0);
+  if (!out->write_image(given, data) || out->has_error() || proxy.failure()) {
+    std::string reason = out->geterror();
     out->close();
-    out.reset();
-    discard(reason);
+    discard(reason, 0);
   }
   // Only close()'s result counts: with Debian 12's libtiff every TIFF close records a harmless
   // "failed TIFFWriteCustomDirectory() of the Exif data" and still writes a good file.
-  if (!out->close()) {
-    std::string reason = one_line(out->geterror());
-    out.reset();
-    discard(reason);
-  }
+  if (!out->close() || !proxy.flush_buffer()) discard(out->geterror(), 0);
   out->geterror();  // drop that message
   out.reset();
+  // A full disk or a failing device may only show here (delayed allocation, NFS).
+  if (::fsync(fd) != 0) discard("", errno);
+  if (::close(fd) != 0) {
+    const int err = errno;
+    ::unlink(temp.c_str());
+    fail_write(path, std::strerror(err));
+  }
+  if (!options.temp_path.empty()) return;  // the caller renames it
   if (std::rename(temp.c_str(), path.c_str()) != 0) {
     std::string reason = std::strerror(errno);
     if (fs::is_directory(target, ec)) reason = "a folder of that name exists";
-    discard(reason);
+    ::unlink(temp.c_str());
+    fail_write(path, reason);
   }
 }
 
-Image read_image(const std::string& path) {
-  auto fail = [&](const std::string& reason) -> Image { throw InputError(path + ": cannot read image: " + reason); };
-  std::error_code ec;
-  if (!fs::exists(path, ec)) return fail("no such file");
-  if (fs::is_directory(path, ec)) return fail("it is a folder");
-
-  OIIO::ImageSpec config;
-  config.attribute("oiio:UnassociatedAlpha", 1);  // alpha is coverage: do not premultiply
-  auto in = OIIO::ImageInput::open(path, &config);
-  if (!in) return fail(one_line(OIIO::geterror()));
-
-  const OIIO::ImageSpec& spec = in->spec();
-  if (spec.deep) return fail("deep images are not supported");
-  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth != 1)
-    return fail("unsupported size " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + "x" +
-                std::to_string(spec.depth) + " with " + std::to_string(spec.nchannels) + " channels");
-  const double count = double(spec.width) * spec.height * spec.nchannels;
-  if (count > double(std::numeric_limits<std::int32_t>::max()))
-    throw ResourceError(path + ": image too large (" + std::to_string(spec.width) + "x" + std::to_string(spec.height) + "x" +
-                        std::to_string(spec.nchannels) + ")");
-
-  Image image;
-  try {
-    image = Image(spec.width, spec.height, spec.nchannels);
-  } catch (const std::bad_alloc&) {
-    throw ResourceError(path + ": out of memory reading a " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
-                        " image");
-  }
-  // The TIFF reader reports a truncated strip through has_error() yet returns true.
-  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data()) || in->has_error())
-    return fail(one_line(in->geterror()));
-  in->close();
-  return image;
-}
-
-std::map<std::string, std::string> read_image_metadata(const std::string& path) {
-  std::error_code ec;
-  if (!fs::exists(path, ec) || fs::is_directory(path, ec))
-    throw InputError(path + ": cannot read image: " + (fs::is_directory(path, ec) ? "it is a folder" : "no such file"));
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) throw InputError(path + ": cannot read image: " + one_line(OIIO::geterror()));
-  std::map<std::string, std::string> metadata;
-  for (const OIIO::ParamValue& p : in->spec().extra_attribs)
-    if (p.type() == OIIO::TypeDesc::STRING) metadata[p.name().string()] = p.get_string();
-  // "key=value" items of the description tag (how write_image keeps them in TIFF).
-  const std::string description = in->spec().get_string_attribute("ImageDescription");
-  std::size_t begin = 0;
-  while (begin < description.size()) {
-    std::size_t end = description.find(';', begin);
-    if (end == std::string::npos) end = description.size();
-    std::string item = description.substr(begin, end - begin);
-    item.erase(0, item.find_first_not_of(' '));
-    const std::size_t equals = item.find('=');
-    if (item.rfind("nmbake:", 0) == 0 && equals != std::string::npos)
-      metadata.emplace(item.substr(0, equals), item.substr(equals + 1));
-    begin = end + 1;
-  }
-  in->close();
-  return metadata;
-}
+// read_image and read_image_metadata: image_read.cpp.
 
 void preload_image_io() {}  // linked directly: nothing to load
 void wait_for_image_io() {}

@@ -23,13 +23,22 @@ int default_bits_for(const std::string& path);
 void check_output_format(const std::string& path, int bits);
 
 struct WriteOptions {
+  // Also {bits, metadata}: written as an aggregate before temp_path was added.
+  WriteOptions(int bits_ = 0, std::vector<std::pair<std::string, std::string>> metadata_ = {})
+      : bits(bits_), metadata(std::move(metadata_)) {}
   int bits = 0;                                               // 8, 16 or 32 (float); 0 = default_bits_for(path)
   std::vector<std::pair<std::string, std::string>> metadata;  // written as string attributes
+  // "" = write to a temporary file beside `path` and rename it into place; else write this file
+  // only (created or emptied, never through a symbolic link) and leave the rename to the caller,
+  // which commits several outputs together (the nmbake command's OutputSet).
+  std::string temp_path;
 };
 
-// Writes `image` (values in [0,1] for integer formats, rounded to nearest) to a temporary file in
-// the same folder and renames it into place, so `path` is either the old file or the complete new
-// one. Throws OutputError (file named) when it cannot be written.
+// Writes `image` (values in [0,1] for integer formats, rounded to nearest) to a temporary file,
+// flushed to disk (fsync), and renames it into place (unless options.temp_path is given), so
+// `path` is either the old file or the complete new one. `path` chooses the format and names the
+// file in errors. Throws OutputError "<path>: cannot write: <reason>", one short line (the
+// system's reason where a write failed: "No space left on device"), the temporary removed.
 void write_image(const std::string& path, const Image& image, const WriteOptions& options = {});
 
 // Reads any format OpenImageIO reads, converted to float (integer formats scaled to [0,1]).

@@ -1,31 +1,52 @@
 #include "io/text_file.h"
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
+#include <filesystem>
 
 #include "core/errors.h"
 
 namespace nmbake {
 
-void write_text_atomically(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw OutputError(path + ": cannot write: " + std::strerror(errno));
-    out << text;
-    out.flush();
-    if (!out) {
-      std::remove(tmp.c_str());
-      throw OutputError(path + ": cannot write: " + std::strerror(errno));
+void write_text_file(const std::string& path, const std::string& temp, const std::string& text) {
+  auto fail = [&](int err) {
+    ::unlink(temp.c_str());
+    throw OutputError(path + ": cannot write: " + std::strerror(err));
+  };
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0666);
+  if (fd < 0) throw OutputError(path + ": cannot write: " + std::strerror(errno));
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int err = n < 0 ? errno : EIO;
+      ::close(fd);
+      fail(err);
     }
+    done += std::size_t(n);
   }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+  // A full disk or a failing device may only show here, on some filesystems (NFS) only at close.
+  if (::fsync(fd) != 0) {
     const int err = errno;
-    std::remove(tmp.c_str());
+    ::close(fd);
+    fail(err);
+  }
+  if (::close(fd) != 0) fail(errno);
+}
+
+void write_text_atomically(const std::string& path, const std::string& text) {
+  const std::filesystem::path target(path);
+  const std::string temp =
+      (target.parent_path() / ("." + target.filename().string() + ".nmbake-tmp." + std::to_string(::getpid()))).string();
+  write_text_file(path, temp, text);
+  if (std::rename(temp.c_str(), path.c_str()) != 0) {
+    const int err = errno;
+    ::unlink(temp.c_str());
     throw OutputError(path + ": cannot write: " + std::strerror(err));
   }
 }

@@ -1,13 +1,18 @@
-// Text outputs (reports, JSON, cages) written like the maps: to a temporary file beside the target,
-// renamed into place only when complete, so a failed write never leaves a partial file or loses the
-// old one.
+// Text outputs (reports, JSON, cages) written like the maps: to a temporary file, renamed into
+// place only when complete, so a failed write never leaves a partial file or loses the old one.
 #pragma once
 
 #include <string>
 
 namespace nmbake {
 
-// Throws OutputError "<path>: cannot write: <reason>" (the temporary removed).
+// Writes `text` to the file `temp` (created, or emptied; never through a symbolic link) and flushes
+// it to disk (fsync); the caller renames it to `path` when every output is complete. Errors name
+// `path`: OutputError "<path>: cannot write: <reason>", the temporary removed.
+void write_text_file(const std::string& path, const std::string& temp, const std::string& text);
+
+// write_text_file to a temporary file beside `path`, then renamed over it. Throws OutputError
+// "<path>: cannot write: <reason>" (the temporary removed).
 void write_text_atomically(const std::string& path, const std::string& text);
 
 }  // namespace nmbake

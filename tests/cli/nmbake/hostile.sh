@@ -8,7 +8,8 @@
 #   CODE  the exit code nmbake must return
 #   PATH  relative to REPO; "shared:" + a path means REPO/../shared/data/<path> (or
 #         $NMBAKE_SHARED_DATA_DIR/<path>); "abs:" + a path is taken as is
-#   TEXT  for CODE 0, ignored; otherwise words the error line must contain
+#   TEXT  for CODE 0, "-" or words stderr must contain (a warning); otherwise words the error
+#         line must contain
 # A failing case must print exactly one line on stderr, "error: ..." naming the file (its base
 # name), contain TEXT, and leave nothing behind in its work folder (neither the map, the miss mask
 # nor the report, nor a temporary); a successful one must write all three. Every case must end within the time limit
@@ -48,6 +49,7 @@ while read -r role code path text; do
   name=$(basename "$file")
   if [ "$code" = 0 ]; then
     for out in map.png miss.png report.json; do [ -s "$dir/$out" ] || problems+=("no $out written"); done
+    [ "$text" = "-" ] || grep -qF -- "$text" "$dir/stderr.txt" || problems+=("stderr lacks: $text")
   else
     lines=$(wc -l <"$dir/stderr.txt")
     [ "$lines" = 1 ] || problems+=("stderr has $lines lines, expected one")

@@ -5,6 +5,7 @@
 #include <random>
 #include <string>
 
+#include "hostile_fixtures.h"
 #include "io/image_io.h"
 
 namespace {
@@ -90,5 +91,6 @@ int main(int argc, char** argv) {
   std::ofstream(path("low_left.obj")) << "v -1 -1 0\nv 0 -1 0\nv 0 1 0\nv -1 1 0\n"
                                          "vt 0 0\nvt 0.5 0\nvt 0.5 1\nvt 0 1\nvn 0 0 1\n"
                                          "f 1/1/1 2/2/1 3/3/1 4/4/1\n";
+  write_hostile_fixtures(dir);
   return 0;
 }

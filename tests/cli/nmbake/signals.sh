@@ -1,0 +1,77 @@
+#!/usr/bin/env bash
+# SIGTERM, SIGHUP and SIGINT during the bake or during the writes, and SIGKILL during the writes.
+#   signals.sh NMBAKE REPO WORK
+# 1. SIGTERM / SIGHUP while the bake runs: exit 143 / 129, one "error: interrupted by ..." line,
+#    the old map, miss mask and report byte-identical, no temporary left.
+# 2. SIGTERM and SIGINT once the map's temporary file exists (the writes have begun): the same
+#    (exit 143 / 130).
+# 3. SIGKILL during the writes leaves only temporaries named ".<name>.nmbake-tmp.<pid>"; the next
+#    run over the same outputs removes them, and a live process's temporary is left alone.
+set -u
+nmbake=$(realpath "$1") repo=$(realpath "$2") work=$3
+low=$repo/data/sample/torus_low.obj high=$repo/data/sample/torus_high.ply
+rm -rf "$work" && mkdir -p "$work/scene" && cd "$work/scene" || exit 1
+log=$work
+fail=0
+bad() { echo "FAIL: $*"; fail=1; }
+state() { for f in $(ls -A | sort); do echo "$f $(md5sum <"$f")"; done; }
+
+"$nmbake" "$low" "$high" -o m.png --size 32 --miss-mask miss.png --report r.json --quiet || { echo "FAIL: the first bake"; exit 1; }
+old=$(state)
+
+# run_and_signal SIGNAL WHEN: starts a bake over the old outputs, sends SIGNAL once WHEN holds
+# ("bake": its worker threads exist; "write": the map's temporary exists), waits, sets $code.
+run_and_signal() {
+  local sig=$1 when=$2
+  # 2048^2 texels: the bake takes about 1 s, the writes 0.2 s (several times that under ASan).
+  "$nmbake" "$low" "$high" -o m.png --size 2048 --threads 2 --miss-mask miss.png --report r.json --quiet \
+    >"$log/stdout.txt" 2>"$log/stderr.txt" &
+  pid=$!
+  local seen=0 until=$((SECONDS + 120))
+  while [ "$SECONDS" -lt "$until" ]; do
+    kill -0 "$pid" 2>/dev/null || break
+    if [ "$when" = bake ]; then
+      threads=$(awk '/^Threads:/ {print $2}' "/proc/$pid/status" 2>/dev/null || echo 0)
+      [ "${threads:-0}" -gt 1 ] && { sleep 0.3; seen=1; break; }
+    elif [ -e ".m.png.nmbake-tmp.$pid" ]; then
+      seen=1
+      break
+    fi
+    sleep 0.005
+  done
+  [ "$seen" = 1 ] || bad "$sig during the $when: the moment never came"
+  kill -s "$sig" "$pid" 2>/dev/null
+  local deadline=$((SECONDS + 60))
+  while kill -0 "$pid" 2>/dev/null && [ "$SECONDS" -lt "$deadline" ]; do sleep 0.05; done
+  kill -0 "$pid" 2>/dev/null && kill -KILL "$pid"
+  wait "$pid"
+  code=$?
+}
+
+for case in TERM:bake:143 HUP:bake:129 TERM:write:143 INT:write:130; do
+  IFS=: read -r sig when expect <<<"$case"
+  run_and_signal "$sig" "$when"
+  err=$(cat "$log/stderr.txt")
+  [ "$code" = "$expect" ] || bad "SIG$sig during the $when: exit $code, expected $expect ($err)"
+  [ "$err" = "error: interrupted by SIG$sig; no output written" ] || bad "SIG$sig during the $when: stderr: $err"
+  [ "$(state)" = "$old" ] || bad "SIG$sig during the $when: files changed or left: $(ls -A | tr '\n' ' ')"
+  echo "ok   SIG$sig during the $when: exit $code: $err"
+done
+
+# 3. SIGKILL: the temporaries stay, named for the output and the process; the next run removes
+# them (not a live process's).
+run_and_signal KILL write
+[ "$code" = 137 ] || bad "SIGKILL: exit $code"
+stale=$(ls -A | grep -c "^\.m\.png\.nmbake-tmp\.$pid$")
+[ "$stale" = 1 ] || bad "SIGKILL: no .m.png.nmbake-tmp.$pid left: $(ls -A | tr '\n' ' ')"
+others=$(ls -A | grep -v -e '^m\.png$' -e '^miss\.png$' -e '^r\.json$' -e "^\.[a-z.]*\.nmbake-tmp\.$pid$" || true)
+[ -z "$others" ] || bad "SIGKILL: unrecognisable files left: $others"
+sleep 1000 &
+alive=$!
+touch ".m.png.nmbake-tmp.$alive" ".r.json.nmbake-old.99999999" ".other.png.nmbake-tmp.4"
+"$nmbake" "$low" "$high" -o m.png --size 32 --miss-mask miss.png --report r.json --quiet || bad "the bake after SIGKILL failed"
+left=$(ls -A | grep nmbake- | sort | tr '\n' ' ')
+[ "$left" = ".m.png.nmbake-tmp.$alive .other.png.nmbake-tmp.4 " ] || bad "after SIGKILL, the next run left: $left"
+kill "$alive"
+echo "ok   SIGKILL left only .NAME.nmbake-tmp.$pid files; the next run removed them (kept: $left)"
+exit $fail

@@ -1,0 +1,184 @@
+// The nmbake command's output set (baker/cli/outputs.h): files compared by identity, outputs that
+// are refused, temporaries removed, all renamed together or none, stale temporaries cleaned.
+#include <sys/stat.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "cli/outputs.h"
+#include "core/errors.h"
+#include "io/text_file.h"
+#include "pipeline/bake.h"
+#include "test_support.h"
+
+namespace nmbake {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void put(const std::string& path, const std::string& text) { std::ofstream(path, std::ios::binary) << text; }
+
+// The names in a folder, sorted.
+std::vector<std::string> listing(const std::string& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// A pid no process has: a child that has exited and been reaped.
+pid_t dead_pid() {
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  ::waitpid(child, nullptr, 0);
+  return child;
+}
+
+TEST(Outputs, SameFileByIdentity) {
+  const std::string d = test::scratch_dir();
+  put(d + "/a.obj", "a");
+  fs::create_symlink("a.obj", d + "/link.obj");
+  fs::create_hard_link(d + "/a.obj", d + "/hard.obj");
+  fs::create_directory(d + "/sub");
+  EXPECT_TRUE(same_file(d + "/a.obj", d + "/link.obj"));
+  EXPECT_TRUE(same_file(d + "/a.obj", d + "/hard.obj"));
+  EXPECT_TRUE(same_file(d + "/a.obj", d + "/sub/../a.obj"));
+  EXPECT_TRUE(same_file(d + "/new.png", d + "/./new.png"));       // neither exists yet
+  EXPECT_TRUE(same_file(d + "/new.png", d + "/sub/../new.png"));  // nor here
+  EXPECT_FALSE(same_file(d + "/a.obj", d + "/b.obj"));
+  EXPECT_FALSE(same_file(d + "/new.png", d + "/new2.png"));
+}
+
+TEST(Outputs, RefusedOutputs) {
+  const std::string d = test::scratch_dir();
+  put(d + "/low.obj", "low");
+  fs::create_symlink("/dev/full", d + "/full.png");
+  fs::create_symlink("nothing.png", d + "/dangling.png");
+  const std::vector<NamedFile> inputs{{"", d + "/low.obj", "the low-poly"}};
+  auto code_of = [&](const std::vector<NamedFile>& outputs, std::string* message) {
+    try {
+      check_output_files(inputs, outputs);
+    } catch (const Error& e) {
+      *message = e.what();
+      return int(e.code());
+    }
+    return 0;
+  };
+  std::string m;
+  EXPECT_EQ(code_of({{"--report", d + "/low.obj", "the report"}}, &m), 1);
+  EXPECT_EQ(m, "--report " + d + "/low.obj is the same file as " + d + "/low.obj; nothing written");
+  EXPECT_EQ(code_of({{"--output", d + "/m.png", "the map"}, {"--miss-mask", d + "/./m.png", "the miss mask"}}, &m), 1);
+  EXPECT_EQ(m, "--miss-mask " + d + "/./m.png is the same file as " + d + "/m.png; nothing written");
+  EXPECT_EQ(code_of({{"--output", d + "/full.png", "the map"}}, &m), 3);
+  EXPECT_NE(m.find("it is a symbolic link to a character device (/dev/full)"), std::string::npos) << m;
+  EXPECT_EQ(code_of({{"--output", d + "/dangling.png", "the map"}}, &m), 3);
+  EXPECT_NE(m.find("a symbolic link to a missing file"), std::string::npos) << m;
+  EXPECT_EQ(code_of({{"--output", d, "the map"}}, &m), 3);
+  EXPECT_NE(m.find("it is a directory"), std::string::npos) << m;
+  EXPECT_EQ(code_of({{"--output", d + "/" + std::string(236, 'x') + ".png", "the map"}}, &m), 3);
+  EXPECT_NE(m.find("its name is 240 bytes long, more than the 235 that leave room for its temporary file"), std::string::npos)
+      << m;
+  EXPECT_EQ(code_of({{"--output", d + "/" + std::string(235, 'x'), "the map"}}, &m), 0) << m;
+  EXPECT_EQ(code_of({{"--output", d + "/no/such/m.png", "the map"}}, &m), 3);
+  EXPECT_NE(m.find("does not exist"), std::string::npos) << m;
+  EXPECT_EQ(code_of({{"--output", d + "/m.png", "the map"}, {"--report", "", "the report"}}, &m), 0) << m;
+}
+
+TEST(Outputs, CommitRenamesAllTogether) {
+  const std::string d = test::scratch_dir();
+  put(d + "/a.png", "old a");
+  ::chmod((d + "/a.png").c_str(), 0640);
+  fs::create_symlink("a.png", d + "/link.png");
+  {
+    OutputSet set;
+    write_text_file(d + "/link.png", set.add(d + "/link.png"), "new a");
+    write_text_file(d + "/b.json", set.add(d + "/b.json"), "new b");
+    EXPECT_EQ(slurp(d + "/a.png"), "old a");  // nothing visible before the commit
+    EXPECT_FALSE(test::exists(d + "/b.json"));
+    set.commit([] { return false; });
+  }
+  EXPECT_EQ(slurp(d + "/a.png"), "new a");
+  EXPECT_EQ(slurp(d + "/b.json"), "new b");
+  EXPECT_TRUE(fs::is_symlink(d + "/link.png"));  // written through
+  struct stat st {};
+  ASSERT_EQ(::stat((d + "/a.png").c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0777, 0640u);  // the old file's permissions
+  EXPECT_EQ(listing(d), (std::vector<std::string>{"a.png", "b.json", "link.png"}));
+}
+
+TEST(Outputs, UncommittedOrCancelledSetChangesNothing) {
+  const std::string d = test::scratch_dir();
+  put(d + "/a.png", "old a");
+  {
+    OutputSet set;
+    write_text_file(d + "/a.png", set.add(d + "/a.png"), "new a");
+    write_text_file(d + "/b.json", set.add(d + "/b.json"), "new b");
+  }
+  EXPECT_EQ(listing(d), (std::vector<std::string>{"a.png"}));
+  EXPECT_EQ(slurp(d + "/a.png"), "old a");
+  {
+    OutputSet set;
+    write_text_file(d + "/a.png", set.add(d + "/a.png"), "new a");
+    EXPECT_THROW(set.commit([] { return true; }), Cancelled);
+  }
+  EXPECT_EQ(listing(d), (std::vector<std::string>{"a.png"}));
+  EXPECT_EQ(slurp(d + "/a.png"), "old a");
+}
+
+// A rename that fails half way (the last output's name is taken by a folder with a file in it,
+// made after the checks) puts back the old files of those already renamed.
+TEST(Outputs, FailedRenameRollsBack) {
+  const std::string d = test::scratch_dir();
+  put(d + "/a.png", "old a");
+  OutputSet set;
+  write_text_file(d + "/a.png", set.add(d + "/a.png"), "new a");
+  write_text_file(d + "/b.png", set.add(d + "/b.png"), "new b");  // no old b
+  write_text_file(d + "/c.json", set.add(d + "/c.json"), "new c");
+  fs::create_directory(d + "/c.json");
+  put(d + "/c.json/keep", "x");
+  try {
+    set.commit([] { return false; });
+    ADD_FAILURE() << "the commit should fail";
+  } catch (const OutputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(d + "/c.json: cannot write: ", 0), 0u) << e.what();
+  }
+  EXPECT_EQ(slurp(d + "/a.png"), "old a");
+  EXPECT_FALSE(test::exists(d + "/b.png"));
+  EXPECT_EQ(listing(d), (std::vector<std::string>{"a.png", "c.json"}));
+}
+
+// Temporaries of a process that no longer exists are removed when the same output is written;
+// a live process's, and other outputs', are not.
+TEST(Outputs, StaleTemporariesRemoved) {
+  const std::string d = test::scratch_dir();
+  const std::string dead = std::to_string(dead_pid()), alive = std::to_string(::getppid());
+  for (const std::string& name : {".m.png.nmbake-tmp." + dead, ".m.png.nmbake-old." + dead, ".m.png.nmbake-tmp." + dead + ".3",
+                                  ".m.png.nmbake-tmp." + alive, ".n.png.nmbake-tmp." + dead, ".m.png.nmbake-tmp.x" + dead})
+    put(d + "/" + name, "stale");
+  OutputSet set;
+  const std::string temp = set.add(d + "/m.png");
+  EXPECT_EQ(temp, d + "/.m.png.nmbake-tmp." + std::to_string(::getpid()));
+  std::vector<std::string> kept{".m.png.nmbake-tmp." + alive, ".m.png.nmbake-tmp." + dead + ".3", ".m.png.nmbake-tmp.x" + dead,
+                                ".n.png.nmbake-tmp." + dead};
+  std::sort(kept.begin(), kept.end());
+  EXPECT_EQ(listing(d), kept);
+}
+
+}  // namespace
+}  // namespace nmbake
