@@ -103,9 +103,11 @@ TEST(HostileGeometry, SmallStacksAreLeftAlone) {
   const Mesh low = test::make_grid(1, 1);
   Mesh high = test::make_grid(1, 1);
   for (int copy = 1; copy < int(kDuplicateFlood); ++copy)
-    for (int k = 0; k < 3; ++k) high.position_index.push_back(high.position_index[k]);
-  high.normal_index = high.position_index;
-  high.uv_index = high.position_index;
+    for (int k = 0; k < 3; ++k) {
+      high.position_index.push_back(high.position_index[k]);
+      high.normal_index.push_back(high.normal_index[k]);
+      high.uv_index.push_back(high.uv_index[k]);
+    }
   high.source_face.resize(high.triangle_count(), 0);
   BakeOptions o;
   o.width = o.height = 16;
