@@ -193,28 +193,33 @@ struct Scene::Impl {
   RTCScene scene = nullptr;
   std::size_t triangles = 0;
 
+  // Releasing must not throw: an error callback that throws from here (a destructor, maybe while
+  // a failed build unwinds) is std::terminate; under ulimit -v a release after a failed
+  // rtcCommitScene did exactly that (exit 134).
   ~Impl() {
+    if (device) rtcSetDeviceErrorFunction(device, nullptr, nullptr);
     if (scene) rtcReleaseScene(scene);
     if (device) rtcReleaseDevice(device);
   }
 };
 
-Scene::Scene(const float* positions, std::size_t vertex_count, const std::uint32_t* indices, std::size_t triangle_count,
-             BuildQuality quality, int threads)
-    : impl_(std::make_unique<Impl>()) {
-  std::string config = threads > 0 ? "threads=" + std::to_string(threads) : std::string();
-  impl_->device = rtcNewDevice(config.empty() ? nullptr : config.c_str());
-  check_device(impl_->device);
-  rtcSetDeviceErrorFunction(impl_->device, throw_on_error, nullptr);
-  impl_->triangles = triangle_count;
+namespace {
 
-  impl_->scene = rtcNewScene(impl_->device);
+void build(Scene::Impl& impl, const float* positions, std::size_t vertex_count, const std::uint32_t* indices,
+           std::size_t triangle_count, BuildQuality quality, int threads) {
+  std::string config = threads > 0 ? "threads=" + std::to_string(threads) : std::string();
+  impl.device = rtcNewDevice(config.empty() ? nullptr : config.c_str());
+  check_device(impl.device);
+  rtcSetDeviceErrorFunction(impl.device, throw_on_error, nullptr);
+  impl.triangles = triangle_count;
+
+  impl.scene = rtcNewScene(impl.device);
   // Robust: coincident and touching triangles must not lose hits to fast approximations. Context
   // filters: the calls under a HitRule pass theirs (the others pass none and pay nothing for it).
-  rtcSetSceneFlags(impl_->scene, RTCSceneFlags(RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION));
-  rtcSetSceneBuildQuality(impl_->scene, to_embree(quality));
+  rtcSetSceneFlags(impl.scene, RTCSceneFlags(RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION));
+  rtcSetSceneBuildQuality(impl.scene, to_embree(quality));
 
-  RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+  RTCGeometry geom = rtcNewGeometry(impl.device, RTC_GEOMETRY_TYPE_TRIANGLE);
   rtcSetGeometryBuildQuality(geom, to_embree(quality));
   // Embree reads vertices with 16-byte loads: its own buffers carry the padding it needs.
   auto* vb = static_cast<float*>(
@@ -224,9 +229,26 @@ Scene::Scene(const float* positions, std::size_t vertex_count, const std::uint32
       rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(std::uint32_t), triangle_count));
   std::memcpy(ib, indices, triangle_count * 3 * sizeof(std::uint32_t));
   rtcCommitGeometry(geom);
-  rtcAttachGeometry(impl_->scene, geom);
+  rtcAttachGeometry(impl.scene, geom);
   rtcReleaseGeometry(geom);
-  rtcCommitScene(impl_->scene);
+  rtcCommitScene(impl.scene);
+}
+
+}  // namespace
+
+Scene::Scene(const float* positions, std::size_t vertex_count, const std::uint32_t* indices, std::size_t triangle_count,
+             BuildQuality quality, int threads)
+    : impl_(std::make_unique<Impl>()) {
+  try {
+    build(*impl_, positions, vertex_count, indices, triangle_count, quality, threads);
+  } catch (const std::bad_alloc&) {
+    // Out of memory in a build: the device and scene are left unreleased (the process is about to
+    // report it and exit). Releasing them after a failed parallel build ended in std::terminate
+    // inside Embree under ulimit -v (exit 134).
+    impl_->scene = nullptr;
+    impl_->device = nullptr;
+    throw;
+  }
 }
 
 Scene::~Scene() = default;

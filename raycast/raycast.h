@@ -164,8 +164,9 @@ class Scene {
 
   std::size_t triangle_count() const;
 
+  struct Impl;  // Embree's device and scene (raycast.cpp)
+
  private:
-  struct Impl;
   std::unique_ptr<Impl> impl_;
 };
 

@@ -239,7 +239,10 @@ void check_outputs(const Args& a, int bits) {
                       {"--save-cage", a.save_cage, "the cage"},
                       {"--report", a.report, "the report"}});
   check_output_format(a.output, bits);
-  if (const std::string problem = image_io_problem(); !problem.empty()) throw OutputError(a.output + ": " + problem);
+  if (const std::string problem = image_io_problem(); !problem.empty()) {
+    if (problem.rfind("out of memory", 0) == 0) throw ResourceError(a.output + ": " + problem);
+    throw OutputError(a.output + ": " + problem);
+  }
   if (!a.miss_mask.empty()) check_output_format(a.miss_mask, default_bits_for(a.miss_mask));
   if (!a.suspect_mask.empty()) check_output_format(a.suspect_mask, default_bits_for(a.suspect_mask));
 }

@@ -74,13 +74,9 @@ std::size_t pad_islands(Image& image, const std::vector<std::uint8_t>& covered, 
   // part's result is the same whichever thread computes it.
   auto parallel = [threads](int parts, auto&& part) {
     std::atomic<int> next{0};
-    auto worker = [&] {
+    run_on_threads(threads, [&](int) {
       for (int i; (i = next.fetch_add(1)) < parts;) part(i);
-    };
-    std::vector<std::thread> pool;
-    for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
-    worker();
-    for (auto& t : pool) t.join();
+    });
   };
   // Pass 1, columns: squared distance to the nearest covered texel in the same column. Columns go
   // in blocks of kBlock neighbours, so the image is read and written a row segment at a time.

@@ -62,7 +62,8 @@ void preload_image_io();
 void wait_for_image_io();
 
 // Why images cannot be written, found without waiting for the background load (the module file
-// is missing or already failed to load), or "" (always "" where OpenImageIO is linked).
+// is missing or already failed to load), or "" (always "" where OpenImageIO is linked). It starts
+// with "out of memory" when memory (ulimit -v) is what is missing.
 std::string image_io_problem();
 
 namespace image_io_detail {

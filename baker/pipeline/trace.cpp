@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <exception>
 #include <limits>
 #include <mutex>
 #include <thread>
@@ -345,17 +346,47 @@ class TileTracer {
 
 // Runs `threads` tracers; the calling thread reports progress every 100 ms. The last worker to
 // finish wakes the wait at once, so the stage does not end up to 100 ms after its work.
+// Tiles are taken from a shared counter, so the tracers that could start cover them all. The first
+// exception of a tracer (std::bad_alloc under ulimit -v) stops the others and is rethrown here; a
+// thread the system refuses (EAGAIN) leaves the work to those started, or to this one.
 void run_tracers(Shared& sh, int threads) {
   std::mutex done_mutex;
   std::condition_variable done_cv;
-  int running = threads;
-  std::vector<std::thread> pool;
-  for (int i = 0; i < threads; ++i)
-    pool.emplace_back([&, i] {
+  std::exception_ptr error;
+  int running = 0;
+  auto work = [&](int i) {
+    try {
       TileTracer(sh, i).run();
+    } catch (...) {
       std::lock_guard<std::mutex> lock(done_mutex);
-      if (--running == 0) done_cv.notify_all();
-    });
+      if (!error) error = std::current_exception();
+      sh.cancel = true;
+    }
+    std::lock_guard<std::mutex> lock(done_mutex);
+    if (--running == 0) done_cv.notify_all();
+  };
+  std::vector<std::thread> pool;
+  try {
+    pool.reserve(std::size_t(threads));
+    for (int i = 0; i < threads; ++i) {
+      {
+        std::lock_guard<std::mutex> lock(done_mutex);
+        ++running;
+      }
+      try {
+        pool.emplace_back(work, i);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(done_mutex);
+        --running;
+        throw;
+      }
+    }
+  } catch (const std::exception&) {
+    if (pool.empty()) {  // not one thread: trace here
+      ++running;
+      work(0);
+    }
+  }
   if (sh.opt.progress) {
     const double tile_count = double(sh.bins.count());
     std::unique_lock<std::mutex> lock(done_mutex);
@@ -367,6 +398,7 @@ void run_tracers(Shared& sh, int threads) {
     }
   }
   for (auto& t : pool) t.join();
+  if (error) std::rethrow_exception(error);
   if (sh.cancel) throw Cancelled();
   if (sh.opt.progress) sh.opt.progress(1.0);
 }
