@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "core/errors.h"
+#include "core/memory_budget.h"
 #include "io/image_io.h"
 #include "io/image_read_guard.h"
 #include "test_support.h"
@@ -80,7 +81,7 @@ TEST(ImageReadGuard, MemoryBudget) {
             "m.png: header says 16384x16384 pixels (3.2 GB; 4.0 GB to read), which exceeds the memory budget of 1.0 GB "
             "(available memory, ulimit -v)");
   EXPECT_EQ(message_of("m.png", h, 1000000, image_read_bytes(h)), "");
-  EXPECT_GT(image_memory_budget(), 0u);
+  EXPECT_GT(memory_budget_bytes(), 0u);
 }
 
 std::string input_error(const std::string& path) {

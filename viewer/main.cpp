@@ -20,6 +20,7 @@
 
 #include "compare.h"
 #include "core/errors.h"
+#include "core/memory_budget.h"
 #include "io/image_read_guard.h"
 #include "gl_context.h"
 #include "interactive.h"

@@ -5,7 +5,6 @@
 // linked directly took 0.35 s, an empty program linked to OpenImageIO 0.27 s); done beside the
 // single-threaded mesh loading, the user no longer waits.
 #include <dlfcn.h>
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -22,6 +21,7 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "core/memory_budget.h"
 #include "io/image_io.h"
 #include "io/image_io_module.h"
 
@@ -68,26 +68,13 @@ std::string module_path(std::string* error) {
 // meanwhile.
 constexpr std::uint64_t kModuleAddressSpace = 560ull << 20;
 
-// The address space ulimit -v leaves this process, or UINT64_MAX without a limit.
-std::uint64_t address_space_left() {
-  rlimit limit{};
-  if (::getrlimit(RLIMIT_AS, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return UINT64_MAX;
-  std::uint64_t pages = 0;
-  if (std::FILE* f = std::fopen("/proc/self/statm", "r")) {
-    if (std::fscanf(f, "%lu", &pages) != 1) pages = 0;
-    std::fclose(f);
-  }
-  const std::uint64_t used = pages * std::uint64_t(::sysconf(_SC_PAGESIZE));
-  return limit.rlim_cur > used ? limit.rlim_cur - used : 0;
-}
-
 Loaded load() {
   Loaded l;
   const std::string path = module_path(&l.error);
   if (path.empty()) return l;
   // Short of address space, one of the libraries' constructors (log4cplus's thread pool) does not
   // fail but waits forever: a run under ulimit -v 510 MB hung. Refused before dlopen instead.
-  if (const std::uint64_t left = address_space_left(); left < kModuleAddressSpace) {
+  if (const std::uint64_t left = address_space_headroom(); left < kModuleAddressSpace) {
     l.error = "out of memory: loading the image library needs about " + std::to_string(kModuleAddressSpace >> 20) +
               " MiB of address space and the limit (ulimit -v) leaves " + std::to_string(left >> 20) + " MiB";
     l.memory = true;

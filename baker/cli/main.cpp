@@ -453,11 +453,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "error: out of memory\n");
     code = int(nmbake::ExitCode::memory);
   } catch (const std::system_error& e) {
-    // A thread or resource the system would not give (EAGAIN under ulimit -v): out of resources.
-    std::fprintf(stderr, "error: %s\n", e.what());
-    code = e.code() == std::errc::resource_unavailable_try_again || e.code() == std::errc::not_enough_memory
-               ? int(nmbake::ExitCode::memory)
-               : 2;
+    // A thread or resource the system would not give (EAGAIN under ulimit -v): out of memory.
+    const bool memory = e.code() == std::errc::resource_unavailable_try_again || e.code() == std::errc::not_enough_memory;
+    std::fprintf(stderr, "error: %s%s\n", memory ? "out of memory: " : "", e.what());
+    code = memory ? int(nmbake::ExitCode::memory) : 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     code = 2;

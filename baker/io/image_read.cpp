@@ -11,6 +11,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "core/errors.h"
+#include "core/memory_budget.h"
 #include "io/image_io.h"
 #include "io/image_read_guard.h"
 
@@ -65,7 +66,7 @@ Image read_pixels(const std::string& path, OIIO::ImageInput& in, std::uint64_t f
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth != 1)
     fail("unsupported size " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + "x" + std::to_string(spec.depth) +
          " with " + std::to_string(spec.nchannels) + " channels");
-  check_image_header(path, header_of(in), file_size, image_memory_budget());
+  check_image_header(path, header_of(in), file_size, memory_budget_bytes());
   const double count = double(spec.width) * spec.height * spec.nchannels;
   if (count > double(std::numeric_limits<std::int32_t>::max()))
     throw ResourceError(path + ": image too large (" + std::to_string(spec.width) + "x" + std::to_string(spec.height) + "x" +

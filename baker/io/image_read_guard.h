@@ -32,16 +32,6 @@ double max_pixel_bytes_per_file_byte(const ImageHeader& header);
 // buffer in the stored type (the PNG reader decodes the whole image before converting it).
 std::uint64_t image_read_bytes(const ImageHeader& header);
 
-// How much memory a read may take: the smallest of MemAvailable (/proc/meminfo), the cgroup's
-// limit minus its usage, and the address-space limit (ulimit -v) minus what the process maps.
-// UINT64_MAX when none is known. (The same rule as pipeline/memory_budget.h, which io cannot
-// include.)
-std::uint64_t image_memory_budget();
-
-// What the address-space limit (ulimit -v) leaves beyond what the process maps now; UINT64_MAX
-// when there is no limit.
-std::uint64_t address_space_headroom();
-
 // Throws ResourceError naming `path` when the header's pixels cannot be in a file of `file_size`
 // bytes ("big.png: header says 20000x20000 pixels (4.8 GB) but the file has 812 bytes") or their
 // reading needs more than `budget` bytes.

@@ -15,7 +15,7 @@
 #include "core/parallel.h"
 #include "pipeline/bvh.h"
 #include "pipeline/distances.h"
-#include "pipeline/memory_budget.h"
+#include "core/memory_budget.h"
 #include "pipeline/pad.h"
 #include "pipeline/prepare.h"
 #include "pipeline/rays.h"

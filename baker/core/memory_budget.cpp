@@ -1,4 +1,4 @@
-#include "pipeline/memory_budget.h"
+#include "core/memory_budget.h"
 
 #include <sys/resource.h>
 #include <unistd.h>
@@ -28,7 +28,8 @@ std::uint64_t mem_available() {
   std::uint64_t value = 0;
   while (in >> key >> value >> unit)
     if (key == "MemAvailable:") return value * 1024;
-  return kUnknown;
+  const long pages = sysconf(_SC_AVPHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+  return pages > 0 && page > 0 ? std::uint64_t(pages) * std::uint64_t(page) : kUnknown;
 }
 
 std::uint64_t cgroup_headroom() {
@@ -44,6 +45,8 @@ std::uint64_t cgroup_headroom() {
   return limit > usage ? limit - usage : 0;
 }
 
+}  // namespace
+
 std::uint64_t address_space_headroom() {
   rlimit rl{};
   if (getrlimit(RLIMIT_AS, &rl) != 0 || rl.rlim_cur == RLIM_INFINITY) return kUnknown;
@@ -53,8 +56,6 @@ std::uint64_t address_space_headroom() {
   const std::uint64_t mapped = pages * std::uint64_t(sysconf(_SC_PAGESIZE));
   return rl.rlim_cur > mapped ? rl.rlim_cur - mapped : 0;
 }
-
-}  // namespace
 
 std::uint64_t memory_budget_bytes() { return std::min({mem_available(), cgroup_headroom(), address_space_headroom()}); }
 
