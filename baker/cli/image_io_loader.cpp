@@ -116,6 +116,13 @@ void start() {
     try {
       g_task = std::packaged_task<Loaded()>(load);
       g_loaded = g_task.get_future().share();
+      // Under ulimit -v the load runs here, before anything else allocates: a library constructor
+      // (log4cplus's thread pool) that meets the limit while the meshes load beside it aborts or
+      // waits forever, and the headroom load() checks holds only if nothing competes for it.
+      if (address_space_headroom() != UINT64_MAX) {
+        g_task();
+        return;
+      }
       try {
         g_loader = std::thread([] { g_task(); });
       } catch (const std::system_error&) {
