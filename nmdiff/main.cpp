@@ -327,5 +327,8 @@ int run(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   std::signal(SIGPIPE, SIG_IGN);
-  return run(argc, argv);
+  nmbake::preload_image_io();  // the image library module: loads beside the parsing, or first under ulimit -v
+  const int code = run(argc, argv);
+  nmbake::wait_for_image_io();  // never exit while the image library's constructors run
+  return code;
 }

@@ -21,7 +21,7 @@
 #include "compare.h"
 #include "core/errors.h"
 #include "core/memory_budget.h"
-#include "io/image_read_guard.h"
+#include "io/image_io.h"
 #include "gl_context.h"
 #include "interactive.h"
 #include "renderer.h"
@@ -147,8 +147,9 @@ int run(const Options& o) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  std::signal(SIGPIPE, SIG_IGN);
+namespace {
+
+int run_command_line(int argc, char** argv) {
   CLI::App app{
       "nmview: the low-poly with its baked tangent-space normal map beside the high-poly, "
       "lit alike from one camera"};
@@ -207,4 +208,14 @@ int main(int argc, char** argv) {
     std::cerr << "error: " << e.what() << "\n";
     return int(nmbake::ExitCode::output);
   }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::signal(SIGPIPE, SIG_IGN);
+  nmbake::preload_image_io();  // the image library module: loads beside the parsing, or first under ulimit -v
+  const int code = run_command_line(argc, argv);
+  nmbake::wait_for_image_io();  // never exit while the image library's constructors run
+  return code;
 }

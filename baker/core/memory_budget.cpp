@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <string>
@@ -58,5 +59,14 @@ std::uint64_t address_space_headroom() {
 }
 
 std::uint64_t memory_budget_bytes() { return std::min({mem_available(), cgroup_headroom(), address_space_headroom()}); }
+
+std::string format_bytes(double bytes) {
+  char text[32];
+  if (bytes >= 1e9) std::snprintf(text, sizeof text, "%.1f GB", bytes / 1e9);
+  else if (bytes >= 1e6) std::snprintf(text, sizeof text, "%.1f MB", bytes / 1e6);
+  else if (bytes >= 1e4) std::snprintf(text, sizeof text, "%.1f kB", bytes / 1e3);
+  else std::snprintf(text, sizeof text, "%.0f bytes", bytes);
+  return text;
+}
 
 }  // namespace nmbake

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 
 namespace nmbake {
 
@@ -14,5 +15,8 @@ std::uint64_t memory_budget_bytes();
 // What the address-space limit (ulimit -v) leaves beyond what the process maps now; UINT64_MAX
 // when there is no limit.
 std::uint64_t address_space_headroom();
+
+// "4.8 GB", "812 bytes": a byte count for a message (decimal units).
+std::string format_bytes(double bytes);
 
 }  // namespace nmbake

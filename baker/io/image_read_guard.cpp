@@ -67,15 +67,6 @@ double tiff_ratio(const std::string& c) {
 
 }  // namespace
 
-std::string format_bytes(double bytes) {
-  char text[32];
-  if (bytes >= 1e9) std::snprintf(text, sizeof text, "%.1f GB", bytes / 1e9);
-  else if (bytes >= 1e6) std::snprintf(text, sizeof text, "%.1f MB", bytes / 1e6);
-  else if (bytes >= 1e4) std::snprintf(text, sizeof text, "%.1f kB", bytes / 1e3);
-  else std::snprintf(text, sizeof text, "%.0f bytes", bytes);
-  return text;
-}
-
 std::uint64_t regular_file_size(const std::string& path) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) {

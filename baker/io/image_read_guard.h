@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <string>
 
+#include "core/memory_budget.h"  // format_bytes
+
 namespace nmbake {
 
 // What an image's header says, as read_image needs it before reading the pixels.
@@ -36,8 +38,5 @@ std::uint64_t image_read_bytes(const ImageHeader& header);
 // bytes ("big.png: header says 20000x20000 pixels (4.8 GB) but the file has 812 bytes") or their
 // reading needs more than `budget` bytes.
 void check_image_header(const std::string& path, const ImageHeader& header, std::uint64_t file_size, std::uint64_t budget);
-
-// "4.8 GB", "812 bytes": a byte count for a message (decimal units).
-std::string format_bytes(double bytes);
 
 }  // namespace nmbake

@@ -2,7 +2,7 @@
 # install.sh CMAKE BUILD WORK SAMPLE_DIR BINDIR MODULEDIR MODULE VIEWER(0|1)
 # Installs BUILD into a prefix under WORK, checks the layout, bakes the bundled sample with the
 # installed nmbake from another folder (by PATH), moves the prefix and bakes again, and runs the
-# installed nmdiff (and nmview) --help. Leaves nothing behind: WORK's scratch folder is removed and
+# installed nmdiff on that map (it loads the module too) and nmview --help. Leaves nothing behind: WORK's scratch folder is removed and
 # BUILD's install_manifest.txt, which `cmake --install` rewrites, is put back as it was.
 set -euo pipefail
 cmake=$1 build=$2 work=$3 sample=$4 bindir=$5 moduledir=$6 module=$7 viewer=$8
@@ -37,5 +37,7 @@ mv "$prefix" "$scratch/moved"
 bake "$scratch/moved" "$scratch/elsewhere2"
 
 "$scratch/moved/$bindir/nmdiff" --help >/dev/null || fail "installed nmdiff --help failed"
+# nmdiff and nmview load the image module too, from the moved tree.
+(cd "$scratch/elsewhere2" && "$scratch/moved/$bindir/nmdiff" map.png map.png >/dev/null) || fail "installed nmdiff could not compare maps"
 if [ "$viewer" = 1 ]; then "$scratch/moved/$bindir/nmview" --help >/dev/null || fail "installed nmview --help failed"; fi
 echo "install test: passed"

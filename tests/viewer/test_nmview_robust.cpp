@@ -1,9 +1,10 @@
 // nmview against hostile inputs and outputs, run headless like test_nmview.cpp: inputs that are not
 // regular files (refused at once, exit 2), a map header stating more pixels than its file holds
-// (exit 4), a closed stdout (exit 3, never a SIGPIPE death), and --compare leaving no file behind
-// unless asked for one. Every failure is one "error: ..." line naming the file.
+// (exit 4), a closed stdout (exit 3, never a SIGPIPE death), --compare leaving no file behind
+// unless asked for one, and ulimit -v (exit 0, or exit 4 with no image). Every failure is one "error: ..." line naming the file.
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -33,8 +34,9 @@ struct Finished {
 
 // Runs nmview with `args` in `dir`, headless, stdin /dev/null. With `closed_stdout`, stdout is a
 // pipe whose reader is already gone (every write fails with EPIPE, or kills by SIGPIPE). Killed
-// after 60 s (a hang fails the test instead of blocking it).
-Finished run_nmview(const std::string& dir, const std::vector<std::string>& args, bool closed_stdout = false) {
+// after 60 s (a hang fails the test instead of blocking it). A nonzero `limit_mb` is its ulimit -v.
+Finished run_nmview(const std::string& dir, const std::vector<std::string>& args, bool closed_stdout = false,
+                    unsigned limit_mb = 0) {
   int out[2], err[2];
   if (::pipe(out) != 0 || ::pipe(err) != 0) return {};
   if (closed_stdout) ::close(out[0]);
@@ -50,6 +52,10 @@ Finished run_nmview(const std::string& dir, const std::vector<std::string>& args
     ::dup2(out[1], 1);
     ::dup2(err[1], 2);
     ::alarm(60);
+    if (limit_mb) {
+      const rlimit limit{rlim_t(limit_mb) << 20, rlim_t(limit_mb) << 20};
+      if (::setrlimit(RLIMIT_AS, &limit) != 0) ::_exit(126);
+    }
     std::vector<std::string> all{NMVIEW_EXE};
     all.insert(all.end(), args.begin(), args.end());
     std::vector<char*> argv;
@@ -164,6 +170,37 @@ TEST(NmviewOutputs, CompareWritesNoImageUnlessAsked) {
   EXPECT_TRUE(fs::exists(s.dir + "/worst.png"));
   EXPECT_NE(f.err.find("worst view written to " + s.dir + "/worst.png"), std::string::npos) << f.err;
   EXPECT_TRUE(files_in(work).empty());
+}
+
+// Out of memory anywhere is exit 4 with one line and no image, never a crash (issue 21, item 16):
+// linked to OpenImageIO directly, nmview crashed before main() below ~440 MB (exit 127, 134, 139).
+TEST(NmviewLimits, UnderUlimitItRendersOrExitsFour) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "ulimit -v and AddressSanitizer do not mix (it reserves terabytes of shadow memory)";
+#endif
+  const Scene s = make_scene();
+  int rendered = 0;
+  for (const unsigned mb : {40u, 120u, 300u, 500u, 800u, 1100u, 2000u}) {
+    const std::string shot = s.dir + "/shot" + std::to_string(mb) + ".png";
+    const Finished f = run_nmview(s.dir, {s.low, s.map, s.high, "--size", "200x100", "--screenshot", shot}, false, mb);
+    SCOPED_TRACE("ulimit -v " + std::to_string(mb) + " MB: " + f.err);
+    ASSERT_FALSE(f.signalled);
+    ASSERT_TRUE(f.code == 0 || f.code == 4) << "exit " << f.code;
+    if (f.code == 0) {
+      ++rendered;
+      EXPECT_TRUE(fs::exists(shot));
+      continue;
+    }
+    EXPECT_FALSE(fs::exists(shot)) << "an image was left after exit 4";
+    std::istringstream in(f.err);
+    std::vector<std::string> errors;
+    for (std::string l; std::getline(in, l);)
+      if (l.rfind("nmview: ", 0) != 0) errors.push_back(l);
+    ASSERT_EQ(errors.size(), 1u);
+    EXPECT_EQ(errors[0].rfind("error: ", 0), 0u);
+    EXPECT_NE(errors[0].find("out of memory"), std::string::npos);
+  }
+  EXPECT_GE(rendered, 1) << "not even 2 GB of address space was enough to render";
 }
 
 }  // namespace

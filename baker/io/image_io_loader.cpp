@@ -1,6 +1,9 @@
-// image_io.h for the nmbake command: OpenImageIO lives in the module libnmbake_oiio.so (next to the
-// executable in the build tree, in lib/nmbake/ when installed), loaded on a background thread that
-// preload_image_io() starts first thing in main(), while the meshes load and the bake runs. Loading
+// image_io.h for the commands (nmbake, nmdiff, nmview): OpenImageIO lives in the module
+// libnmbake_oiio.so (in the build tree's baker/ folder, in lib/nmbake/ when installed), loaded on a
+// background thread that preload_image_io() starts first thing in main(), while the meshes load and
+// the bake runs. Under ulimit -v it loads first thing, checked against the address space left: linked
+// directly, its libraries' static constructors met the limit before main() and crashed (nmdiff and
+// nmview below ~440 MB: exit 127, 134 or 139). Loading
 // it costs ~0.15-0.3 s of symbol relocation in its ~260 libraries (measured: `nmbake --version`
 // linked directly took 0.35 s, an empty program linked to OpenImageIO 0.27 s); done beside the
 // single-threaded mesh loading, the user no longer waits.
@@ -34,9 +37,11 @@ struct Loaded {
   bool memory = false;  // for want of memory (ulimit -v): exit 4, not the caller's code
 };
 
-// Where the module may be, in the order looked at: next to the executable (the build tree's baker/
-// folder), then the installed layout's module folder relative to the executable's
-// (NMBAKE_IMAGE_MODULE_DIR, set by cmake/Install.cmake, e.g. "../lib/nmbake").
+// Where the module may be, in the order looked at: next to the executable (nmbake in the build
+// tree), the installed layout's module folder relative to the executable's (NMBAKE_IMAGE_MODULE_DIR,
+// set by cmake/Install.cmake, e.g. "../lib/nmbake"), then the build tree's baker/ folder seen from its nmdiff/ and viewer/
+// folders. Relative to the executable only, so that a command copied elsewhere without its module says so
+// (cli.nmbake.image_module_missing).
 std::vector<std::string> module_candidates() {
   char exe[PATH_MAX];
   const ssize_t n = ::readlink("/proc/self/exe", exe, sizeof exe - 1);
@@ -49,6 +54,7 @@ std::vector<std::string> module_candidates() {
 #ifdef NMBAKE_IMAGE_MODULE_DIR
   paths.push_back(dir + "/" NMBAKE_IMAGE_MODULE_DIR "/" NMBAKE_IMAGE_MODULE);
 #endif
+  paths.push_back(dir + "/../baker/" NMBAKE_IMAGE_MODULE);  // the build tree's nmdiff/ and viewer/ folders
   return paths;
 }
 
