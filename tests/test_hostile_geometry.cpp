@@ -99,6 +99,48 @@ TEST(HostileGeometry, StacksOfIdenticalTrianglesEnterTheBvhOnce) {
   EXPECT_TRUE(r.coverage == single.coverage);
 }
 
+// The report says what was done to the input: the stacks entered once (high_mesh.
+// duplicates_skipped) and the point far meshes were re-centred on (origin).
+TEST(HostileGeometry, ReportGivesSkippedStacksAndTheOrigin) {
+  const std::string dir = test::scratch_dir();
+  const double x0 = 1e6 + 0.1, y0 = -2e6 + 0.3;  // far, and not float values: read in double
+  std::string low = "", high = "";
+  char line[160];
+  for (int j = 0; j <= 4; ++j)
+    for (int i = 0; i <= 4; ++i) {
+      std::snprintf(line, sizeof line, "v %.17g %.17g %.17g\nvt %g %g\n", x0 + 0.25 * i, y0 + 0.25 * j, 5.0, 0.25 * i, 0.25 * j);
+      low += line;
+      std::snprintf(line, sizeof line, "v %.17g %.17g %.17g\n", x0 + 0.25 * i, y0 + 0.25 * j, 5.0 + 0.01 * ((i + j) % 2));
+      high += line;
+    }
+  int faces = 0;
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < 4; ++i) {
+      const int a = 1 + i + 5 * j, b = a + 1, c = a + 6, d = a + 5;
+      std::snprintf(line, sizeof line, "f %d/%d %d/%d %d/%d\nf %d/%d %d/%d %d/%d\n", a, a, b, b, c, c, a, a, c, c, d, d);
+      low += line;
+      for (int copy = 0; copy < 12; ++copy) {  // each triangle 12 times: stacks above kDuplicateFlood
+        std::snprintf(line, sizeof line, "f %d %d %d\nf %d %d %d\n", a, b, c, a, c, d);
+        high += line;
+      }
+      faces += 2;
+    }
+  write_text(dir + "/low.obj", low);
+  write_text(dir + "/high.obj", high);
+  const test::CliRun r = run_nmbake("low.obj high.obj -o out.png --size 32 --report r.json", "", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.report["high_mesh"]["duplicates_skipped"], 11 * faces);
+  const nlohmann::json& origin = r.report["origin"];
+  ASSERT_EQ(origin.size(), 3u) << r.report.dump();
+  EXPECT_NEAR(origin[0].get<double>(), x0 + 0.5, 1e-9);
+  EXPECT_NEAR(origin[1].get<double>(), y0 + 0.5, 1e-9);
+
+  const test::CliRun near = run_nmbake(kLow + " " + kHigh + " -o out.png --size 16 --report r.json");
+  ASSERT_EQ(near.code, 0) << near.err;
+  EXPECT_EQ(near.report["origin"], nlohmann::json::array({0.0, 0.0, 0.0}));
+  EXPECT_EQ(near.report["high_mesh"]["duplicates_skipped"], 0);
+}
+
 TEST(HostileGeometry, SmallStacksAreLeftAlone) {
   const Mesh low = test::make_grid(1, 1);
   Mesh high = test::make_grid(1, 1);

@@ -359,6 +359,10 @@ RunInfo run_info(const Args& a, int argc, char** argv, int bits) {
   return run;
 }
 
+// What the command does, for an out-of-memory message ("error: out of memory while writing the
+// outputs"); the bake names its own stages.
+const char* g_doing = nullptr;
+
 int run(int argc, char** argv) {
   Args a;
   CLI::App app{"nmbake: bake a tangent-space normal map from a high-poly mesh onto a low-poly mesh with UVs.", "nmbake"};
@@ -386,10 +390,12 @@ int run(int argc, char** argv) {
 
   // Load.
   RunInfo run = run_info(a, argc, argv, bits);
+  g_doing = "loading the meshes";
   auto t0 = Clock::now();
   LoadOptions low_opts;
   low_opts.require_uvs = true;
   Mesh low = load_mesh(a.low, low_opts, &run.low_info);
+  run.origin = {low.origin.x, low.origin.y, low.origin.z};
   LoadOptions shared;  // the high-poly and the cage share the low-poly's origin (re-centred when far)
   shared.origin = low.origin;
   Mesh high = load_mesh(a.high, shared, &run.high_info);
@@ -405,6 +411,7 @@ int run(int argc, char** argv) {
 
   ProgressBar bar(tty);
   o.progress = [&](double f) { return bar.update(f); };
+  g_doing = "baking";
   const BakeResult r = bake_normal_map(low, high, cage_mesh, o);
   const BakeStats& s = r.stats;
   // Topology checks are only reported: they run beside the image write, which uses one core
@@ -413,13 +420,16 @@ int run(int argc, char** argv) {
   if (!a.quiet) print_distances(s);
   if (interrupted()) throw Cancelled();
   ErrorEstimate estimate;
+  g_doing = "estimating the error";
   if (a.estimate_error) estimate = estimate_error(low, high, cage_mesh, o, r, bits);
 
   // Every output to its temporary file, then all renamed into place together.
   OutputSet outputs;
+  g_doing = "writing the outputs";
   t0 = Clock::now();
   write_outputs(outputs, a, o, r, low, bits);
   run.seconds_write = std::chrono::duration<double>(Clock::now() - t0).count();
+  g_doing = "checking the high-poly's topology";
   run.high_topology = topology.get();
   warnings.add(bake_warnings(s, run.high_topology, a.low, a.high));
   warnings.check_strict();
@@ -427,6 +437,7 @@ int run(int argc, char** argv) {
   run.seconds_total = std::chrono::duration<double>(Clock::now() - start).count();
   run.peak_memory_bytes = peak_memory_bytes();
   run.threads_used = unsigned(worker_threads(a.threads));
+  g_doing = "writing the report";
   if (!a.report.empty()) write_report(outputs, a, o, run, s, a.estimate_error ? &estimate : nullptr);
   outputs.commit(interrupted);
   if (!a.quiet) print_summary(a, o, run, s, bits);
@@ -450,7 +461,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "error: %s\n", e.what());
     code = int(e.code());
   } catch (const std::bad_alloc&) {
-    std::fprintf(stderr, "error: out of memory\n");
+    std::fprintf(stderr, "error: out of memory%s%s\n", g_doing ? " while " : "", g_doing ? g_doing : "");
     code = int(nmbake::ExitCode::memory);
   } catch (const std::system_error& e) {
     // A thread or resource the system would not give (EAGAIN under ulimit -v): out of memory.

@@ -146,6 +146,8 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
   high["non_manifold_edges"] = t.non_manifold_edges;
   high["inconsistent_winding_faces"] = t.inconsistent_winding_faces;
   high["triangles_culled"] = s.high_triangles_culled;
+  high["duplicates_skipped"] = s.high_duplicates_skipped;
+  report["origin"] = r.origin;
   report["version"] = NMBAKE_VERSION;
   report["command"] = r.command;
   report["started"] = r.started;

@@ -1,6 +1,7 @@
 // The --report JSON of a bake, and atomic text output.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <ctime>
 #include <string>
@@ -25,6 +26,7 @@ struct RunInfo {
   std::vector<std::string> command;   // argv, as given
   std::string started;                // UTC, "2026-11-25T03:04:05Z" (utc_time_text(report_time()))
   std::vector<std::string> warnings;  // every warning line, "warning: ..." (printed or not)
+  std::array<double, 3> origin{};     // the point the meshes were re-centred on (Mesh::origin), 0 when not
 };
 
 const char* to_string(RayPolicy p);

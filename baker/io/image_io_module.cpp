@@ -3,14 +3,16 @@
 
 #include <exception>
 #include <new>
+#include <string>
 
 #include "core/errors.h"
 
 namespace nmbake {
 namespace {
 
+// Errors of image_io.cpp name the file themselves; others get "<path>: cannot <doing>: ".
 template <typename Fn>
-int guarded(std::string* error, Fn&& fn) {
+int guarded(std::string* error, const std::string& path, const char* doing, Fn&& fn) {
   try {
     fn();
     return 0;
@@ -18,10 +20,10 @@ int guarded(std::string* error, Fn&& fn) {
     *error = e.what();
     return int(e.code());
   } catch (const std::bad_alloc&) {
-    *error = "out of memory";
+    *error = path + ": cannot " + doing + ": out of memory";
     return int(ExitCode::memory);
   } catch (const std::exception& e) {
-    *error = e.what();
+    *error = path + ": cannot " + doing + ": " + e.what();
     return int(ExitCode::output);
   }
 }
@@ -29,11 +31,13 @@ int guarded(std::string* error, Fn&& fn) {
 const ImageIoModule kModule = {
     kImageIoModuleVersion,
     [](const std::string& path, const Image& image, const WriteOptions& options, std::string* error) {
-      return guarded(error, [&] { write_image(path, image, options); });
+      return guarded(error, path, "write", [&] { write_image(path, image, options); });
     },
-    [](const std::string& path, Image* image, std::string* error) { return guarded(error, [&] { *image = read_image(path); }); },
+    [](const std::string& path, Image* image, std::string* error) {
+      return guarded(error, path, "read image", [&] { *image = read_image(path); });
+    },
     [](const std::string& path, std::map<std::string, std::string>* metadata, std::string* error) {
-      return guarded(error, [&] { *metadata = read_image_metadata(path); });
+      return guarded(error, path, "read image", [&] { *metadata = read_image_metadata(path); });
     },
 };
 

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <new>
 #include <optional>
 #include <string>
 #include <thread>
@@ -167,9 +168,12 @@ struct TraceInputs {
   RaySetup rays;
 };
 
+// `stage` says what runs, for an out-of-memory message (bake_normal_map).
 void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt, int threads, TraceInputs& in,
-                   BakeResult& result) {
+                   BakeResult& result, std::string& stage) {
   BakeStats& st = result.stats;
+  stage = "preparing " + std::to_string(low.triangle_count()) + " low-poly and " + std::to_string(high.triangle_count()) +
+          " high-poly triangles";
   st.low_triangles = low.triangle_count();
   st.high_triangles = high.triangle_count();
   auto t0 = Clock::now();
@@ -186,11 +190,13 @@ void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const Ba
     kept = select_reachable(
         s, high, mode.probing ? mode.reach * 1.01 + 1e-6 * s.diagonal : ray_margin(s, mode.any_cage, opt.front, opt.rear));
   st.high_duplicates_skipped = drop_duplicate_floods(s, high, threads, kept);
+  stage = "building the BVH of " + std::to_string(kept.empty() ? high.triangle_count() : kept.size()) + " high-poly triangles";
   HighScene& scene = in.scene;
   build_high_scene(scene, s, high, kept, bvh_quality_for(opt, kept.empty() ? high.triangle_count() : kept.size()), opt.threads);
   st.seconds_bvh = seconds_since(t0);
 
   t0 = Clock::now();
+  stage = "measuring the ray distances";
   measure_reach(mode, low, opt, threads, s, scene, result);
   st.seconds_distances = seconds_since(t0);
 
@@ -200,6 +206,7 @@ void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const Ba
     t0 = Clock::now();
     double reach_out = 0.0;
     for (float d : result.vertex_search) reach_out = std::max(reach_out, double(d));
+    stage = "building the BVH of the reachable high-poly triangles";
     if (narrow_reachable(s, high, ray_margin(s, mode.any_cage, st.front, std::max<double>(st.rear, reach_out)), kept))
       build_high_scene(scene, s, high, kept, bvh_quality_for(opt, kept.size()), opt.threads);
     st.seconds_bvh += seconds_since(t0);
@@ -248,25 +255,34 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   }
   check_bake_inputs(low, high, cage, opt);
   const int threads = worker_threads(opt.threads);
-  BakeResult result;
-  BakeStats& st = result.stats;
-  std::vector<std::uint8_t> disagree;  // per texel: its samples disagree (suspect), with several samples
-  OutputAllocation outputs(opt, result, disagree);
-  TraceInputs in;
-  prepare_trace(low, high, cage, opt, threads, in, result);
+  const std::string texels = std::to_string(opt.width) + "x" + std::to_string(opt.height) + " texels, " +
+                             std::to_string(opt.samples) + (opt.samples == 1 ? " sample" : " samples");
+  std::string stage = "allocating the map (" + texels + ")";
+  try {
+    BakeResult result;
+    BakeStats& st = result.stats;
+    std::vector<std::uint8_t> disagree;  // per texel: its samples disagree (suspect), with several samples
+    OutputAllocation outputs(opt, result, disagree);
+    TraceInputs in;
+    prepare_trace(low, high, cage, opt, threads, in, result, stage);
 
-  auto t0 = Clock::now();
-  const double cpu0 = process_cpu_seconds();
-  const TileBins bins = bin_triangles(low, opt.width, opt.height, tile_side(opt));
-  outputs.wait();
-  trace_and_shade(in.s, in.scene, bins, in.rays, opt, threads, {result.map, result.coverage, result.miss_mask, disagree}, st);
-  st.seconds_trace = seconds_since(t0);
-  st.cpu_seconds_trace = process_cpu_seconds() - cpu0;
+    stage = "tracing (" + texels + ")";
+    auto t0 = Clock::now();
+    const double cpu0 = process_cpu_seconds();
+    const TileBins bins = bin_triangles(low, opt.width, opt.height, tile_side(opt));
+    outputs.wait();
+    trace_and_shade(in.s, in.scene, bins, in.rays, opt, threads, {result.map, result.coverage, result.miss_mask, disagree}, st);
+    st.seconds_trace = seconds_since(t0);
+    st.cpu_seconds_trace = process_cpu_seconds() - cpu0;
 
-  t0 = Clock::now();
-  pad_map(opt, disagree, threads, result);
-  st.seconds_padding = seconds_since(t0);
-  return result;
+    stage = "padding (" + texels + ")";
+    t0 = Clock::now();
+    pad_map(opt, disagree, threads, result);
+    st.seconds_padding = seconds_since(t0);
+    return result;
+  } catch (const std::bad_alloc&) {
+    throw ResourceError("out of memory while " + stage);
+  }
 }
 
 BakeRays bake_rays(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt) {
@@ -277,7 +293,8 @@ BakeRays bake_rays(const Mesh& low, const Mesh& high, const Mesh* cage, const Ba
   check_bake_inputs(low, high, cage, opt);
   BakeResult result;
   TraceInputs in;
-  prepare_trace(low, high, cage, opt, worker_threads(opt.threads), in, result);
+  std::string stage;
+  prepare_trace(low, high, cage, opt, worker_threads(opt.threads), in, result, stage);
   const TileBins bins = bin_triangles(low, opt.width, opt.height, tile_side(opt));
   return {trace_rays(in.s, in.scene, bins, in.rays, opt), result.stats};
 }

@@ -1,5 +1,5 @@
 // A fault-injection shim for the output tests, loaded with LD_PRELOAD: the Nth call of one kind of
-// file operation fails with a chosen errno.
+// file operation or allocation fails with a chosen errno.
 //
 //   NMBAKE_FAULT=KIND:N:ERRNO     the Nth call of KIND fails (counted from 1), the others run
 //   NMBAKE_FAULT=KIND:N+:ERRNO    the Nth call and every later one fail (a disk that stays full)
@@ -11,7 +11,16 @@
 //   fsync   fsync, fdatasync
 //   rename  rename, renameat, renameat2
 //   create  open, open64, openat, openat64 with O_CREAT, creat, fopen/fopen64 for writing
-// ERRNO is ENOSPC, EIO, EDQUOT, EROFS or EACCES. Reads, and writes to terminals and pipes
+//   alloc   malloc, calloc, realloc, posix_memalign, aligned_alloc, memalign, valloc, pvalloc and
+//           anonymous mmap/mmap64 (Embree's and TBB's own pools) of at least NMBAKE_FAULT_MIN_BYTES
+//           (default 65536): the buffers a bake sizes by its input, where memory really runs out
+//           (operator new and std containers allocate through malloc). Smaller ones are not
+//           counted: failing one inside a library's static constructor or the dynamic loader tests
+//           those libraries, not nmbake. Nor is any allocation made inside dlopen (the image
+//           module's ~260 libraries' constructors): an exception from one (libcharls throws
+//           std::bad_alloc) cannot cross the loader and ends in std::terminate, whatever the
+//           program does; nmbake checks the address space left before it loads them instead.
+// ERRNO is ENOSPC, EIO, EDQUOT, EROFS, EACCES or ENOMEM. Reads, and writes to terminals and pipes
 // (stdout, stderr), are never counted: the tests need the command's messages.
 // glibc's stdio writes through internal calls that no shim sees, so fwrite and fclose are covered
 // here themselves.
@@ -20,10 +29,12 @@
 #endif
 #include <dlfcn.h>
 #include <fcntl.h>
+#include <malloc.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 #include <sys/types.h>
 #include <sys/uio.h>
@@ -34,14 +45,15 @@
 
 namespace {
 
-enum Kind { kWrite, kClose, kFsync, kRename, kCreate, kKinds };
-const char* const kNames[kKinds] = {"write", "close", "fsync", "rename", "create"};
+enum Kind { kWrite, kClose, kFsync, kRename, kCreate, kAlloc, kKinds };
+const char* const kNames[kKinds] = {"write", "close", "fsync", "rename", "create", "alloc"};
 
 std::atomic<long> g_calls[kKinds];
 int g_kind = -1;        // the kind that fails, -1 for none
 long g_nth = 0;         // its call that fails
 bool g_onward = false;  // and every later one
 int g_errno = 0;
+size_t g_min_bytes = 65536;  // allocations counted: this size and larger
 
 template <typename F>
 F real(const char* name) {
@@ -54,10 +66,12 @@ int parse_errno(const char* s) {
   if (!strcmp(s, "EDQUOT")) return EDQUOT;
   if (!strcmp(s, "EROFS")) return EROFS;
   if (!strcmp(s, "EACCES")) return EACCES;
+  if (!strcmp(s, "ENOMEM")) return ENOMEM;
   return 0;
 }
 
 __attribute__((constructor)) void configure() {
+  if (const char* min = getenv("NMBAKE_FAULT_MIN_BYTES"); min && *min) g_min_bytes = size_t(atoll(min));
   const char* spec = getenv("NMBAKE_FAULT");
   if (!spec || !*spec) return;
   char kind[16] = {0}, nth[24] = {0}, err[16] = {0};
@@ -99,6 +113,11 @@ bool fault(Kind kind) {
   errno = g_errno;
   return true;
 }
+
+thread_local int t_in_dlopen = 0;  // this thread is inside dlopen: its allocations are not counted
+
+// An allocation of `bytes` is counted, and fails, only from g_min_bytes on, outside dlopen.
+bool alloc_fault(size_t bytes) { return bytes >= g_min_bytes && !t_in_dlopen && fault(kAlloc); }
 
 bool writing_mode(const char* mode) { return mode && (strchr(mode, 'w') || strchr(mode, 'a') || strchr(mode, '+')); }
 
@@ -227,6 +246,70 @@ FILE* fopen64(const char* path, const char* mode) {
   static auto f = real<FILE* (*)(const char*, const char*)>("fopen64");
   if (writing_mode(mode) && fault(kCreate)) return nullptr;
   return f(path, mode);
+}
+
+void* dlopen(const char* file, int mode) {
+  static auto f = real<void* (*)(const char*, int)>("dlopen");
+  ++t_in_dlopen;
+  void* handle = f(file, mode);
+  --t_in_dlopen;
+  return handle;
+}
+
+// The allocator: glibc's own entry points (__libc_*), not dlsym, which itself allocates.
+void* __libc_malloc(size_t);
+void* __libc_calloc(size_t, size_t);
+void* __libc_realloc(void*, size_t);
+void* __libc_memalign(size_t, size_t);
+
+void* malloc(size_t n) {
+  if (alloc_fault(n)) return nullptr;
+  return __libc_malloc(n);
+}
+
+void* calloc(size_t count, size_t n) {
+  if (n && count <= SIZE_MAX / n && alloc_fault(count * n)) return nullptr;
+  return __libc_calloc(count, n);
+}
+
+void* realloc(void* p, size_t n) {
+  if (alloc_fault(n)) return nullptr;  // p stays valid, as with a real failing realloc
+  return __libc_realloc(p, n);
+}
+
+void* memalign(size_t alignment, size_t n) {
+  if (alloc_fault(n)) return nullptr;
+  return __libc_memalign(alignment, n);
+}
+
+void* aligned_alloc(size_t alignment, size_t n) { return memalign(alignment, n); }
+
+void* valloc(size_t n) { return memalign(size_t(sysconf(_SC_PAGESIZE)), n); }
+
+void* pvalloc(size_t n) {
+  const size_t page = size_t(sysconf(_SC_PAGESIZE));
+  return memalign(page, (n + page - 1) / page * page);
+}
+
+int posix_memalign(void** out, size_t alignment, size_t n) {
+  if (alignment % sizeof(void*) != 0 || (alignment & (alignment - 1)) != 0) return EINVAL;
+  if (alloc_fault(n)) return ENOMEM;
+  void* p = __libc_memalign(alignment, n);
+  if (!p) return ENOMEM;
+  *out = p;
+  return 0;
+}
+
+void* mmap(void* addr, size_t n, int prot, int flags, int fd, off_t offset) {
+  static auto f = real<void* (*)(void*, size_t, int, int, int, off_t)>("mmap");
+  if ((flags & MAP_ANONYMOUS) && alloc_fault(n)) return MAP_FAILED;
+  return f(addr, n, prot, flags, fd, offset);
+}
+
+void* mmap64(void* addr, size_t n, int prot, int flags, int fd, off64_t offset) {
+  static auto f = real<void* (*)(void*, size_t, int, int, int, off64_t)>("mmap64");
+  if ((flags & MAP_ANONYMOUS) && alloc_fault(n)) return MAP_FAILED;
+  return f(addr, n, prot, flags, fd, offset);
 }
 
 }  // extern "C"
