@@ -164,18 +164,23 @@ TEST(Outputs, FailedRenameRollsBack) {
 }
 
 // Temporaries of a process that no longer exists are removed when the same output is written;
-// a live process's, and other outputs', are not.
+// a live process's, and other outputs', are not. An old copy that is a second name of the output
+// goes too; one that differs from it is the only copy of an old output and stays.
 TEST(Outputs, StaleTemporariesRemoved) {
   const std::string d = test::scratch_dir();
   const std::string dead = std::to_string(dead_pid()), alive = std::to_string(::getppid());
-  for (const std::string& name : {".m.png.nmbake-tmp." + dead, ".m.png.nmbake-old." + dead, ".m.png.nmbake-tmp." + dead + ".3",
-                                  ".m.png.nmbake-tmp." + alive, ".n.png.nmbake-tmp." + dead, ".m.png.nmbake-tmp.x" + dead})
+  const std::string dead2 = std::to_string(dead_pid());
+  put(d + "/m.png", "current");
+  ASSERT_EQ(::link((d + "/m.png").c_str(), (d + "/.m.png.nmbake-old." + dead).c_str()), 0);
+  put(d + "/.m.png.nmbake-old." + dead2, "the only old copy");
+  for (const std::string& name : {".m.png.nmbake-tmp." + dead, ".m.png.nmbake-tmp." + dead + ".3", ".m.png.nmbake-tmp." + alive,
+                                  ".n.png.nmbake-tmp." + dead, ".m.png.nmbake-tmp.x" + dead})
     put(d + "/" + name, "stale");
   OutputSet set;
   const std::string temp = set.add(d + "/m.png");
   EXPECT_EQ(temp, d + "/.m.png.nmbake-tmp." + std::to_string(::getpid()));
   std::vector<std::string> kept{".m.png.nmbake-tmp." + alive, ".m.png.nmbake-tmp." + dead + ".3", ".m.png.nmbake-tmp.x" + dead,
-                                ".n.png.nmbake-tmp." + dead};
+                                ".n.png.nmbake-tmp." + dead,  ".m.png.nmbake-old." + dead2,       "m.png"};
   std::sort(kept.begin(), kept.end());
   EXPECT_EQ(listing(d), kept);
 }

@@ -123,8 +123,10 @@ void check_place(const NamedFile& out) {
                       " that leave room for its temporary file (the folder allows " + std::to_string(name_max) + ")");
 }
 
-// Removes ".<name>.nmbake-tmp.<pid>" and ".<name>.nmbake-old.<pid>" beside `target` whose
-// process no longer exists.
+// Removes ".<name>.nmbake-tmp.<pid>" beside `target` whose process no longer exists, and its
+// ".<name>.nmbake-old.<pid>" where that is only a second name of `target` (a run killed during
+// commit). An old copy that differs from `target` is kept: it is the only copy of an old output,
+// left by a commit whose renames failed and could not be undone, and that run's error named it.
 void remove_stale(const std::string& target) {
   const std::string dir = folder_of(target);
   const std::string name = "." + fs::path(target).filename().string();
@@ -140,7 +142,15 @@ void remove_stale(const std::string& target) {
     const long pid = std::stol(number);
     if (pid == long(::getpid()) || pid <= 0) continue;
     if (::kill(pid_t(pid), 0) == 0 || errno != ESRCH) continue;  // alive (or not ours to ask)
-    ::unlink((dir + "/" + entry).c_str());
+    const std::string path = dir + "/" + entry;
+    if (rest.compare(0, std::strlen(kOldTag), kOldTag) == 0) {
+      struct stat old {
+      }, now{};
+      if (::stat(path.c_str(), &old) != 0 || ::stat(target.c_str(), &now) != 0 || old.st_dev != now.st_dev ||
+          old.st_ino != now.st_ino)
+        continue;
+    }
+    ::unlink(path.c_str());
   }
   ::closedir(d);
 }

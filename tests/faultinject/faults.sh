@@ -87,6 +87,21 @@ for n in 1 2 $write_count; do run "write:$n+:ENOSPC"; done
 # Memory that stays short from the Nth large allocation on.
 alloc_count=$(awk '$1 == "alloc" {print $2}' "$log/counts.txt")
 for n in 1 $((alloc_count / 2)) $((alloc_count - 5)); do run "alloc:$n+:ENOMEM"; done
+# Renames that keep failing, so that the first output's rename cannot be undone: exit 3, and the
+# error names the hidden copy that holds the old output, byte-identical; the next run keeps it.
+NMBAKE_FAULT=rename:2+:EIO LD_PRELOAD=$shim bake --size 64 >"$log/stdout.txt" 2>"$log/stderr.txt"
+code=$? err=$(cat "$log/stderr.txt")
+echo "rename:2+:EIO        exit $code $err"
+kept=$(echo "$err" | sed -n 's/.*; the old m\.png is kept as \(\.m\.png\.nmbake-old\.[0-9]*\)$/\1/p')
+if [ "$code" != 3 ] || [ -z "$kept" ] || [ ! -f "$kept" ]; then
+  bad "rename:2+:EIO: exit $code, expected 3 and the old map's copy named: $err"
+else
+  cmp -s "$kept" "$work/old/m.png" || bad "rename:2+:EIO: $kept is not the old map"
+  bake --size 32 >/dev/null 2>&1 || bad "the bake after rename:2+:EIO failed"
+  [ -f "$kept" ] || bad "the next run removed $kept, the only copy of the old map"
+  rm -f "$kept"
+fi
+rm -f $outputs && cp "$work/old/"* .
 [ "$failures" -gt 0 ] || bad "no run failed: the shim had no effect"
 echo "fault injection: $runs runs, $failures failed as they should, $([ $fail = 0 ] && echo 'all checks passed' || echo 'some checks FAILED')"
 exit $fail
