@@ -11,6 +11,7 @@
 #include <cstring>
 #include <ctime>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <map>
 #include <memory>
@@ -289,13 +290,34 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
   const std::string temp = options.temp_path.empty() ? temp_path_for(target) : options.temp_path;
   const int fd = ::open(temp.c_str(), O_RDWR | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0666);
   if (fd < 0) fail_write(path, std::strerror(errno));
-  FileProxy proxy(temp, fd);
+  // The proxy's buffer is allocated here, not while libpng's C code calls it.
+  std::optional<FileProxy> made;
+  try {
+    made.emplace(temp, fd);
+  } catch (...) {
+    ::close(fd);
+    ::unlink(temp.c_str());
+    throw;
+  }
+  FileProxy& proxy = *made;
+  // Whatever ends the write early (an error, std::bad_alloc from the encoder) closes the encoder
+  // before the proxy it writes to, and removes the temporary.
+  bool open = true, kept = false;
+  auto abandon = [&] {
+    out.reset();
+    if (open) ::close(fd);
+    open = false;
+    if (!kept) ::unlink(temp.c_str());
+    kept = true;
+  };
+  struct OnExit {
+    const std::function<void()> run;
+    ~OnExit() { run(); }
+  } on_exit{abandon};
   // The first failure's reason: the system's for a failed write, else OpenImageIO's.
   auto discard = [&](const std::string& message, int err) {
     if (!err) err = proxy.failure();
-    out.reset();  // before the proxy it writes to
-    ::close(fd);
-    ::unlink(temp.c_str());
+    abandon();
     fail_write(path, err ? std::string(std::strerror(err)) : first_message(message));
   };
   out->set_ioproxy(&proxy);
@@ -314,18 +336,19 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
   quiet.reset();
   // A full disk or a failing device may only show here (delayed allocation, NFS).
   if (::fsync(fd) != 0) discard("", errno);
-  if (::close(fd) != 0) {
-    const int err = errno;
-    ::unlink(temp.c_str());
-    fail_write(path, std::strerror(err));
+  open = false;
+  if (::close(fd) != 0) discard("", errno);
+  if (!options.temp_path.empty()) {
+    kept = true;  // the caller renames it
+    return;
   }
-  if (!options.temp_path.empty()) return;  // the caller renames it
   if (std::rename(temp.c_str(), path.c_str()) != 0) {
     std::string reason = std::strerror(errno);
     if (fs::is_directory(target, ec)) reason = "a folder of that name exists";
-    ::unlink(temp.c_str());
+    abandon();
     fail_write(path, reason);
   }
+  kept = true;
 }
 
 // read_image and read_image_metadata: image_read.cpp.
