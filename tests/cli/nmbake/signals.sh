@@ -6,7 +6,8 @@
 # 2. SIGTERM and SIGINT once the map's temporary file exists (the writes have begun): the same
 #    (exit 143 / 130).
 # 3. SIGKILL during the writes leaves only temporaries named ".<name>.nmbake-tmp.<pid>"; the next
-#    run over the same outputs removes them, and a live process's temporary is left alone.
+#    run over the same outputs removes them, and a live process's temporary is left alone, as is an
+#    old copy that differs from its output (the only copy of it).
 set -u
 nmbake=$(realpath "$1") repo=$(realpath "$2") work=$3
 low=$repo/data/sample/torus_low.obj high=$repo/data/sample/torus_high.ply
@@ -68,10 +69,14 @@ others=$(ls -A | grep -v -e '^m\.png$' -e '^miss\.png$' -e '^r\.json$' -e "^\.[a
 [ -z "$others" ] || bad "SIGKILL: unrecognisable files left: $others"
 sleep 1000 &
 alive=$!
-touch ".m.png.nmbake-tmp.$alive" ".r.json.nmbake-old.99999999" ".other.png.nmbake-tmp.4"
+# A dead run's second name of r.json goes; its copy of an old miss.png that differs from miss.png is
+# the only copy of an old output (a commit that could not be undone) and stays.
+touch ".m.png.nmbake-tmp.$alive" ".other.png.nmbake-tmp.4"
+ln r.json ".r.json.nmbake-old.99999999"
+echo "an old mask" >".miss.png.nmbake-old.99999998"
 "$nmbake" "$low" "$high" -o m.png --size 32 --miss-mask miss.png --report r.json --quiet || bad "the bake after SIGKILL failed"
 left=$(ls -A | grep nmbake- | sort | tr '\n' ' ')
-[ "$left" = ".m.png.nmbake-tmp.$alive .other.png.nmbake-tmp.4 " ] || bad "after SIGKILL, the next run left: $left"
+[ "$left" = ".m.png.nmbake-tmp.$alive .miss.png.nmbake-old.99999998 .other.png.nmbake-tmp.4 " ] || bad "after SIGKILL, the next run left: $left"
 kill "$alive"
 echo "ok   SIGKILL left only .NAME.nmbake-tmp.$pid files; the next run removed them (kept: $left)"
 exit $fail
