@@ -29,6 +29,7 @@
 #include "io/mesh_io.h"
 #include "io/text_file.h"
 #include "cli/outputs.h"
+#include "cli/progress.h"
 #include "cli/report.h"
 #include "core/parallel.h"
 #include "cli/warnings.h"
@@ -87,7 +88,7 @@ struct Args {
   int padding = 16;
   int threads = 0;
   int quiet = 0;  // times --quiet was given
-  bool no_warnings = false, strict = false;
+  bool no_warnings = false, strict = false, progress = false;
   bool no_cull = false;
   bool keep_backfaces = false;
   bool estimate_error = false;
@@ -115,28 +116,6 @@ std::string human(double v) {
   else std::snprintf(buf, sizeof buf, "%.0f", v);
   return buf;
 }
-
-class ProgressBar {
- public:
-  explicit ProgressBar(bool enabled) : enabled_(enabled) {}
-  bool update(double f) {
-    if (interrupted()) return false;
-    if (!enabled_) return true;
-    const int pct = int(f * 100.0);
-    if (pct == last_) return true;
-    last_ = pct;
-    const int width = 40, filled = int(f * width);
-    std::fprintf(stderr, "\rbaking [%s%s] %3d%%", std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(),
-                 pct);
-    if (pct >= 100) std::fprintf(stderr, "\r%*s\r", width + 16, "");
-    std::fflush(stderr);
-    return true;
-  }
-
- private:
-  bool enabled_;
-  int last_ = -1;
-};
 
 // The command line's options, with its help text.
 void add_options(CLI::App& app, Args& a) {
@@ -183,8 +162,11 @@ void add_options(CLI::App& app, Args& a) {
   app.add_flag("--keep-backfaces", a.keep_backfaces,
                "Take the first hit whatever it faces (default: hits on back faces, the insides of other parts, are passed "
                "over and counted as backface_skips in the report)");
+  app.add_flag("--progress", a.progress,
+               "Show the progress line (each stage, the time since the start, the time left once tracing has run a "
+               "second) even when stderr is not a terminal (default: on a terminal only; never with --quiet)");
   app.add_flag("--quiet", a.quiet,
-               "No progress bar, no summary line, no distances line; warnings still print, one line each (twice: "
+               "No progress line, no summary line, no distances line; warnings still print, one line each (twice: "
                "--quiet --quiet, no warnings either)");
   app.add_flag("--no-warnings", a.no_warnings, "Do not print warnings (they are still in --report's \"warnings\")");
   app.add_flag("--strict", a.strict,
@@ -265,7 +247,7 @@ void print_distances(const BakeStats& s) {
 }
 
 ErrorEstimate estimate_error(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& o, const BakeResult& r,
-                             int bits) {
+                             int bits, Progress& progress) {
   ErrorEstimateOptions eo;
   eo.bits = bits;
   const ErrorEstimate estimate = estimate_bake_error(low, high, cage, o, r, eo);
@@ -274,10 +256,13 @@ ErrorEstimate estimate_error(const Mesh& low, const Mesh& high, const Mesh* cage
   if (bits != 32)
     std::snprintf(quant, sizeof quant, "%d-bit output adds quantisation of mean %.4f deg, max %.4f deg", bits,
                   estimate.quantization_mean_deg, estimate.quantization_max_deg);
-  std::fprintf(stderr,
-               "nmbake: error estimate: mean %.4f deg, p95 %.4f deg, max %.4f deg against %d samples on %zu texels "
-               "(%.2f s); %s\n",
-               estimate.mean_deg, estimate.p95_deg, estimate.max_deg, estimate.samples, estimate.texels, estimate.seconds, quant);
+  progress.above([&] {
+    std::fprintf(stderr,
+                 "nmbake: error estimate: mean %.4f deg, p95 %.4f deg, max %.4f deg against %d samples on %zu texels "
+                 "(%.2f s); %s\n",
+                 estimate.mean_deg, estimate.p95_deg, estimate.max_deg, estimate.samples, estimate.texels, estimate.seconds,
+                 quant);
+  });
   return estimate;
 }
 
@@ -385,12 +370,14 @@ int run(int argc, char** argv) {
   validate_options(o);  // the library's checks, before a long load
   const int bits = a.bits ? a.bits : default_bits_for(a.output);
   check_outputs(a, bits);
-  const bool tty = !a.quiet && ::isatty(STDERR_FILENO);
   WarningLog warnings(a.quiet < 2 && !a.no_warnings, a.strict);
+  // One line for the whole command, on a terminal or with --progress; never with --quiet.
+  Progress progress(!a.quiet && (a.progress || ::isatty(STDERR_FILENO)), start, interrupted);
 
   // Load.
   RunInfo run = run_info(a, argc, argv, bits);
   g_doing = "loading the meshes";
+  progress.stage("loading");
   auto t0 = Clock::now();
   LoadOptions low_opts;
   low_opts.require_uvs = true;
@@ -403,34 +390,42 @@ int run(int argc, char** argv) {
   if (!a.cage.empty()) cage = load_mesh(a.cage, shared, &run.cage_info);
   const Mesh* cage_mesh = a.cage.empty() ? nullptr : &cage;
   run.seconds_load = std::chrono::duration<double>(Clock::now() - t0).count();
-  warnings.add(load_warnings(run.low_info, a.low));
-  warnings.add(load_warnings(run.high_info, a.high));
-  if (cage_mesh) warnings.add(load_warnings(run.cage_info, a.cage));
+  progress.above([&] {
+    warnings.add(load_warnings(run.low_info, a.low));
+    warnings.add(load_warnings(run.high_info, a.high));
+    if (cage_mesh) warnings.add(load_warnings(run.cage_info, a.cage));
+  });
   warnings.check_strict();  // before a long bake
   if (interrupted()) throw Cancelled();
 
-  ProgressBar bar(tty);
-  o.progress = [&](double f) { return bar.update(f); };
+  o.progress = [&](double f) { return progress.fraction(f); };
+  o.on_stage = [&](const char* stage) { progress.stage(stage); };
   g_doing = "baking";
   const BakeResult r = bake_normal_map(low, high, cage_mesh, o);
   const BakeStats& s = r.stats;
   // Topology checks are only reported: they run beside the image write, which uses one core
   // (about 0.3-0.6 s CPU per 400k triangles; beside the bake they took time from its threads).
   auto topology = std::async(std::launch::async, [&high] { return inspect_topology(high); });
-  if (!a.quiet) print_distances(s);
+  if (!a.quiet) progress.above([&] { print_distances(s); });
+  o.on_stage = nullptr;  // the estimate's re-bake is one stage
   if (interrupted()) throw Cancelled();
   ErrorEstimate estimate;
   g_doing = "estimating the error";
-  if (a.estimate_error) estimate = estimate_error(low, high, cage_mesh, o, r, bits);
+  if (a.estimate_error) {
+    progress.stage("estimating the error");
+    estimate = estimate_error(low, high, cage_mesh, o, r, bits, progress);
+  }
 
   // Every output to its temporary file, then all renamed into place together.
   OutputSet outputs;
   g_doing = "writing the outputs";
+  progress.stage("writing", false);  // not redrawn while the encoders' stderr is redirected
   t0 = Clock::now();
   write_outputs(outputs, a, o, r, low, bits);
   run.seconds_write = std::chrono::duration<double>(Clock::now() - t0).count();
   g_doing = "checking the high-poly's topology";
   run.high_topology = topology.get();
+  progress.finish();
   warnings.add(bake_warnings(s, run.high_topology, a.low, a.high));
   warnings.check_strict();
   run.warnings = warnings.all();

@@ -168,10 +168,15 @@ struct TraceInputs {
   RaySetup rays;
 };
 
+void announce(const BakeOptions& opt, const char* stage) {
+  if (opt.on_stage) opt.on_stage(stage);
+}
+
 // `stage` says what runs, for an out-of-memory message (bake_normal_map).
 void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt, int threads, TraceInputs& in,
                    BakeResult& result, std::string& stage) {
   BakeStats& st = result.stats;
+  announce(opt, "preparing");
   stage = "preparing " + std::to_string(low.triangle_count()) + " low-poly and " + std::to_string(high.triangle_count()) +
           " high-poly triangles";
   st.low_triangles = low.triangle_count();
@@ -190,12 +195,14 @@ void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const Ba
     kept = select_reachable(
         s, high, mode.probing ? mode.reach * 1.01 + 1e-6 * s.diagonal : ray_margin(s, mode.any_cage, opt.front, opt.rear));
   st.high_duplicates_skipped = drop_duplicate_floods(s, high, threads, kept);
+  announce(opt, "building the BVH");
   stage = "building the BVH of " + std::to_string(kept.empty() ? high.triangle_count() : kept.size()) + " high-poly triangles";
   HighScene& scene = in.scene;
   build_high_scene(scene, s, high, kept, bvh_quality_for(opt, kept.empty() ? high.triangle_count() : kept.size()), opt.threads);
   st.seconds_bvh = seconds_since(t0);
 
   t0 = Clock::now();
+  announce(opt, "measuring distances");
   stage = "measuring the ray distances";
   measure_reach(mode, low, opt, threads, s, scene, result);
   st.seconds_distances = seconds_since(t0);
@@ -266,6 +273,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     TraceInputs in;
     prepare_trace(low, high, cage, opt, threads, in, result, stage);
 
+    announce(opt, "tracing");
     stage = "tracing (" + texels + ")";
     auto t0 = Clock::now();
     const double cpu0 = process_cpu_seconds();
@@ -275,6 +283,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     st.seconds_trace = seconds_since(t0);
     st.cpu_seconds_trace = process_cpu_seconds() - cpu0;
 
+    announce(opt, "padding");
     stage = "padding (" + texels + ")";
     t0 = Clock::now();
     pad_map(opt, disagree, threads, result);

@@ -77,6 +77,9 @@ struct BakeOptions {
   // Called from the calling thread with the fraction done in [0,1]; return false to cancel
   // (bake_normal_map then throws Cancelled).
   std::function<bool(double)> progress;
+  // Called from the calling thread as each stage begins: "preparing", "building the BVH",
+  // "measuring distances", "tracing", "padding" (a progress line names them).
+  std::function<void(const char*)> on_stage;
 };
 
 struct BakeStats {
