@@ -119,7 +119,8 @@ std::string human(double v) {
 
 // The command line's options, with its help text.
 void add_options(CLI::App& app, Args& a) {
-  app.footer(std::string("\nInputs: OBJ, PLY (ascii/binary), OFF, STL. The low-poly must have UVs.\n"
+  app.footer(std::string("\nInputs: OBJ, PLY (ascii/binary), OFF, STL; glTF (.gltf/.glb), FBX (to metres), DAE, 3DS and\n"
+                         "what else Assimp reads. The low-poly must have UVs.\n"
                          "Maps use the OpenGL convention (green = +bitangent, \"Y+\") unless --green down;\n"
                          "tangent frames follow MikkTSpace (Blender, glTF, Substance, Unity, Unreal).\n\n") +
              kExitCodes);

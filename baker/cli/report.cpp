@@ -75,7 +75,8 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
                 {"normals_dropped", info.normals_dropped},
                 {"faces_without_normals", info.faces_without_normals},
                 {"uvs_dropped", info.uvs_dropped},
-                {"faces_without_uvs", info.faces_without_uvs}};
+                {"faces_without_uvs", info.faces_without_uvs},
+                {"unit_scale", info.unit_scale}};
   };
   json report = {
       {"nmbake_version", NMBAKE_VERSION},

@@ -63,7 +63,7 @@ struct MeshLoadInfo {
   std::size_t polygons_triangulated = 0;  // faces with more than 3 corners, fanned into triangles
   std::size_t normals_renormalized = 0;   // file normals that were not unit length
   std::size_t zero_normals = 0;           // file normals of length ~0 (replaced by computed ones)
-  std::string format;                     // "obj", "ply-binary", "ply-ascii", "off", "stl"
+  std::string format;                     // "obj", "ply-binary", "ply-ascii", "off", "stl", "gltf", "fbx", "dae", ...
   // The file's normals (or UVs) were discarded because only some faces had them, or (normals) one
   // had length ~0; normal_index (uv_index) is then empty and normals get computed later.
   bool normals_dropped = false;
@@ -72,6 +72,9 @@ struct MeshLoadInfo {
   std::size_t faces_without_uvs = 0;         // counted when only some faces had UVs
   std::size_t degenerate_faces_dropped = 0;  // STL facets whose corners welded together (OpenMesh drops them)
   double largest_coordinate = 0.0;           // largest |x|, |y| or |z| a face uses, as in the file
+  // The scale applied to the file's coordinates: an FBX file's unit to metres (0.01 for
+  // centimetres); 1 for every other format (glTF is in metres, OBJ, PLY, OFF and STL say nothing).
+  double unit_scale = 1.0;
 };
 
 }  // namespace nmbake

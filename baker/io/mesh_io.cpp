@@ -1,6 +1,6 @@
 // load_mesh(): reads the file once into memory, hands it to the reader for its extension, then
 // applies the checks and repairs every format shares. The readers live in mesh_io_obj.cpp,
-// mesh_io_ply.cpp and mesh_io_openmesh.cpp (OFF, STL).
+// mesh_io_ply.cpp, mesh_io_openmesh.cpp (OFF, STL) and mesh_io_assimp.cpp (glTF, FBX, DAE, 3DS...).
 #include "io/mesh_io.h"
 
 #include <fcntl.h>
@@ -107,7 +107,11 @@ std::string_view skip_utf8_bom(std::string_view text) {
   return text;
 }
 
-ParsedMesh parse_by_extension(const std::string& path, const std::string& ext, std::string_view bytes) {
+// Formats with a reader of our own; any other extension Assimp reads goes to Assimp.
+bool own_format(const std::string& ext) { return ext == "obj" || ext == "ply" || ext == "off" || ext == "stl"; }
+
+ParsedMesh parse_by_extension(const std::string& path, const std::string& ext, std::string_view bytes, bool read_path) {
+  if (!own_format(ext)) return mesh_io_detail::parse_assimp(path, ext, bytes, read_path);
   if (ext == "obj") return mesh_io_detail::parse_obj(path, skip_utf8_bom(bytes));
   if (ext == "ply") return mesh_io_detail::parse_ply(path, bytes);
   if (ext == "off") return mesh_io_detail::parse_off(path, skip_utf8_bom(bytes));
@@ -218,6 +222,7 @@ Mesh finish_mesh(ParsedMesh parsed, const std::string& path, const LoadOptions& 
   info.file_faces = parsed.file_faces;
   info.polygons_triangulated = parsed.polygons_triangulated;
   info.degenerate_faces_dropped = parsed.degenerate_faces_dropped;
+  info.unit_scale = parsed.unit_scale;
   settle_uvs(parsed, path, options, info);
   settle_normals(parsed, info);
   place(parsed, path, options, info);
@@ -227,18 +232,21 @@ Mesh finish_mesh(ParsedMesh parsed, const std::string& path, const LoadOptions& 
 
 void check_extension(const std::string& path) {
   std::string ext = lower_extension(path);
-  if (ext != "obj" && ext != "ply" && ext != "off" && ext != "stl")
+  if (!own_format(ext) && !mesh_io_detail::assimp_reads(ext))
     fail(path, (ext.empty() ? std::string("has no file extension") : "unknown file type '." + ext + "'") +
-                   "; supported: .obj .ply .off .stl");
+                   "; supported: .obj .ply .off .stl, and through Assimp .gltf .glb .fbx .dae .3ds and others");
 }
 
-Mesh parse_bytes(const std::string& path, std::string_view bytes, const LoadOptions& options, MeshLoadInfo& info) {
+// `read_path`: an Assimp format is read by its path (a .gltf finds its .bin beside it).
+Mesh parse_bytes(const std::string& path, std::string_view bytes, const LoadOptions& options, MeshLoadInfo& info,
+                 bool read_path) {
   const std::string ext = lower_extension(path);
   if (bytes.empty() || is_whitespace_only(bytes)) fail(path, "file is empty");
-  // Binary STL is the only binary format whose first bytes are arbitrary.
-  if (!(ext == "stl" && mesh_io_detail::is_binary_stl(bytes)) && looks_like_utf16(bytes))
+  // Binary STL is the only binary format of our own readers whose first bytes are arbitrary;
+  // Assimp's formats are binary or read UTF-16 themselves (COLLADA).
+  if (own_format(ext) && !(ext == "stl" && mesh_io_detail::is_binary_stl(bytes)) && looks_like_utf16(bytes))
     fail(path, "looks like UTF-16 text; save it as UTF-8");
-  return finish_mesh(parse_by_extension(path, ext, bytes), path, options, info);
+  return finish_mesh(parse_by_extension(path, ext, bytes, read_path), path, options, info);
 }
 
 }  // namespace
@@ -249,7 +257,7 @@ Mesh load_mesh_from_memory(const std::string& name, std::string_view bytes, cons
   out_info = MeshLoadInfo{};
   try {
     check_extension(name);
-    return parse_bytes(name, bytes, options, out_info);
+    return parse_bytes(name, bytes, options, out_info, false);
   } catch (const std::bad_alloc&) {
     throw ResourceError(name + ": out of memory while loading");
   } catch (const std::length_error&) {
@@ -264,7 +272,7 @@ Mesh load_mesh(const std::string& path, const LoadOptions& options, MeshLoadInfo
   try {
     check_regular_file(path);
     check_extension(path);
-    return parse_bytes(path, read_file(path), options, out_info);
+    return parse_bytes(path, read_file(path), options, out_info, true);
   } catch (const std::bad_alloc&) {
     throw ResourceError(path + ": out of memory while loading");
   } catch (const std::length_error&) {

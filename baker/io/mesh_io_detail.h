@@ -40,6 +40,7 @@ struct ParsedMesh {
   std::size_t faces_with_normals = 0;
   std::string first_face_without_uvs;  // "line 40: face 3" or "face 0", for the require_uvs message
   std::size_t degenerate_faces_dropped = 0;
+  double unit_scale = 1.0;  // see MeshLoadInfo::unit_scale
 };
 
 // Throws InputError("<path>: <problem>").
@@ -49,6 +50,11 @@ ParsedMesh parse_obj(const std::string& path, std::string_view text);
 ParsedMesh parse_ply(const std::string& path, std::string_view bytes);
 ParsedMesh parse_off(const std::string& path, std::string_view text);
 ParsedMesh parse_stl(const std::string& path, std::string_view bytes);
+// Through Assimp (mesh_io_assimp.cpp): by `path` when `read_path` (a .gltf finds its .bin), else
+// from `bytes`, with `ext` (lower case, no dot) naming the format.
+ParsedMesh parse_assimp(const std::string& path, const std::string& ext, std::string_view bytes, bool read_path);
+// Whether Assimp reads files with this extension (lower case, no dot).
+bool assimp_reads(const std::string& ext);
 
 // True when the size matches a binary STL's facet count (84 + 50 bytes per facet).
 bool is_binary_stl(std::string_view bytes);

@@ -1,0 +1,173 @@
+// The asset formats artists export (glTF 2.0, FBX, DAE, 3DS and whatever else Assimp reads),
+// through Assimp. The only code that includes Assimp.
+//
+// Every mesh of every node is placed by the node's transform (its own times its parents'), in
+// double; a mirroring transform (negative determinant) has its triangles' corners reversed so that
+// they stay counter-clockwise from the front. FBX files are brought to metres by their
+// UnitScaleFactor (centimetres: 0.01), as glTF is by definition and Assimp's COLLADA reader does
+// from the file's <unit>; MeshLoadInfo::unit_scale says what was applied. Positions equal after
+// placing are welded (Assimp splits a vertex at every seam and hard edge), normals and UVs stay
+// per corner, so hard edges and seams are kept as in an OBJ file. Points and lines are left out.
+#include <assimp/Importer.hpp>
+#include <assimp/config.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "io/mesh_io_detail.h"
+
+namespace nmbake::mesh_io_detail {
+namespace {
+
+struct PositionHash {
+  std::size_t operator()(const glm::dvec3& p) const {
+    std::uint64_t h = 1469598103934665603ull;
+    for (int k = 0; k < 3; ++k) {
+      std::uint64_t bits = 0;
+      const double v = p[k] == 0.0 ? 0.0 : p[k];  // -0 and +0 weld
+      std::memcpy(&bits, &v, sizeof bits);
+      h = (h ^ bits) * 1099511628211ull;
+    }
+    return std::size_t(h ^ (h >> 29));
+  }
+};
+
+glm::dmat4 to_glm(const aiMatrix4x4& m) {
+  // aiMatrix4x4 is row-major (a1..a4 the first row), glm column-major.
+  return glm::dmat4(m.a1, m.b1, m.c1, m.d1, m.a2, m.b2, m.c2, m.d2, m.a3, m.b3, m.c3, m.d3, m.a4, m.b4, m.c4, m.d4);
+}
+
+// The scale that brings the scene to metres, where the file says its unit.
+double unit_scale_to_metres(const aiScene& scene, const std::string& ext) {
+  if (ext != "fbx" || !scene.mMetaData) return 1.0;
+  double centimetres_per_unit = 0.0;
+  float f = 0.0f;
+  if (scene.mMetaData->Get("UnitScaleFactor", centimetres_per_unit) && centimetres_per_unit > 0.0)
+    return centimetres_per_unit / 100.0;
+  if (scene.mMetaData->Get("UnitScaleFactor", f) && f > 0.0f) return double(f) / 100.0;
+  return 1.0;
+}
+
+class SceneReader {
+ public:
+  SceneReader(const std::string& path, const aiScene& scene, double scale) : path_(path), scene_(scene), scale_(scale) {
+    out_.unit_scale = scale;
+    // Which attributes every mesh with faces has decides whether corners get UV or normal slots.
+    bool any = false;
+    for (unsigned i = 0; i < scene.mNumMeshes; ++i) {
+      const aiMesh& m = *scene.mMeshes[i];
+      if (!(m.mPrimitiveTypes & (aiPrimitiveType_TRIANGLE | aiPrimitiveType_POLYGON))) continue;
+      any = true;
+      out_.corner_uvs = out_.corner_uvs && m.HasTextureCoords(0);
+      out_.corner_normals = out_.corner_normals && m.HasNormals();
+    }
+    if (!any) out_.corner_uvs = out_.corner_normals = false;
+  }
+
+  ParsedMesh read() {
+    visit(*scene_.mRootNode, glm::dmat4(scale_), 0);
+    out_.mesh.positions.reserve(out_.exact_positions.size());
+    for (const glm::dvec3& p : out_.exact_positions) out_.mesh.positions.emplace_back(p);
+    return std::move(out_);
+  }
+
+ private:
+  void visit(const aiNode& node, const glm::dmat4& parent, int depth) {
+    if (depth > 1000) fail(path_, "node '" + std::string(node.mName.C_Str()) + "' is nested more than 1000 deep");
+    const glm::dmat4 world = parent * to_glm(node.mTransformation);
+    for (unsigned i = 0; i < node.mNumMeshes; ++i) {
+      if (node.mMeshes[i] >= scene_.mNumMeshes) fail(path_, "node '" + std::string(node.mName.C_Str()) + "' names no mesh");
+      add_mesh(*scene_.mMeshes[node.mMeshes[i]], world);
+    }
+    for (unsigned i = 0; i < node.mNumChildren; ++i) visit(*node.mChildren[i], world, depth + 1);
+  }
+
+  void add_mesh(const aiMesh& m, const glm::dmat4& world) {
+    if (!(m.mPrimitiveTypes & (aiPrimitiveType_TRIANGLE | aiPrimitiveType_POLYGON))) return;
+    const std::string name = "mesh '" + std::string(m.mName.C_Str()) + "'";
+    const glm::dmat3 normal_matrix = glm::transpose(glm::inverse(glm::dmat3(world)));
+    const bool mirrored = glm::determinant(glm::dmat3(world)) < 0.0;
+    std::vector<std::uint32_t> position(m.mNumVertices);
+    const std::uint32_t normal_base = std::uint32_t(out_.mesh.normals.size());
+    const std::uint32_t uv_base = std::uint32_t(out_.mesh.uvs.size());
+    for (unsigned v = 0; v < m.mNumVertices; ++v) {
+      const aiVector3D& a = m.mVertices[v];
+      const glm::dvec3 p = glm::dvec3(world * glm::dvec4(a.x, a.y, a.z, 1.0));
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+        fail(path_, name + ": vertex " + std::to_string(v) + " has a non-finite coordinate");
+      auto [it, added] = weld_.try_emplace(p, std::uint32_t(out_.exact_positions.size()));
+      if (added) out_.exact_positions.push_back(p);
+      position[v] = it->second;
+      if (out_.corner_normals) {
+        const aiVector3D& n = m.mNormals[v];
+        glm::dvec3 w = normal_matrix * glm::dvec3(n.x, n.y, n.z);
+        const double length = glm::length(w);
+        if (length > 0.0 && std::isfinite(length)) w /= length;
+        out_.mesh.normals.emplace_back(w);
+      }
+      if (out_.corner_uvs) out_.mesh.uvs.emplace_back(m.mTextureCoords[0][v].x, m.mTextureCoords[0][v].y);
+    }
+    std::vector<Corner> corners;
+    for (unsigned f = 0; f < m.mNumFaces; ++f) {
+      const aiFace& face = m.mFaces[f];
+      ++out_.file_faces;
+      if (face.mNumIndices < 3) continue;  // a point or a line
+      corners.clear();
+      for (unsigned c = 0; c < face.mNumIndices; ++c) {
+        const unsigned k = face.mIndices[c];
+        if (k >= m.mNumVertices)
+          fail(path_, name + ": face " + std::to_string(f) + " uses vertex " + std::to_string(k) + " of " +
+                          std::to_string(m.mNumVertices));
+        corners.push_back({position[k], uv_base + k, normal_base + k});
+      }
+      if (mirrored) std::reverse(corners.begin() + 1, corners.end());
+      add_polygon(out_, corners.data(), corners.size(), std::uint32_t(out_.file_faces - 1));
+      if (out_.corner_uvs) ++out_.faces_with_uvs;
+      if (out_.corner_normals) ++out_.faces_with_normals;
+      if (!out_.corner_uvs && out_.first_face_without_uvs.empty())
+        out_.first_face_without_uvs = name + " face " + std::to_string(f);
+    }
+  }
+
+  const std::string& path_;
+  const aiScene& scene_;
+  const double scale_;
+  ParsedMesh out_;
+  std::unordered_map<glm::dvec3, std::uint32_t, PositionHash> weld_;
+};
+
+}  // namespace
+
+bool assimp_reads(const std::string& ext) {
+  static const Assimp::Importer importer;
+  return !ext.empty() && importer.IsExtensionSupported("." + ext);
+}
+
+ParsedMesh parse_assimp(const std::string& path, const std::string& ext, std::string_view bytes, bool read_path) {
+  Assimp::Importer importer;
+  // Points and lines are dropped by the reader; the scene is checked for indices out of range.
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  const unsigned flags = aiProcess_ValidateDataStructure | aiProcess_SortByPType;
+  // A file beside others (a .gltf and its .bin) is read by name; bytes alone for the fuzz target.
+  const aiScene* scene =
+      read_path ? importer.ReadFile(path, flags) : importer.ReadFileFromMemory(bytes.data(), bytes.size(), flags, ext.c_str());
+  if (!scene || !scene->mRootNode) {
+    std::string why = importer.GetErrorString();
+    for (char& c : why)
+      if (c == '\n' || c == '\r') c = ' ';
+    if (why.size() > 200) why = why.substr(0, 200) + "...";
+    fail(path, "cannot read as ." + ext + (why.empty() ? std::string() : ": " + why));
+  }
+  const double scale = unit_scale_to_metres(*scene, ext);
+  ParsedMesh parsed = SceneReader(path, *scene, scale).read();
+  parsed.format = ext == "glb" || ext == "gltf" ? "gltf" : ext;
+  return parsed;
+}
+
+}  // namespace nmbake::mesh_io_detail
