@@ -182,5 +182,31 @@ TEST(AssimpFormats, NodeTransformsAreApplied) {
   EXPECT_LE(mean_difference(bake_files(dir + "/low.glb", dir + "/high.glb"), bake_files(low, high)), 0.05);
 }
 
+// Triangles whose winding (counter-clockwise from the front) agrees with their corners' normals.
+double share_wound_with_normals(const Mesh& m) {
+  std::size_t agree = 0;
+  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+    const glm::vec3 face =
+        glm::cross(m.corner_position(t, 1) - m.corner_position(t, 0), m.corner_position(t, 2) - m.corner_position(t, 0));
+    agree += glm::dot(face, m.corner_normal(t, 0) + m.corner_normal(t, 1) + m.corner_normal(t, 2)) > 0.0f;
+  }
+  return double(agree) / double(m.triangle_count());
+}
+
+// A mirroring node transform (negative determinant) turns the winding over; the reader reverses
+// the corners so that triangles stay counter-clockwise from the side their normals face.
+TEST(AssimpFormats, MirroringTransformsKeepTheWinding) {
+  const std::string dir = test::scratch_dir();
+  const std::string low = test::data_path("sample/torus_low.obj");
+  aiMatrix4x4 mirror;
+  aiMatrix4x4::Scaling(aiVector3D(-1.0f, 1.0f, 1.0f), mirror);
+  export_scene(low, "glb2", dir + "/mirrored.glb", 1.0, &mirror);
+  export_scene(low, "glb2", dir + "/plain.glb");
+  const Mesh mirrored = load_mesh(dir + "/mirrored.glb"), plain = load_mesh(dir + "/plain.glb");
+  EXPECT_GT(share_wound_with_normals(plain), 0.99);
+  EXPECT_GT(share_wound_with_normals(mirrored), 0.99);
+  EXPECT_LT(mirrored.positions[0].x * plain.positions[0].x, 0.0f) << "not mirrored";
+}
+
 }  // namespace
 }  // namespace nmbake
