@@ -25,6 +25,7 @@
 #include "pipeline/bake.h"
 #include "pipeline/error_estimate.h"
 #include "core/errors.h"
+#include "core/normals.h"
 #include "io/image_io.h"
 #include "io/mesh_io.h"
 #include "io/text_file.h"
@@ -79,6 +80,7 @@ const char* kExitCodes =
 
 struct Args {
   std::string low, high, output, cage, miss_mask, report, save_cage, suspect_mask;
+  std::vector<std::string> highs;  // every HIGH given; `high` names them in messages
   std::string size = "2048";
   int samples = 1;
   double front = -1.0, rear = -1.0;
@@ -126,7 +128,7 @@ void add_options(CLI::App& app, Args& a) {
              kExitCodes);
   app.get_formatter()->column_width(34);
   app.add_option("low", a.low, "Low-poly mesh with UVs")->required();
-  app.add_option("high", a.high, "High-poly mesh (UVs not needed)")->required();
+  app.add_option("high", a.highs, "High-poly mesh (UVs not needed); several: baked as one")->required();
   app.add_option("-o,--output", a.output, "Output map: .png (8-bit), .tif (16-bit), .exr (float)")->required();
   app.add_option("--size", a.size, "Map size N or WxH in texels (default 2048)");
   app.add_option("--samples", a.samples, "Sample points per texel, 1-1024 (default 1)");
@@ -215,12 +217,13 @@ void check_outputs(const Args& a, int bits) {
     for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
     if (ext != ".obj") throw UsageError("--save-cage " + a.save_cage + ": the cage is written as OBJ (.obj)");
   }
-  check_output_files({{"", a.low, "the low-poly"}, {"", a.high, "the high-poly"}, {"--cage", a.cage, "the cage"}},
-                     {{"--output", a.output, "the map"},
-                      {"--miss-mask", a.miss_mask, "the miss mask"},
-                      {"--suspect-mask", a.suspect_mask, "the suspect mask"},
-                      {"--save-cage", a.save_cage, "the cage"},
-                      {"--report", a.report, "the report"}});
+  std::vector<NamedFile> inputs{{"", a.low, "the low-poly"}, {"--cage", a.cage, "the cage"}};
+  for (const std::string& h : a.highs) inputs.push_back({"", h, "the high-poly"});
+  check_output_files(inputs, {{"--output", a.output, "the map"},
+                              {"--miss-mask", a.miss_mask, "the miss mask"},
+                              {"--suspect-mask", a.suspect_mask, "the suspect mask"},
+                              {"--save-cage", a.save_cage, "the cage"},
+                              {"--report", a.report, "the report"}});
   check_output_format(a.output, bits);
   if (const std::string problem = image_io_problem(); !problem.empty()) {
     if (problem.rfind("out of memory", 0) == 0) throw ResourceError(a.output + ": " + problem);
@@ -330,11 +333,33 @@ void print_summary(const Args& a, const BakeOptions& o, const RunInfo& run, cons
       run.seconds_total);
 }
 
+// What loading found in several high-poly files, summed (one file: its own).
+MeshLoadInfo combined_info(const std::vector<MeshLoadInfo>& infos) {
+  MeshLoadInfo all = infos.front();
+  for (std::size_t i = 1; i < infos.size(); ++i) {
+    const MeshLoadInfo& f = infos[i];
+    if (all.format.find(f.format) == std::string::npos) all.format += "+" + f.format;
+    all.file_faces += f.file_faces;
+    all.polygons_triangulated += f.polygons_triangulated;
+    all.normals_renormalized += f.normals_renormalized;
+    all.zero_normals += f.zero_normals;
+    all.normals_dropped = all.normals_dropped || f.normals_dropped;
+    all.uvs_dropped = all.uvs_dropped || f.uvs_dropped;
+    all.faces_without_normals += f.faces_without_normals;
+    all.faces_without_uvs += f.faces_without_uvs;
+    all.degenerate_faces_dropped += f.degenerate_faces_dropped;
+    all.largest_coordinate = std::max(all.largest_coordinate, f.largest_coordinate);
+    if (f.unit_scale != all.unit_scale) all.unit_scale = 0.0;  // mixed: high_files gives each
+  }
+  return all;
+}
+
 // What the report says of the run besides the bake's counts (the timings come later).
 RunInfo run_info(const Args& a, int argc, char** argv, int bits) {
   RunInfo run;
   run.low_path = a.low;
-  run.high_path = a.high;
+  run.high_path = a.highs.front();
+  run.high_paths = a.highs;
   run.cage_path = a.cage;
   run.output_path = a.output;
   run.miss_mask_path = a.miss_mask;
@@ -363,6 +388,7 @@ int run(int argc, char** argv) {
     throw UsageError(e.what());
   }
 
+  a.high = a.highs.front() + (a.highs.size() > 1 ? " and " + std::to_string(a.highs.size() - 1) + " more" : "");
   a.front_given = app.count("--front") > 0;
   a.rear_given = app.count("--rear") > 0;
   const auto start = Clock::now();
@@ -386,14 +412,20 @@ int run(int argc, char** argv) {
   run.origin = {low.origin.x, low.origin.y, low.origin.z};
   LoadOptions shared;  // the high-poly and the cage share the low-poly's origin (re-centred when far)
   shared.origin = low.origin;
-  Mesh high = load_mesh(a.high, shared, &run.high_info);
+  std::vector<Mesh> highs;
+  for (const std::string& path : a.highs) {
+    highs.push_back(load_mesh(path, shared, &run.high_infos.emplace_back()));
+    run.high_triangles.push_back(highs.back().triangle_count());
+  }
+  run.high_info = combined_info(run.high_infos);
+  Mesh high = merge_meshes(std::move(highs));
   Mesh cage;
   if (!a.cage.empty()) cage = load_mesh(a.cage, shared, &run.cage_info);
   const Mesh* cage_mesh = a.cage.empty() ? nullptr : &cage;
   run.seconds_load = std::chrono::duration<double>(Clock::now() - t0).count();
   progress.above([&] {
     warnings.add(load_warnings(run.low_info, a.low));
-    warnings.add(load_warnings(run.high_info, a.high));
+    for (std::size_t i = 0; i < a.highs.size(); ++i) warnings.add(load_warnings(run.high_infos[i], a.highs[i]));
     if (cage_mesh) warnings.add(load_warnings(run.cage_info, a.cage));
   });
   warnings.check_strict();  // before a long bake

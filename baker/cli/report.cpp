@@ -149,6 +149,14 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
   high["triangles_culled"] = s.high_triangles_culled;
   high["duplicates_skipped"] = s.high_duplicates_skipped;
   report["origin"] = r.origin;
+  report["highs"] = r.high_paths;
+  json files = json::array();
+  for (std::size_t i = 0; i < r.high_paths.size() && i < r.high_infos.size() && i < r.high_triangles.size(); ++i)
+    files.push_back({{"file", r.high_paths[i]},
+                     {"format", r.high_infos[i].format},
+                     {"triangles", r.high_triangles[i]},
+                     {"unit_scale", r.high_infos[i].unit_scale}});
+  report["high_files"] = files;
   report["version"] = NMBAKE_VERSION;
   report["command"] = r.command;
   report["started"] = r.started;

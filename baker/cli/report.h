@@ -18,8 +18,11 @@ namespace nmbake {
 struct RunInfo {
   std::string low_path, high_path, cage_path, output_path, miss_mask_path, suspect_mask_path;
   int bits = 8;
-  MeshLoadInfo low_info, high_info, cage_info;
-  MeshTopology high_topology;  // inspect_topology(high)
+  MeshLoadInfo low_info, high_info, cage_info;  // high_info: every high-poly file's, summed
+  std::vector<std::string> high_paths;          // every HIGH, in order
+  std::vector<MeshLoadInfo> high_infos;         // each file's
+  std::vector<std::size_t> high_triangles;      // each file's triangles
+  MeshTopology high_topology;                   // inspect_topology(high)
   double seconds_load = 0, seconds_write = 0, seconds_total = 0;
   std::uint64_t peak_memory_bytes = 0;
   unsigned threads_used = 0;

@@ -1,6 +1,8 @@
 #include "core/normals.h"
 
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "core/mesh_topology.h"
 
@@ -49,6 +51,33 @@ bool ensure_normals(Mesh& mesh) {
   mesh.normal_index.resize(mesh.normals.size());
   for (std::size_t c = 0; c < mesh.normal_index.size(); ++c) mesh.normal_index[c] = std::uint32_t(c);
   return true;
+}
+
+Mesh merge_meshes(std::vector<Mesh> meshes) {
+  if (meshes.size() == 1) return std::move(meshes.front());
+  Mesh out;
+  if (meshes.empty()) return out;
+  out.source = meshes.front().source;
+  out.origin = meshes.front().origin;
+  bool uvs = true;
+  for (Mesh& m : meshes) {
+    ensure_normals(m);
+    uvs = uvs && m.has_uvs();
+  }
+  for (const Mesh& m : meshes) {
+    const auto p0 = std::uint32_t(out.positions.size()), n0 = std::uint32_t(out.normals.size()),
+               u0 = std::uint32_t(out.uvs.size());
+    out.positions.insert(out.positions.end(), m.positions.begin(), m.positions.end());
+    out.normals.insert(out.normals.end(), m.normals.begin(), m.normals.end());
+    for (std::uint32_t i : m.position_index) out.position_index.push_back(p0 + i);
+    for (std::uint32_t i : m.normal_index) out.normal_index.push_back(n0 + i);
+    if (uvs) {
+      out.uvs.insert(out.uvs.end(), m.uvs.begin(), m.uvs.end());
+      for (std::uint32_t i : m.uv_index) out.uv_index.push_back(u0 + i);
+    }
+    out.source_face.insert(out.source_face.end(), m.source_face.begin(), m.source_face.end());
+  }
+  return out;
 }
 
 }  // namespace nmbake

@@ -29,4 +29,10 @@ std::vector<glm::vec3> compute_vertex_normals(const Mesh& mesh);
 // Returns true when normals were computed.
 bool ensure_normals(Mesh& mesh);
 
+// Several high-poly meshes (`nmbake LOW HIGH HIGH...`, all on one origin) as one: their triangles
+// in order, indices moved on. One mesh is returned as it is. With several, each without normals
+// first gets the ones the bake would compute for it alone (ensure_normals), so that the others
+// keep theirs; UVs are kept only when every one has them. Triangles keep their file's face numbers.
+Mesh merge_meshes(std::vector<Mesh> meshes);
+
 }  // namespace nmbake
