@@ -41,6 +41,34 @@ std::uint64_t peak_memory_bytes() {
   return std::uint64_t(ru.ru_maxrss) * 1024;  // Linux reports KiB
 }
 
+namespace {
+
+// The high-poly's topology, what the bake left out of it, and each of its files.
+void add_high_details(nlohmann::json& report, const BakeStats& s, const RunInfo& r) {
+  using json = nlohmann::json;
+  const MeshTopology& t = r.high_topology;
+  json& high = report["high_mesh"];
+  high["welded_vertices"] = t.welded_vertices;
+  high["isolated_vertices"] = t.isolated_vertices;
+  high["duplicate_faces"] = t.duplicate_faces;
+  high["boundary_edges"] = t.boundary_edges;
+  high["non_manifold_edges"] = t.non_manifold_edges;
+  high["inconsistent_winding_faces"] = t.inconsistent_winding_faces;
+  high["triangles_culled"] = s.high_triangles_culled;
+  high["duplicates_skipped"] = s.high_duplicates_skipped;
+  report["origin"] = r.origin;
+  report["highs"] = r.high_paths;
+  json files = json::array();
+  for (std::size_t i = 0; i < r.high_paths.size() && i < r.high_infos.size() && i < r.high_triangles.size(); ++i)
+    files.push_back({{"file", r.high_paths[i]},
+                     {"format", r.high_infos[i].format},
+                     {"triangles", r.high_triangles[i]},
+                     {"unit_scale", r.high_infos[i].unit_scale}});
+  report["high_files"] = files;
+}
+
+}  // namespace
+
 nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunInfo& r) {
   using nlohmann::json;
   json options = {
@@ -138,25 +166,7 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
       {"coordinate_spacing", s.coordinate_spacing},
       {"largest_coordinate", s.largest_coordinate},
   };
-  const MeshTopology& t = r.high_topology;
-  json& high = report["high_mesh"];
-  high["welded_vertices"] = t.welded_vertices;
-  high["isolated_vertices"] = t.isolated_vertices;
-  high["duplicate_faces"] = t.duplicate_faces;
-  high["boundary_edges"] = t.boundary_edges;
-  high["non_manifold_edges"] = t.non_manifold_edges;
-  high["inconsistent_winding_faces"] = t.inconsistent_winding_faces;
-  high["triangles_culled"] = s.high_triangles_culled;
-  high["duplicates_skipped"] = s.high_duplicates_skipped;
-  report["origin"] = r.origin;
-  report["highs"] = r.high_paths;
-  json files = json::array();
-  for (std::size_t i = 0; i < r.high_paths.size() && i < r.high_infos.size() && i < r.high_triangles.size(); ++i)
-    files.push_back({{"file", r.high_paths[i]},
-                     {"format", r.high_infos[i].format},
-                     {"triangles", r.high_triangles[i]},
-                     {"unit_scale", r.high_infos[i].unit_scale}});
-  report["high_files"] = files;
+  add_high_details(report, s, r);
   report["version"] = NMBAKE_VERSION;
   report["command"] = r.command;
   report["started"] = r.started;

@@ -221,6 +221,34 @@ class EncoderStderr {
   int saved_ = -1;
 };
 
+// The header written: size, stored type, metadata, and the encoder's settings for `ext`.
+OIIO::ImageSpec output_spec(const Image& image, OIIO::TypeDesc stored, const std::string& ext, const WriteOptions& options) {
+  OIIO::ImageSpec spec(image.width, image.height, image.channels, stored);
+  // Alpha is coverage, not premultiplication: keep colour values exactly as given.
+  spec.attribute("oiio:UnassociatedAlpha", 1);
+  for (const auto& [key, value] : options.metadata) spec.attribute(key, value);
+  if (const std::string date = reproducible_date_time(); !date.empty() && spec.get_string_attribute("DateTime").empty())
+    spec.attribute("DateTime", date);
+  // Measured on a 2048^2 map: PNG at zlib level 6 took 3.3 s, level 1 0.6 s (file ~10% larger);
+  // EXR zip shrank float normals by 1% in 2.3 s, uncompressed takes 0.1 s. With level 1, libpng's
+  // adaptive filter choice costs about a third of the write: the "up" filter alone (0x20) wrote
+  // the torus_s3 map in 0.18-0.27 s instead of 0.31-0.37 s, and 2% smaller (4.97 MB, not 5.08).
+  if (ext == ".png") {
+    spec.attribute("png:compressionLevel", 1);
+    spec.attribute("png:filter", 0x20);
+  }
+  if (ext == ".exr") spec.attribute("compression", "none");
+  // The TIFF writer drops attributes it does not know; keep them readable (and parsable by
+  // read_image_metadata) as "key=value" items after any given description in the description tag.
+  if (ext == ".tif" || ext == ".tiff") {
+    std::string description = spec.get_string_attribute("ImageDescription");
+    for (const auto& [key, value] : options.metadata)
+      if (key != "ImageDescription") description += (description.empty() ? "" : "; ") + key + "=" + value;
+    if (!description.empty()) spec.attribute("ImageDescription", description);
+  }
+  return spec;
+}
+
 }  // namespace
 
 void write_image(const std::string& path, const Image& image, const WriteOptions& options) {
@@ -259,29 +287,7 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
     stored = OIIO::TypeDesc::HALF;
   }
 
-  OIIO::ImageSpec spec(image.width, image.height, image.channels, stored);
-  // Alpha is coverage, not premultiplication: keep colour values exactly as given.
-  spec.attribute("oiio:UnassociatedAlpha", 1);
-  for (const auto& [key, value] : options.metadata) spec.attribute(key, value);
-  if (const std::string date = reproducible_date_time(); !date.empty() && spec.get_string_attribute("DateTime").empty())
-    spec.attribute("DateTime", date);
-  // Measured on a 2048^2 map: PNG at zlib level 6 took 3.3 s, level 1 0.6 s (file ~10% larger);
-  // EXR zip shrank float normals by 1% in 2.3 s, uncompressed takes 0.1 s. With level 1, libpng's
-  // adaptive filter choice costs about a third of the write: the "up" filter alone (0x20) wrote
-  // the torus_s3 map in 0.18-0.27 s instead of 0.31-0.37 s, and 2% smaller (4.97 MB, not 5.08).
-  if (ext == ".png") {
-    spec.attribute("png:compressionLevel", 1);
-    spec.attribute("png:filter", 0x20);
-  }
-  if (ext == ".exr") spec.attribute("compression", "none");
-  // The TIFF writer drops attributes it does not know; keep them readable (and parsable by
-  // read_image_metadata) as "key=value" items after any given description in the description tag.
-  if (ext == ".tif" || ext == ".tiff") {
-    std::string description = spec.get_string_attribute("ImageDescription");
-    for (const auto& [key, value] : options.metadata)
-      if (key != "ImageDescription") description += (description.empty() ? "" : "; ") + key + "=" + value;
-    if (!description.empty()) spec.attribute("ImageDescription", description);
-  }
+  const OIIO::ImageSpec spec = output_spec(image, stored, ext, options);
 
   // Create with the real path so the writer is chosen by its extension.
   auto out = OIIO::ImageOutput::create(path);
