@@ -92,5 +92,7 @@ struct OpenMeshRead {
   std::size_t vertices = 0, faces = 0;
 };
 OpenMeshRead openmesh_read(const std::string& path);
+// Assimp's ReadFile with the flags nmbake's Assimp reader uses (bench_assimp.cpp); same fields.
+OpenMeshRead assimp_read(const std::string& path);
 
 }  // namespace nmbake::bench
