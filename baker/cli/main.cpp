@@ -87,6 +87,8 @@ struct Args {
   bool front_given = false, rear_given = false;  // set after parsing: a distance given is never "auto"
   std::string policy = "cage-first", space = "tangent", green = "up", bitangent = "pixel";
   int bits = 0;
+  std::string compression;  // --compression: EXR only
+  bool dither = false;
   int padding = 16;
   int threads = 0;
   int quiet = 0;  // times --quiet was given
@@ -153,6 +155,11 @@ void add_options(CLI::App& app, Args& a) {
   app.add_option("--bitangent", a.bitangent, "pixel = B from interpolated N,T (MikkTSpace, default); vertex = interpolated B")
       ->check(CLI::IsMember({"pixel", "vertex"}));
   app.add_option("--bits", a.bits, "8, 16 or 32 (float); default from the extension")->check(CLI::IsMember({8, 16, 32}));
+  app.add_option("--compression", a.compression, "EXR compression: zip (lossless, default), none, piz (lossless) or dwaa (lossy)")
+      ->check(CLI::IsMember({"none", "zip", "piz", "dwaa"}));
+  app.add_flag("--dither", a.dither,
+               "8-bit output: add triangular noise of one step before rounding (no banding in fine gradients; the same "
+               "map whatever the thread count)");
   app.add_option("--padding", a.padding, "Edge padding around UV islands in texels (default 16)");
   app.add_option("--miss-mask", a.miss_mask, "Write an image of the share of missed rays per texel");
   app.add_option("--suspect-mask", a.suspect_mask,
@@ -225,6 +232,10 @@ void check_outputs(const Args& a, int bits) {
                               {"--save-cage", a.save_cage, "the cage"},
                               {"--report", a.report, "the report"}});
   check_output_format(a.output, bits);
+  if (!a.compression.empty() && image_io_detail::lower_extension(a.output) != ".exr")
+    throw UsageError("--compression " + a.compression + " applies to EXR output, not " + a.output);
+  if (a.dither && bits != 8)
+    throw UsageError("--dither applies to 8-bit output; " + a.output + " is " + std::to_string(bits) + "-bit");
   if (const std::string problem = image_io_problem(); !problem.empty()) {
     if (problem.rfind("out of memory", 0) == 0) throw ResourceError(a.output + ": " + problem);
     throw OutputError(a.output + ": " + problem);
@@ -286,6 +297,8 @@ void write_outputs(OutputSet& outputs, const Args& a, const BakeOptions& o, cons
       {"ImageDescription",
        std::string(o.space == NormalSpace::object ? "object-space normal map" : "tangent-space normal map, ") +
            (o.space == NormalSpace::object ? "" : (o.green_down ? "DirectX (Y-)" : "OpenGL (Y+)")) + ", baked by nmbake"}};
+  wo.compression = a.compression;
+  wo.dither = a.dither;
   wo.temp_path = outputs.add(a.output);
   write_image(a.output, r.map, wo);
   for (const auto& [path, image] : {std::pair{&a.miss_mask, &r.miss_mask}, std::pair{&a.suspect_mask, &r.suspect_mask}}) {
@@ -365,6 +378,8 @@ RunInfo run_info(const Args& a, int argc, char** argv, int bits) {
   run.miss_mask_path = a.miss_mask;
   run.suspect_mask_path = a.suspect_mask;
   run.bits = bits;
+  run.dither = a.dither;
+  if (image_io_detail::lower_extension(a.output) == ".exr") run.compression = a.compression.empty() ? "zip" : a.compression;
   run.command.assign(argv, argv + argc);
   run.started = utc_time_text(report_time());
   return run;

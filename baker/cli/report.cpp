@@ -88,6 +88,8 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
       {"green", o.green_down ? "down" : "up"},
       {"bitangent", to_string(o.bitangent)},
       {"bits", r.bits},
+      {"compression", r.compression},
+      {"dither", r.dither},
       {"padding", o.padding},
       {"threads", r.threads_used},
       {"cull", o.cull_far},

@@ -18,6 +18,8 @@ namespace nmbake {
 struct RunInfo {
   std::string low_path, high_path, cage_path, output_path, miss_mask_path, suspect_mask_path;
   int bits = 8;
+  std::string compression;  // the EXR compression written ("zip", ...), "" for other formats
+  bool dither = false;
   MeshLoadInfo low_info, high_info, cage_info;  // high_info: every high-poly file's, summed
   std::vector<std::string> high_paths;          // every HIGH, in order
   std::vector<MeshLoadInfo> high_infos;         // each file's

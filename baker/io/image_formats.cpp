@@ -19,10 +19,8 @@ struct FormatInfo {
   bool bits8, bits16, bits32;
 };
 constexpr FormatInfo kFormats[] = {
-    {".png", true, true, false},
-    {".tif", true, true, true},
-    {".tiff", true, true, true},
-    {".exr", false, true, true},
+    {".png", true, true, false}, {".tga", true, false, false}, {".tif", true, true, true},
+    {".tiff", true, true, true}, {".exr", false, true, true},
 };
 
 }  // namespace
@@ -54,7 +52,7 @@ int default_bits_for(const std::string& path) {
 void check_output_format(const std::string& path, int bits) {
   const std::string ext = image_io_detail::lower_extension(path);
   const FormatInfo* f = find_format(ext);
-  if (!f) throw UsageError(path + ": unsupported image format '" + ext + "' (use .png, .tif, .tiff or .exr)");
+  if (!f) throw UsageError(path + ": unsupported image format '" + ext + "' (use .png, .tga, .tif, .tiff or .exr)");
   if (bits == 0) return;
   bool ok = (bits == 8 && f->bits8) || (bits == 16 && f->bits16) || (bits == 32 && f->bits32);
   if (!ok) {

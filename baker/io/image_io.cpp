@@ -59,6 +59,31 @@ std::vector<T> quantize(const Floats& values, double scale) {
   return out;
 }
 
+// A value in [0, 1) from a 64-bit key (splitmix64's finaliser): the same for a texel and channel
+// whatever thread writes it.
+double unit_hash(std::uint64_t key) {
+  key += 0x9E3779B97F4A7C15ull;
+  key = (key ^ (key >> 30)) * 0xBF58476D1CE4E5B9ull;
+  key = (key ^ (key >> 27)) * 0x94D049BB133111EBull;
+  key ^= key >> 31;
+  return double(key >> 11) * (1.0 / 9007199254740992.0);
+}
+
+// 8-bit values with triangular noise of one step added before rounding (WriteOptions::dither):
+// the sum of two uniform values in [0, 1) minus 1, seeded by the value's index, so that a gradient
+// finer than a step shows no bands and the average over many texels keeps the float value.
+std::vector<std::uint8_t> quantize_dithered(const Image::Pixels& values) {
+  std::vector<std::uint8_t> out(values.size());
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const double noise = unit_hash(2 * std::uint64_t(i)) + unit_hash(2 * std::uint64_t(i) + 1) - 1.0;
+    double v = static_cast<double>(values[i]) * 255.0 + 0.5 + noise;
+    if (!(v > 0.0)) v = 0.0;
+    if (v > 255.0) v = 255.0;
+    out[i] = static_cast<std::uint8_t>(v);
+  }
+  return out;
+}
+
 // A temporary beside `target` for write_image without WriteOptions::temp_path (nmdiff, the tests).
 std::string temp_path_for(const fs::path& target) {
   static std::atomic<unsigned> counter{0};
@@ -237,7 +262,8 @@ OIIO::ImageSpec output_spec(const Image& image, OIIO::TypeDesc stored, const std
     spec.attribute("png:compressionLevel", 1);
     spec.attribute("png:filter", 0x20);
   }
-  if (ext == ".exr") spec.attribute("compression", "none");
+  // EXR: ZIP (lossless) unless WriteOptions::compression says otherwise.
+  if (ext == ".exr") spec.attribute("compression", options.compression.empty() ? "zip" : options.compression);
   // The TIFF writer drops attributes it does not know; keep them readable (and parsable by
   // read_image_metadata) as "key=value" items after any given description in the description tag.
   if (ext == ".tif" || ext == ".tiff") {
@@ -276,7 +302,7 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
   std::vector<std::uint16_t> data16;
   const void* data = image.pixels.data();
   if (bits == 8) {
-    data8 = quantize<std::uint8_t>(image.pixels, 255.0);
+    data8 = options.dither ? quantize_dithered(image.pixels) : quantize<std::uint8_t>(image.pixels, 255.0);
     stored = given = OIIO::TypeDesc::UINT8;
     data = data8.data();
   } else if (bits == 16 && ext != ".exr") {

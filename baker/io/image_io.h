@@ -15,11 +15,12 @@
 
 namespace nmbake {
 
-// Bit depth implied by a file name: .png -> 8, .tif/.tiff -> 16, .exr -> 32 (float), others 8.
+// Bit depth implied by a file name: .png, .tga -> 8, .tif/.tiff -> 16, .exr -> 32 (float), others 8.
 int default_bits_for(const std::string& path);
 
-// Throws UsageError when the extension is not one OpenImageIO can write, or the format cannot hold
-// `bits` (8, 16 or 32; 32 means float: EXR and TIFF only; EXR with 16 is half float).
+// Throws UsageError when the extension is not one we write (.png, .tga, .tif, .tiff, .exr), or the
+// format cannot hold `bits` (8, 16 or 32; 32 means float: EXR and TIFF only; EXR with 16 is half
+// float; TGA 8 only).
 void check_output_format(const std::string& path, int bits);
 
 struct WriteOptions {
@@ -32,6 +33,11 @@ struct WriteOptions {
   // only (created or emptied, never through a symbolic link) and leave the rename to the caller,
   // which commits several outputs together (the nmbake command's OutputSet).
   std::string temp_path;
+  // EXR compression as OpenImageIO names it ("none", "zip", "piz", "dwaa", ...); "" = ZIP (lossless).
+  std::string compression;
+  // 8-bit output: triangular noise of one step before rounding, the same for a texel whatever
+  // thread or run writes it.
+  bool dither = false;
 };
 
 // Writes `image` (values in [0,1] for integer formats, rounded to nearest) to a temporary file,

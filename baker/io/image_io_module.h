@@ -18,7 +18,7 @@ struct ImageIoModule {
   int (*read_metadata)(const std::string& path, std::map<std::string, std::string>* metadata, std::string* error);
 };
 
-constexpr int kImageIoModuleVersion = 2;
+constexpr int kImageIoModuleVersion = 3;
 
 }  // namespace nmbake
 
