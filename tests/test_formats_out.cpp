@@ -20,16 +20,6 @@ using test::run_nmbake;
 const std::string kLow = test::data_path("sample/torus_low.obj");
 const std::string kHigh = test::data_path("sample/torus_high.ply");
 
-std::string slurp(const std::string& path) {
-  std::string bytes;
-  if (std::FILE* f = std::fopen(path.c_str(), "rb")) {
-    char buf[65536];
-    for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;) bytes.append(buf, n);
-    std::fclose(f);
-  }
-  return bytes;
-}
-
 Image gradient(int w, int h) {
   Image im(w, h, 3, 0.0f);
   for (int y = 0; y < h; ++y)
@@ -99,7 +89,7 @@ TEST(FormatsOut, DitherKeepsTheValueOnAverage) {
   write_image(dir + "/plain.png", flat);
   write_image(dir + "/dither.png", flat, dithered);
   write_image(dir + "/again.png", flat, dithered);
-  EXPECT_TRUE(slurp(dir + "/dither.png") == slurp(dir + "/again.png"));
+  EXPECT_TRUE(test::read_file(dir + "/dither.png") == test::read_file(dir + "/again.png"));
   const Image plain = read_image(dir + "/plain.png"), noisy = read_image(dir + "/dither.png");
   double sum = 0.0;
   for (std::size_t i = 0; i < noisy.pixels.size(); ++i) {
@@ -120,8 +110,9 @@ TEST(FormatsOut, DitheredMapIsTheSameWhateverTheThreads) {
   ASSERT_EQ(one.code, 0) << one.err;
   ASSERT_EQ(two.code, 0) << two.err;
   ASSERT_EQ(plain.code, 0) << plain.err;
-  EXPECT_TRUE(slurp(dir + "/one.png") == slurp(dir + "/two.png")) << "the thread count changed the dithered map";
-  EXPECT_TRUE(slurp(dir + "/one.png") != slurp(dir + "/plain.png")) << "--dither changed nothing";
+  EXPECT_TRUE(test::read_file(dir + "/one.png") == test::read_file(dir + "/two.png"))
+      << "the thread count changed the dithered map";
+  EXPECT_TRUE(test::read_file(dir + "/one.png") != test::read_file(dir + "/plain.png")) << "--dither changed nothing";
 }
 
 }  // namespace

@@ -24,13 +24,6 @@ using test::run_nmbake;
 const std::string kLow = test::data_path("sample/torus_low.obj");
 const std::string kHigh = test::data_path("sample/torus_high.ply");
 
-void write_text(const std::string& path, const std::string& text) {
-  std::FILE* f = std::fopen(path.c_str(), "w");
-  ASSERT_NE(f, nullptr) << path;
-  std::fwrite(text.data(), 1, text.size(), f);
-  std::fclose(f);
-}
-
 TEST(HostileGeometry, DistancesBeyondTheRayTracerAreRefused) {
   for (const char* option : {"--front", "--rear"})
     for (const char* value : {"1.8e18", "1e19", "1e25"}) {
@@ -46,8 +39,8 @@ TEST(HostileGeometry, DistancesBeyondTheRayTracerAreRefused) {
 
 TEST(HostileGeometry, CoordinatesBeyondTheRayTracerAreRefused) {
   const std::string dir = test::scratch_dir();
-  write_text(dir + "/big.obj", "v 0 0 0\nv 1.8e18 0 0\nv 0 1.8e18 0\nf 1 2 3\n");
-  write_text(dir + "/max.obj", "v 0 0 0\nv 3e38 0 0\nv 0 3e38 0\nf 1 2 3\n");
+  test::write_file(dir + "/big.obj", "v 0 0 0\nv 1.8e18 0 0\nv 0 1.8e18 0\nf 1 2 3\n");
+  test::write_file(dir + "/max.obj", "v 0 0 0\nv 3e38 0 0\nv 0 3e38 0\nf 1 2 3\n");
   for (const char* name : {"big.obj", "max.obj"}) {
     const test::CliRun r = run_nmbake(kLow + " " + name + " -o out.png --size 32", "", dir);
     EXPECT_EQ(r.code, 2) << name;
@@ -125,8 +118,8 @@ TEST(HostileGeometry, ReportGivesSkippedStacksAndTheOrigin) {
       }
       faces += 2;
     }
-  write_text(dir + "/low.obj", low);
-  write_text(dir + "/high.obj", high);
+  test::write_file(dir + "/low.obj", low);
+  test::write_file(dir + "/high.obj", high);
   const test::CliRun r = run_nmbake("low.obj high.obj -o out.png --size 32 --report r.json", "", dir);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.report["high_mesh"]["duplicates_skipped"], 11 * faces);
@@ -169,7 +162,7 @@ TEST(HostileGeometry, HugePolygonsAreNotFanned) {
   for (int i = 1; i <= n; ++i) text += " " + std::to_string(i);
   text += "\n";
   const std::string dir = test::scratch_dir();
-  write_text(dir + "/disc.obj", text);
+  test::write_file(dir + "/disc.obj", text);
   const Mesh m = load_mesh(dir + "/disc.obj");
   ASSERT_EQ(m.triangle_count(), std::size_t(n - 2));
   double area = 0.0;
@@ -185,7 +178,7 @@ TEST(HostileGeometry, HugePolygonsAreNotFanned) {
   EXPECT_NEAR(area, 0.5 * n * std::sin(2.0 * 3.14159265358979 / n), 1e-4);  // the polygon's area
   EXPECT_LE(around_centre, 12u);
   // Up to kMaxFanCorners corners, the fan Blender makes.
-  write_text(dir + "/hexagon.obj", "v 1 0 0\nv 2 0 0\nv 3 1 0\nv 2 2 0\nv 1 2 0\nv 0 1 0\nf 1 2 3 4 5 6\n");
+  test::write_file(dir + "/hexagon.obj", "v 1 0 0\nv 2 0 0\nv 3 1 0\nv 2 2 0\nv 1 2 0\nv 0 1 0\nf 1 2 3 4 5 6\n");
   EXPECT_EQ(load_mesh(dir + "/hexagon.obj").position_index, (std::vector<std::uint32_t>{0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 5}));
 }
 
@@ -209,8 +202,8 @@ TEST(HostileGeometry, AsciiStlBakesAsTheSameTrianglesInObj) {
     stl += "  endloop\n endfacet\n";
   }
   stl += "endsolid torus\n";
-  write_text(dir + "/high.stl", stl);
-  write_text(dir + "/high.obj", obj_text(high, "torus high, no normals"));
+  test::write_file(dir + "/high.stl", stl);
+  test::write_file(dir + "/high.obj", obj_text(high, "torus high, no normals"));
   LoadOptions low_options;
   low_options.require_uvs = true;
   const Mesh low = load_mesh(kLow, low_options);

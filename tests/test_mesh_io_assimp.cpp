@@ -22,13 +22,6 @@
 namespace nmbake {
 namespace {
 
-void write_file(const std::string& path, const std::string& bytes) {
-  std::FILE* f = std::fopen(path.c_str(), "wb");
-  ASSERT_NE(f, nullptr) << path;
-  std::fwrite(bytes.data(), 1, bytes.size(), f);
-  std::fclose(f);
-}
-
 // Distinct normals the corners of the mesh use.
 std::size_t distinct_normals(const Mesh& m) {
   std::vector<glm::vec3> seen;
@@ -65,9 +58,9 @@ TEST(AssimpFormats, RealFilesLoadWithHardEdges) {
 TEST(AssimpFormats, MalformedFilesAreOneLineErrors) {
   const std::string dir = test::scratch_dir();
   const std::string bad = dir + "/bad.glb", empty = dir + "/empty.fbx", junk = dir + "/junk.dae";
-  write_file(bad, std::string("glTF\x02\0\0\0\x10\0\0\0junkjunk", 20));
-  write_file(empty, "");
-  write_file(junk, "<?xml version=\"1.0\"?><COLLADA><library_geometries><geometry>");
+  test::write_file(bad, std::string("glTF\x02\0\0\0\x10\0\0\0junkjunk", 20));
+  test::write_file(empty, "");
+  test::write_file(junk, "<?xml version=\"1.0\"?><COLLADA><library_geometries><geometry>");
   for (const std::string& path : {bad, empty, junk}) {
     try {
       load_mesh(path);
@@ -78,7 +71,7 @@ TEST(AssimpFormats, MalformedFilesAreOneLineErrors) {
       EXPECT_EQ(what.find('\n'), std::string::npos) << what;
     }
   }
-  write_file(dir + "/mesh.xyz123", "v 0 0 0\n");
+  test::write_file(dir + "/mesh.xyz123", "v 0 0 0\n");
   try {
     load_mesh(dir + "/mesh.xyz123");
     ADD_FAILURE() << "an unknown extension loaded";

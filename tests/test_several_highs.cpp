@@ -43,35 +43,18 @@ std::string obj_part(const Mesh& m, std::size_t first, std::size_t last, bool no
   return text;
 }
 
-void write_text(const std::string& path, const std::string& text) {
-  std::FILE* f = std::fopen(path.c_str(), "w");
-  ASSERT_NE(f, nullptr) << path;
-  std::fwrite(text.data(), 1, text.size(), f);
-  std::fclose(f);
-}
-
-std::string slurp(const std::string& path) {
-  std::string bytes;
-  if (std::FILE* f = std::fopen(path.c_str(), "rb")) {
-    char buf[65536];
-    for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;) bytes.append(buf, n);
-    std::fclose(f);
-  }
-  return bytes;
-}
-
 TEST(SeveralHighs, ASculptSplitInTwoFilesBakesTheWholeMap) {
   const std::string dir = test::scratch_dir();
   const Mesh high = load_mesh(kHigh);
   ASSERT_TRUE(high.has_normals());
   const std::size_t half = high.triangle_count() / 2;
-  write_text(dir + "/front.obj", obj_part(high, 0, half, true));
-  write_text(dir + "/back.obj", obj_part(high, half, high.triangle_count(), true));
+  test::write_file(dir + "/front.obj", obj_part(high, 0, half, true));
+  test::write_file(dir + "/back.obj", obj_part(high, half, high.triangle_count(), true));
   const test::CliRun one = run_nmbake(kLow + " " + kHigh + " -o one.png --size 128", "", dir);
   ASSERT_EQ(one.code, 0) << one.err;
   const test::CliRun two = run_nmbake(kLow + " front.obj back.obj -o two.png --size 128 --report r.json", "", dir);
   ASSERT_EQ(two.code, 0) << two.err;
-  EXPECT_EQ(slurp(dir + "/one.png"), slurp(dir + "/two.png")) << "the split sculpt baked another map";
+  EXPECT_TRUE(test::read_file(dir + "/one.png") == test::read_file(dir + "/two.png")) << "the split sculpt baked another map";
   EXPECT_EQ(two.report["highs"], nlohmann::json::array({"front.obj", "back.obj"}));
   ASSERT_EQ(two.report["high_files"].size(), 2u);
   EXPECT_EQ(two.report["high_files"][0]["triangles"], half);
@@ -85,8 +68,8 @@ TEST(SeveralHighs, FilesWithAndWithoutNormalsMix) {
   const std::string dir = test::scratch_dir();
   const Mesh high = load_mesh(kHigh);
   const std::size_t half = high.triangle_count() / 2;
-  write_text(dir + "/front.obj", obj_part(high, 0, half, true));
-  write_text(dir + "/back.obj", obj_part(high, half, high.triangle_count(), false));
+  test::write_file(dir + "/front.obj", obj_part(high, 0, half, true));
+  test::write_file(dir + "/back.obj", obj_part(high, half, high.triangle_count(), false));
   const test::CliRun r = run_nmbake(kLow + " front.obj back.obj -o m.png --size 64 --report r.json", "", dir);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_FALSE(r.report["high_normals_computed"].get<bool>()) << "the front file's normals were dropped";
@@ -95,13 +78,13 @@ TEST(SeveralHighs, FilesWithAndWithoutNormalsMix) {
 TEST(SeveralHighs, NoOutputMayOverwriteAnyOfThem) {
   const std::string dir = test::scratch_dir();
   const Mesh high = load_mesh(kHigh);
-  write_text(dir + "/a.obj", obj_part(high, 0, 10, false));
-  write_text(dir + "/b.obj", obj_part(high, 10, 20, false));
-  const std::string before = slurp(dir + "/b.obj");
+  test::write_file(dir + "/a.obj", obj_part(high, 0, 10, false));
+  test::write_file(dir + "/b.obj", obj_part(high, 10, 20, false));
+  const std::string before = test::read_file(dir + "/b.obj");
   const test::CliRun r = run_nmbake(kLow + " a.obj b.obj -o m.png --size 16 --report b.obj", "", dir);
   EXPECT_EQ(r.code, 1) << r.err;
   EXPECT_TRUE(contains(r.err, "b.obj")) << r.err;
-  EXPECT_EQ(slurp(dir + "/b.obj"), before);
+  EXPECT_EQ(test::read_file(dir + "/b.obj"), before);
   EXPECT_FALSE(test::exists(dir + "/m.png"));
 }
 

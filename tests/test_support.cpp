@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 
 #include <gtest/gtest.h>
 
@@ -33,6 +34,19 @@ std::string scratch_dir() {
   return dir.string();
 }
 
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void write_file(const std::string& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out << bytes;
+  if (!out.flush()) throw std::runtime_error("cannot write " + path);
+}
+
 CliRun run_nmbake(const std::string& args, const std::string& prefix, const std::string& dir) {
   CliRun r;
   r.dir = dir.empty() ? scratch_dir() : dir;
@@ -41,15 +55,9 @@ CliRun run_nmbake(const std::string& args, const std::string& prefix, const std:
   const std::string cmd = "cd '" + r.dir + "' && " + prefix + " '" + exe + "' " + args + " >out.txt 2>err.txt";
   const int status = std::system(("bash -c \"" + cmd + "\"").c_str());
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  auto slurp = [](const std::string& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-  };
-  r.out = slurp(r.dir + "/out.txt");
-  r.err = slurp(r.dir + "/err.txt");
-  if (exists(r.dir + "/r.json")) r.report = nlohmann::json::parse(slurp(r.dir + "/r.json"));
+  r.out = read_file(r.dir + "/out.txt");
+  r.err = read_file(r.dir + "/err.txt");
+  if (exists(r.dir + "/r.json")) r.report = nlohmann::json::parse(read_file(r.dir + "/r.json"));
   std::printf("$ nmbake %s\n-> exit %d\n%s%s", args.c_str(), r.code, r.out.c_str(), r.err.c_str());
   return r;
 }

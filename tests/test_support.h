@@ -18,6 +18,8 @@ namespace nmbake::test {
 std::string data_path(const std::string& relative);         // <repo>/data/<relative>
 std::string shared_data_path(const std::string& relative);  // <repo>/../shared/data/<relative>
 bool exists(const std::string& path);
+std::string read_file(const std::string& path);                      // the whole file ("" when unreadable)
+void write_file(const std::string& path, const std::string& bytes);  // created or replaced; throws when it cannot
 
 // A fresh empty folder under the build tree, named after the running test.
 std::string scratch_dir();
