@@ -80,6 +80,36 @@ TEST(AssimpFormats, MalformedFilesAreOneLineErrors) {
   }
 }
 
+// --uv-set picks a UV set of a file that has several (cube_with_2UVs.DAE); own formats have one.
+TEST(AssimpFormats, UvSetPicksTheSet) {
+  LoadOptions first, second, third;
+  second.uv_set = 1;
+  third.uv_set = 2;
+  const std::string dae = test::data_path("assimp/cube_with_2UVs.DAE");
+  const Mesh a = load_mesh(dae, first), b = load_mesh(dae, second);
+  ASSERT_TRUE(a.has_uvs());
+  ASSERT_TRUE(b.has_uvs());
+  EXPECT_EQ(a.position_index, b.position_index);
+  EXPECT_TRUE(a.uvs != b.uvs) << "set 1 read the same UVs as set 0";
+  third.require_uvs = true;
+  try {
+    load_mesh(dae, third);
+    ADD_FAILURE() << "UV set 2 of a file with two loaded";
+  } catch (const InputError& e) {
+    EXPECT_TRUE(test::contains(e.what(), "(UV set 2) has no UVs")) << e.what();
+  }
+  try {
+    load_mesh(test::data_path("sample/torus_low.obj"), second);
+    ADD_FAILURE() << "UV set 1 of an OBJ loaded";
+  } catch (const InputError& e) {
+    EXPECT_TRUE(test::contains(e.what(), ".obj files have one UV set")) << e.what();
+  }
+  const test::CliRun r = test::run_nmbake(dae + " " + dae + " -o m.png --size 32 --uv-set 1 --report r.json");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.report["options"]["uv_set"], 1);
+  EXPECT_EQ(test::run_nmbake(dae + " " + dae + " -o m.png --size 32 --uv-set 8").code, 1);
+}
+
 // `in` re-saved by Assimp's exporter as `format` (an Assimp export id) at `out`, its coordinates
 // scaled by `scale` (an FBX in centimetres: 100, with the file's unit the exporter writes, 1 cm;
 // the vertices themselves, as the FBX exporter leaves out the root node's transform).

@@ -88,6 +88,7 @@ struct Args {
   std::string policy = "cage-first", space = "tangent", green = "up", bitangent = "pixel";
   int bits = 0;
   std::string compression;  // --compression: EXR only
+  unsigned uv_set = 0;
   bool dither = false;
   int padding = 16;
   int threads = 0;
@@ -155,6 +156,8 @@ void add_options(CLI::App& app, Args& a) {
   app.add_option("--bitangent", a.bitangent, "pixel = B from interpolated N,T (MikkTSpace, default); vertex = interpolated B")
       ->check(CLI::IsMember({"pixel", "vertex"}));
   app.add_option("--bits", a.bits, "8, 16 or 32 (float); default from the extension")->check(CLI::IsMember({8, 16, 32}));
+  app.add_option("--uv-set", a.uv_set, "The low-poly's UV set to bake into, from 0 (glTF, FBX, DAE may have several)")
+      ->check(CLI::Range(0u, kMaxUvSets - 1));
   app.add_option("--compression", a.compression, "EXR compression: zip (lossless, default), none, piz (lossless) or dwaa (lossy)")
       ->check(CLI::IsMember({"none", "zip", "piz", "dwaa"}));
   app.add_flag("--dither", a.dither,
@@ -379,6 +382,7 @@ RunInfo run_info(const Args& a, int argc, char** argv, int bits) {
   run.suspect_mask_path = a.suspect_mask;
   run.bits = bits;
   run.dither = a.dither;
+  run.uv_set = a.uv_set;
   if (image_io_detail::lower_extension(a.output) == ".exr") run.compression = a.compression.empty() ? "zip" : a.compression;
   run.command.assign(argv, argv + argc);
   run.started = utc_time_text(report_time());
@@ -426,6 +430,7 @@ int run(int argc, char** argv) {
   auto t0 = Clock::now();
   LoadOptions low_opts;
   low_opts.require_uvs = true;
+  low_opts.uv_set = a.uv_set;
   Mesh low = load_mesh(a.low, low_opts, &run.low_info);
   run.origin = {low.origin.x, low.origin.y, low.origin.z};
   LoadOptions shared;  // the high-poly and the cage share the low-poly's origin (re-centred when far)

@@ -90,6 +90,7 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
       {"bits", r.bits},
       {"compression", r.compression},
       {"dither", r.dither},
+      {"uv_set", r.uv_set},
       {"padding", o.padding},
       {"threads", r.threads_used},
       {"cull", o.cull_far},

@@ -20,6 +20,7 @@ struct RunInfo {
   int bits = 8;
   std::string compression;  // the EXR compression written ("zip", ...), "" for other formats
   bool dither = false;
+  unsigned uv_set = 0;                          // --uv-set
   MeshLoadInfo low_info, high_info, cage_info;  // high_info: every high-poly file's, summed
   std::vector<std::string> high_paths;          // every HIGH, in order
   std::vector<MeshLoadInfo> high_infos;         // each file's

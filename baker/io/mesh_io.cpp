@@ -110,8 +110,12 @@ std::string_view skip_utf8_bom(std::string_view text) {
 // Formats with a reader of our own; any other extension Assimp reads goes to Assimp.
 bool own_format(const std::string& ext) { return ext == "obj" || ext == "ply" || ext == "off" || ext == "stl"; }
 
-ParsedMesh parse_by_extension(const std::string& path, const std::string& ext, std::string_view bytes, bool read_path) {
-  if (!own_format(ext)) return mesh_io_detail::parse_assimp(path, ext, bytes, read_path);
+ParsedMesh parse_by_extension(const std::string& path, const std::string& ext, std::string_view bytes, bool read_path,
+                              unsigned uv_set) {
+  if (!own_format(ext)) return mesh_io_detail::parse_assimp(path, ext, bytes, read_path, uv_set);
+  if (uv_set > 0)
+    fail(path, "." + ext + " files have one UV set; UV set " + std::to_string(uv_set) +
+                   " needs a format with several (glTF, FBX, DAE)");
   if (ext == "obj") return mesh_io_detail::parse_obj(path, skip_utf8_bom(bytes));
   if (ext == "ply") return mesh_io_detail::parse_ply(path, bytes);
   if (ext == "off") return mesh_io_detail::parse_off(path, skip_utf8_bom(bytes));
@@ -246,7 +250,10 @@ Mesh parse_bytes(const std::string& path, std::string_view bytes, const LoadOpti
   // Assimp's formats are binary or read UTF-16 themselves (COLLADA).
   if (own_format(ext) && !(ext == "stl" && mesh_io_detail::is_binary_stl(bytes)) && looks_like_utf16(bytes))
     fail(path, "looks like UTF-16 text; save it as UTF-8");
-  return finish_mesh(parse_by_extension(path, ext, bytes, read_path), path, options, info);
+  if (options.uv_set >= kMaxUvSets)
+    fail(path,
+         "UV set " + std::to_string(options.uv_set) + " asked for; sets are numbered 0 to " + std::to_string(kMaxUvSets - 1));
+  return finish_mesh(parse_by_extension(path, ext, bytes, read_path, options.uv_set), path, options, info);
 }
 
 }  // namespace

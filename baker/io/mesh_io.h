@@ -16,12 +16,17 @@ namespace nmbake {
 
 struct LoadOptions {
   bool require_uvs = false;  // throw "<file>: face N has no UVs" when any face lacks them
+  // Which UV set to read (--uv-set): 0 the first. OBJ, PLY, OFF and STL have one; glTF, FBX, DAE
+  // may have several (read through Assimp, up to kMaxUvSets).
+  unsigned uv_set = 0;
   // The point subtracted (in double) from the file's coordinates: Mesh::origin. Unset: the centre
   // of the mesh's bounds when the mesh lies farther from the file's origin than kFarFactor times
   // its size, else (0,0,0). Meshes baked together must share one: load the low-poly first and
   // pass its origin for the high-poly and the cage.
   std::optional<glm::dvec3> origin = std::nullopt;
 };
+
+constexpr unsigned kMaxUvSets = 8;
 
 // A mesh whose largest coordinate exceeds kFarFactor times its bounding-box diagonal is loaded
 // re-centred (float would lose more than 4 bits of its precision there).

@@ -56,7 +56,8 @@ double unit_scale_to_metres(const aiScene& scene, const std::string& ext) {
 
 class SceneReader {
  public:
-  SceneReader(const std::string& path, const aiScene& scene, double scale) : path_(path), scene_(scene), scale_(scale) {
+  SceneReader(const std::string& path, const aiScene& scene, double scale, unsigned uv_set)
+      : path_(path), scene_(scene), scale_(scale), uv_set_(uv_set) {
     out_.unit_scale = scale;
     // Which attributes every mesh with faces has decides whether corners get UV or normal slots.
     bool any = false;
@@ -64,7 +65,7 @@ class SceneReader {
       const aiMesh& m = *scene.mMeshes[i];
       if (!(m.mPrimitiveTypes & (aiPrimitiveType_TRIANGLE | aiPrimitiveType_POLYGON))) continue;
       any = true;
-      out_.corner_uvs = out_.corner_uvs && m.HasTextureCoords(0);
+      out_.corner_uvs = out_.corner_uvs && m.HasTextureCoords(uv_set_);
       out_.corner_normals = out_.corner_normals && m.HasNormals();
     }
     if (!any) out_.corner_uvs = out_.corner_normals = false;
@@ -111,7 +112,7 @@ class SceneReader {
         if (length > 0.0 && std::isfinite(length)) w /= length;
         out_.mesh.normals.emplace_back(w);
       }
-      if (out_.corner_uvs) out_.mesh.uvs.emplace_back(m.mTextureCoords[0][v].x, m.mTextureCoords[0][v].y);
+      if (out_.corner_uvs) out_.mesh.uvs.emplace_back(m.mTextureCoords[uv_set_][v].x, m.mTextureCoords[uv_set_][v].y);
     }
     std::vector<Corner> corners;
     for (unsigned f = 0; f < m.mNumFaces; ++f) {
@@ -131,13 +132,15 @@ class SceneReader {
       if (out_.corner_uvs) ++out_.faces_with_uvs;
       if (out_.corner_normals) ++out_.faces_with_normals;
       if (!out_.corner_uvs && out_.first_face_without_uvs.empty())
-        out_.first_face_without_uvs = name + " face " + std::to_string(f);
+        out_.first_face_without_uvs =
+            name + " face " + std::to_string(f) + (uv_set_ ? " (UV set " + std::to_string(uv_set_) + ")" : "");
     }
   }
 
   const std::string& path_;
   const aiScene& scene_;
   const double scale_;
+  const unsigned uv_set_;
   ParsedMesh out_;
   std::unordered_map<glm::dvec3, std::uint32_t, PositionHash> weld_;
 };
@@ -149,7 +152,8 @@ bool assimp_reads(const std::string& ext) {
   return !ext.empty() && importer.IsExtensionSupported("." + ext);
 }
 
-ParsedMesh parse_assimp(const std::string& path, const std::string& ext, std::string_view bytes, bool read_path) {
+ParsedMesh parse_assimp(const std::string& path, const std::string& ext, std::string_view bytes, bool read_path,
+                        unsigned uv_set) {
   Assimp::Importer importer;
   // Points and lines are dropped by the reader; the scene is checked for indices out of range.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
@@ -165,7 +169,7 @@ ParsedMesh parse_assimp(const std::string& path, const std::string& ext, std::st
     fail(path, "cannot read as ." + ext + (why.empty() ? std::string() : ": " + why));
   }
   const double scale = unit_scale_to_metres(*scene, ext);
-  ParsedMesh parsed = SceneReader(path, *scene, scale).read();
+  ParsedMesh parsed = SceneReader(path, *scene, scale, uv_set).read();
   parsed.format = ext == "glb" || ext == "gltf" ? "gltf" : ext;
   return parsed;
 }

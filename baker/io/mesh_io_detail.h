@@ -52,7 +52,7 @@ ParsedMesh parse_off(const std::string& path, std::string_view text);
 ParsedMesh parse_stl(const std::string& path, std::string_view bytes);
 // Through Assimp (mesh_io_assimp.cpp): by `path` when `read_path` (a .gltf finds its .bin), else
 // from `bytes`, with `ext` (lower case, no dot) naming the format.
-ParsedMesh parse_assimp(const std::string& path, const std::string& ext, std::string_view bytes, bool read_path);
+ParsedMesh parse_assimp(const std::string& path, const std::string& ext, std::string_view bytes, bool read_path, unsigned uv_set);
 // Whether Assimp reads files with this extension (lower case, no dot).
 bool assimp_reads(const std::string& ext);
 
