@@ -322,18 +322,10 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
   const std::string temp = options.temp_path.empty() ? temp_path_for(target) : options.temp_path;
   const int fd = ::open(temp.c_str(), O_RDWR | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0666);
   if (fd < 0) fail_write(path, std::strerror(errno));
-  // The proxy's buffer is allocated here, not while libpng's C code calls it.
+  // Whatever ends the write early (an error, std::bad_alloc from the encoder or the proxy's buffer)
+  // closes the encoder before the proxy it writes to, and removes the temporary. The proxy is
+  // declared before the guard, so it is destroyed after it.
   std::optional<FileProxy> made;
-  try {
-    made.emplace(temp, fd);
-  } catch (...) {
-    ::close(fd);
-    ::unlink(temp.c_str());
-    throw;
-  }
-  FileProxy& proxy = *made;
-  // Whatever ends the write early (an error, std::bad_alloc from the encoder) closes the encoder
-  // before the proxy it writes to, and removes the temporary.
   bool open = true, kept = false;
   auto abandon = [&] {
     out.reset();
@@ -346,6 +338,8 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
     const std::function<void()> run;
     ~OnExit() { run(); }
   } on_exit{abandon};
+  made.emplace(temp, fd);  // its buffer allocated here, not while libpng's C code calls it
+  FileProxy& proxy = *made;
   // The first failure's reason: the system's for a failed write, else OpenImageIO's.
   auto discard = [&](const std::string& message, int err) {
     if (!err) err = proxy.failure();
