@@ -63,6 +63,7 @@ struct RuleContext {
   const HitRule* rule = nullptr;
   std::uint8_t outward[8] = {};
   float prefer_lo[8], prefer_hi[8];  // the preferred part of each ray
+  std::uint32_t group[8];            // each ray's group (HitRule::group)
   float backface_t[8];               // nearest back face passed over
   // The hit accepted so far: of hits at one distance (a ray through an edge), the lower triangle
   // index is kept, whichever Embree met first, so the hit does not depend on the BVH's shape.
@@ -87,6 +88,7 @@ struct RuleContext {
       accepted_prim[k] = no_hit;
       prefer_lo[k] = 0.0f;
       prefer_hi[k] = inf;
+      group[k] = 0;
       for (auto& kk : kept) kk[k] = {inf, 0.0f, 0.0f, 0.0f, no_hit};
     }
   }
@@ -107,6 +109,10 @@ struct RuleContext {
       if (args->valid[i] != -1) continue;
       const unsigned lane = RTCRayN_id(args->ray, n, i) & 7u;
       const std::uint32_t prim = RTCHitN_primID(args->hit, n, i);
+      if (rule.group && rule.group[prim] != rc.group[lane]) {  // not in this ray's scene
+        args->valid[i] = 0;
+        continue;
+      }
       // The low-poly's outside: -direction for inward rays, +direction for outward ones.
       const float side = rc.outward[lane] ? 1.0f : -1.0f;
       const glm::vec3 out(side * RTCRayN_dir_x(args->ray, n, i), side * RTCRayN_dir_y(args->ray, n, i),
@@ -270,10 +276,11 @@ Hit Scene::intersect(const Ray& ray) const {
   return h;
 }
 
-Hit Scene::intersect(const Ray& ray, const HitRule& rule, bool outward, std::uint8_t* flags, float prefer_lo,
-                     float prefer_hi) const {
+Hit Scene::intersect(const Ray& ray, const HitRule& rule, bool outward, std::uint8_t* flags, float prefer_lo, float prefer_hi,
+                     std::uint32_t group) const {
   RuleContext rc(&rule);
   rc.reset_lanes();
+  rc.group[0] = group;
   rc.outward[0] = outward;
   rc.prefer_lo[0] = prefer_lo;
   rc.prefer_hi[0] = prefer_hi;
@@ -339,6 +346,7 @@ void Scene::intersect(const RayBatch& rays, const HitBatch& hits, std::size_t co
         rc.outward[k] = rays.outward ? rays.outward[i] : 0;
         if (rays.prefer_lo) rc.prefer_lo[k] = rays.prefer_lo[i];
         if (rays.prefer_hi) rc.prefer_hi[k] = rays.prefer_hi[i];
+        if (rays.group) rc.group[k] = rays.group[i];
       }
     }
     rtcIntersect8(valid, impl_->scene, &rc.context, &rh);

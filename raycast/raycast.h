@@ -50,6 +50,8 @@ struct RayBatch {
   // then the one nearest to it (the part of a ray beyond a cage that a neighbouring part limits).
   const float* prefer_lo = nullptr;
   const float* prefer_hi = nullptr;
+  // For a HitRule with groups: per ray, its group (HitRule::group).
+  const std::uint32_t* group = nullptr;
 };
 // Their hits, the same way: triangle[i] is no_hit for a miss (t, u, v then unspecified).
 struct HitBatch {
@@ -77,10 +79,13 @@ struct HitBatch {
 // In order: a front-face hit inside the ray's preferred part (RayBatch::prefer_lo/hi), the first
 // along the ray; else one outside it, the nearest to it; else one whose normal points away. Of
 // hits at one distance (a ray through an edge) the lower triangle index is taken.
+// With group (per triangle) a ray sees only the triangles of its own group (RayBatch::group; a
+// single ray's is 0 unless given): the others are not there for it, as if in another scene.
 struct HitRule {
   const std::int8_t* facing = nullptr;  // per triangle, as above; null: +127 for all
   bool skip_backfaces = true;
   const glm::vec3* corner_normals = nullptr;  // 3 per triangle (any length), or null: no normal test
+  const std::uint32_t* group = nullptr;       // per triangle, or null: one group
 };
 
 // facing[t] for a triangle whose normals point to the side `sign` (+1 or -1) of its winding and
@@ -160,7 +165,7 @@ class Scene {
   void intersect(const RayBatch& rays, const HitBatch& hits, std::size_t count, const HitRule* rule = nullptr) const;
   // Single rays under a rule (`outward` as in RayBatch); `flags` receives the HitFlags when not null.
   Hit intersect(const Ray& ray, const HitRule& rule, bool outward = false, std::uint8_t* flags = nullptr, float prefer_lo = 0.0f,
-                float prefer_hi = std::numeric_limits<float>::infinity()) const;
+                float prefer_hi = std::numeric_limits<float>::infinity(), std::uint32_t group = 0) const;
 
   std::size_t triangle_count() const;
 

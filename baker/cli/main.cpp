@@ -97,6 +97,7 @@ struct Args {
   bool no_cull = false;
   bool keep_backfaces = false;
   bool estimate_error = false;
+  std::string match = "none", match_suffixes;  // --match, --match-suffixes
 };
 
 void parse_size(const std::string& text, int& w, int& h) {
@@ -163,6 +164,14 @@ void add_options(CLI::App& app, Args& a) {
   app.add_flag("--dither", a.dither,
                "8-bit output: add triangular noise of one step before rounding (no banding in fine gradients; the same "
                "map whatever the thread count)");
+  app.add_option("--match", a.match,
+                 "names: bake each low-poly object only from the high-poly objects of the same base name (arm_low from "
+                 "arm_high; objects: OBJ o/g, glTF/FBX/DAE nodes); an object without a match is left flat. none (default): "
+                 "every ray sees the whole high-poly")
+      ->check(CLI::IsMember({"none", "names"}));
+  app.add_option("--match-suffixes", a.match_suffixes,
+                 "With --match names: LOW:HIGH name suffixes, comma-separated, stripped to find the base name (default "
+                 "_low:_high,_lp:_hp; case-insensitive)");
   app.add_option("--padding", a.padding, "Edge padding around UV islands in texels (default 16)");
   app.add_option("--miss-mask", a.miss_mask, "Write an image of the share of missed rays per texel");
   app.add_option("--suspect-mask", a.suspect_mask,
@@ -215,6 +224,10 @@ BakeOptions bake_options(const Args& a) {
   o.suspect_mask = !a.suspect_mask.empty();
   o.cull_far = !a.no_cull;
   o.keep_backfaces = a.keep_backfaces;
+  if (!a.match_suffixes.empty()) {
+    if (a.match != "names") throw UsageError("--match-suffixes applies with --match names");
+    parse_match_suffixes(a.match_suffixes);  // a malformed list fails before the meshes load
+  }
   return o;
 }
 
@@ -446,10 +459,14 @@ int run(int argc, char** argv) {
   if (!a.cage.empty()) cage = load_mesh(a.cage, shared, &run.cage_info);
   const Mesh* cage_mesh = a.cage.empty() ? nullptr : &cage;
   run.seconds_load = std::chrono::duration<double>(Clock::now() - t0).count();
+  run.low_objects = object_list(low);
+  run.high_objects = object_list(high);
+  if (a.match == "names") run.match = match_by_names(run.low_objects, run.high_objects, a.match_suffixes, o);
   progress.above([&] {
     warnings.add(load_warnings(run.low_info, a.low));
     for (std::size_t i = 0; i < a.highs.size(); ++i) warnings.add(load_warnings(run.high_infos[i], a.highs[i]));
     if (cage_mesh) warnings.add(load_warnings(run.cage_info, a.cage));
+    warnings.add(match_warnings(run.match, run.low_objects, run.high_objects, a.low, a.high));
   });
   warnings.check_strict();  // before a long bake
   if (interrupted()) throw Cancelled();

@@ -95,6 +95,7 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
       {"threads", r.threads_used},
       {"cull", o.cull_far},
       {"keep_backfaces", o.keep_backfaces},
+      {"match", r.match.on ? "names" : "none"},
   };
   auto mesh_json = [](const MeshLoadInfo& info, std::size_t triangles) {
     return json{{"format", info.format},
@@ -170,6 +171,7 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
       {"largest_coordinate", s.largest_coordinate},
   };
   add_high_details(report, s, r);
+  add_objects_report(report, r.low_objects, r.high_objects, r.match, s);
   report["version"] = NMBAKE_VERSION;
   report["command"] = r.command;
   report["started"] = r.started;

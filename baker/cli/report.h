@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli/objects.h"
 #include "pipeline/bake.h"
 #include "core/mesh.h"
 #include "core/mesh_topology.h"
@@ -29,10 +30,12 @@ struct RunInfo {
   double seconds_load = 0, seconds_write = 0, seconds_total = 0;
   std::uint64_t peak_memory_bytes = 0;
   unsigned threads_used = 0;
-  std::vector<std::string> command;   // argv, as given
-  std::string started;                // UTC, "2026-11-25T03:04:05Z" (utc_time_text(report_time()))
-  std::vector<std::string> warnings;  // every warning line, "warning: ..." (printed or not)
-  std::array<double, 3> origin{};     // the point the meshes were re-centred on (Mesh::origin), 0 when not
+  std::vector<std::string> command;      // argv, as given
+  std::string started;                   // UTC, "2026-11-25T03:04:05Z" (utc_time_text(report_time()))
+  std::vector<std::string> warnings;     // every warning line, "warning: ..." (printed or not)
+  std::array<double, 3> origin{};        // the point the meshes were re-centred on (Mesh::origin), 0 when not
+  ObjectList low_objects, high_objects;  // every object of the low-poly and of the high-poly files
+  MatchInfo match;                       // --match
 };
 
 const char* to_string(RayPolicy p);

@@ -34,9 +34,22 @@ struct Mesh {
   // Face number in the file for each triangle (a polygon's fan triangles share it), for messages.
   std::vector<std::uint32_t> source_face;
 
+  // The named parts of the mesh: an OBJ file's objects (`o`, or `g` in a file without `o`), a
+  // glTF, FBX or DAE node's meshes; a file without names is one object named after the file.
+  // Objects of several files merged (merge_meshes) keep their file. triangle_object[t] is triangle
+  // t's object, or empty when there is one object (every triangle then is object 0).
+  struct Object {
+    std::string name;
+    std::string file;
+  };
+  std::vector<Object> objects;
+  std::vector<std::uint32_t> triangle_object;
+
   std::size_t triangle_count() const { return position_index.size() / 3; }
   bool has_normals() const { return !normal_index.empty(); }
   bool has_uvs() const { return !uv_index.empty(); }
+  std::uint32_t object_of(std::size_t tri) const { return triangle_object.empty() ? 0u : triangle_object[tri]; }
+  std::size_t object_count() const { return objects.empty() ? 1 : objects.size(); }
 
   glm::vec3 corner_position(std::size_t tri, int corner) const { return positions[position_index[3 * tri + corner]]; }
   glm::vec2 corner_uv(std::size_t tri, int corner) const { return uvs[uv_index[3 * tri + corner]]; }

@@ -76,7 +76,12 @@ Mesh merge_meshes(std::vector<Mesh> meshes) {
       for (std::uint32_t i : m.uv_index) out.uv_index.push_back(u0 + i);
     }
     out.source_face.insert(out.source_face.end(), m.source_face.begin(), m.source_face.end());
+    const auto o0 = std::uint32_t(out.objects.size());
+    if (m.objects.empty()) out.objects.push_back({m.source, m.source});
+    out.objects.insert(out.objects.end(), m.objects.begin(), m.objects.end());
+    for (std::size_t t = 0; t < m.triangle_count(); ++t) out.triangle_object.push_back(o0 + m.object_of(t));
   }
+  if (out.objects.size() == 1) out.triangle_object.clear();
   return out;
 }
 

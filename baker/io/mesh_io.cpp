@@ -122,6 +122,28 @@ ParsedMesh parse_by_extension(const std::string& path, const std::string& ext, s
   return mesh_io_detail::parse_stl(path, bytes);
 }
 
+// The objects as the bake reads them (Mesh::objects): every one named (the unnamed first one after
+// the file), each with triangles, and triangle_object only when there are two or more.
+void settle_objects(ParsedMesh& parsed, const std::string& path) {
+  Mesh& m = parsed.mesh;
+  std::string stem = path.substr(path.find_last_of('/') + 1);
+  if (const auto dot = stem.find_last_of('.'); dot != std::string::npos && dot > 0) stem.resize(dot);
+  if (m.objects.empty()) m.objects.push_back({});
+  std::vector<std::size_t> triangles(m.objects.size(), 0);
+  if (m.triangle_object.empty()) triangles[0] = m.triangle_count();
+  for (std::uint32_t k : m.triangle_object) ++triangles[k];
+  std::vector<std::uint32_t> renumber(m.objects.size(), 0);
+  std::vector<Mesh::Object> kept;
+  for (std::size_t k = 0; k < m.objects.size(); ++k) {
+    if (triangles[k] == 0) continue;
+    renumber[k] = std::uint32_t(kept.size());
+    kept.push_back({m.objects[k].name.empty() ? stem : m.objects[k].name, path});
+  }
+  m.objects = std::move(kept);
+  if (m.objects.size() == 1) m.triangle_object.clear();
+  for (std::uint32_t& k : m.triangle_object) k = renumber[k];
+}
+
 // Keeps UVs only when every face has them.
 void settle_uvs(ParsedMesh& parsed, const std::string& path, const LoadOptions& options, MeshLoadInfo& info) {
   Mesh& m = parsed.mesh;
@@ -229,6 +251,7 @@ Mesh finish_mesh(ParsedMesh parsed, const std::string& path, const LoadOptions& 
   info.unit_scale = parsed.unit_scale;
   settle_uvs(parsed, path, options, info);
   settle_normals(parsed, info);
+  settle_objects(parsed, path);
   place(parsed, path, options, info);
   parsed.mesh.source = path;
   return std::move(parsed.mesh);

@@ -8,6 +8,8 @@
 // from the file's <unit>; MeshLoadInfo::unit_scale says what was applied. Positions equal after
 // placing are welded (Assimp splits a vertex at every seam and hard edge), normals and UVs stay
 // per corner, so hard edges and seams are kept as in an OBJ file. Points and lines are left out.
+// Each node with meshes is an object named after the node (Mesh::objects); a node name met twice
+// is one object.
 #include <assimp/Importer.hpp>
 #include <assimp/config.h>
 #include <assimp/postprocess.h>
@@ -84,6 +86,11 @@ class SceneReader {
     const glm::dmat4 world = parent * to_glm(node.mTransformation);
     for (unsigned i = 0; i < node.mNumMeshes; ++i) {
       if (node.mMeshes[i] >= scene_.mNumMeshes) fail(path_, "node '" + std::string(node.mName.C_Str()) + "' names no mesh");
+      // A node's meshes (one per material) are one object, named after the node (or its first mesh).
+      if (i == 0) {
+        const std::string mesh_name = scene_.mMeshes[node.mMeshes[0]]->mName.C_Str();
+        start_object(out_, node.mName.length ? std::string(node.mName.C_Str()) : mesh_name);
+      }
       add_mesh(*scene_.mMeshes[node.mMeshes[i]], world);
     }
     for (unsigned i = 0; i < node.mNumChildren; ++i) visit(*node.mChildren[i], world, depth + 1);

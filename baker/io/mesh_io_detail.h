@@ -15,6 +15,7 @@
 #include <cstring>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 #include "core/errors.h"
@@ -41,7 +42,33 @@ struct ParsedMesh {
   std::string first_face_without_uvs;  // "line 40: face 3" or "face 0", for the require_uvs message
   std::size_t degenerate_faces_dropped = 0;
   double unit_scale = 1.0;  // see MeshLoadInfo::unit_scale
+  // The object triangles are added to (Mesh::objects); by name, for a name met again.
+  std::uint32_t object = 0;
+  bool per_triangle_objects = false;  // mesh.triangle_object is being filled
+  std::unordered_map<std::string, std::uint32_t> object_by_name;
 };
+
+// Triangles added from now on belong to the object `name` (met again: the same object). A name
+// given before any triangle names the first object; objects that end up without triangles are
+// dropped when the mesh is finished (settle_objects).
+inline void start_object(ParsedMesh& out, const std::string& name) {
+  Mesh& m = out.mesh;
+  if (m.objects.empty()) {
+    if (m.source_face.empty()) {
+      m.objects.push_back({name, {}});
+      out.object_by_name.emplace(name, 0);
+      return;
+    }
+    m.objects.push_back({});  // the triangles before the first name: named after the file
+  }
+  const auto [it, added] = out.object_by_name.try_emplace(name, std::uint32_t(m.objects.size()));
+  if (added) m.objects.push_back({name, {}});
+  if (!out.per_triangle_objects && it->second != 0) {
+    out.per_triangle_objects = true;
+    m.triangle_object.assign(m.source_face.size(), 0);
+  }
+  out.object = it->second;
+}
 
 // Throws InputError("<path>: <problem>").
 [[noreturn]] inline void fail(const std::string& path, const std::string& problem) { throw InputError(path + ": " + problem); }
@@ -80,6 +107,7 @@ inline void add_polygon(ParsedMesh& out, const Corner* corners, std::size_t n, s
       if (out.corner_normals) m.normal_index.push_back(corners[k][2]);
     }
     m.source_face.push_back(face);
+    if (out.per_triangle_objects) m.triangle_object.push_back(out.object);
   };
   if (n <= kMaxFanCorners) {
     for (std::size_t i = 1; i + 1 < n; ++i) triangle(0, i, i + 1);

@@ -1,5 +1,6 @@
-// Wavefront OBJ reader: v, vt, vn and f lines; every other statement (o, g, s, usemtl, mtllib, l,
-// p, free-form curves, ...) is ignored. One pass over the text in memory, no iostreams.
+// Wavefront OBJ reader: v, vt, vn and f lines, and objects by o (or, in a file without o, by g);
+// every other statement (s, usemtl, mtllib, l, p, free-form curves, ...) is ignored. One pass over the text in memory, no
+// iostreams.
 //
 // Accepted: v, v/vt, v//vn, v/vt/vn corners; negative (relative) indices; tabs and repeated
 // spaces; CRLF; a last line without newline; '\' line continuation; '#' comments; extra values
@@ -52,6 +53,7 @@ class ObjParser {
   std::size_t line_ = 0;
   std::uint32_t face_number_ = 0;  // 0-based count of f statements so far
   std::vector<Corner> corners_;
+  bool named_by_o_ = false;  // an `o` was met: `g` no longer names objects
 
   // The largest positive index seen per attribute and its line, checked once the totals are known.
   long long max_index_[3] = {0, 0, 0};
@@ -194,6 +196,13 @@ void ObjParser::parse_line(std::string_view line, std::size_t line_number) {
     parse_normal(line, pos);
   } else if (keyword == "f" || keyword == "fo") {  // "fo" is the obsolete spelling of "f"
     parse_face(line, pos);
+  } else if (keyword == "o" || (keyword == "g" && !named_by_o_)) {
+    // Objects by `o`; in a file without `o` (Maya, 3ds Max), by group.
+    named_by_o_ = named_by_o_ || keyword == "o";
+    std::string_view name = line.substr(std::min(pos, line.size()));
+    while (!name.empty() && is_space(name.front())) name.remove_prefix(1);
+    while (!name.empty() && is_space(name.back())) name.remove_suffix(1);
+    if (!name.empty()) start_object(out_, std::string(name.substr(0, 256)));
   }
 }
 

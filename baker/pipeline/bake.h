@@ -48,6 +48,8 @@ constexpr double kSuspectTiltDeg = 85.0;
 constexpr double kSuspectAgreement = 0.8;
 constexpr double kSuspectShareWarn = 0.005;
 constexpr double kMixedShare = 0.2;
+// BakeOptions::low_object_group: a low-poly object matched to no high-poly object.
+constexpr std::uint32_t kNoMatch = 0xffffffffu;
 
 struct BakeOptions {
   int width = 2048;     // map width in texels
@@ -74,6 +76,11 @@ struct BakeOptions {
   // Bytes the bake's buffers may take (estimate_bake_bytes); 0 = what the machine has
   // (memory_budget_bytes: MemAvailable, cgroup limit, ulimit -v). Larger bakes are refused.
   std::uint64_t memory_limit = 0;
+  // Matching (--match names): per object of the low-poly and of the high-poly (Mesh::objects), its
+  // group. A low-poly object's rays see only the high-poly objects of its group; one in kNoMatch
+  // casts no ray and is written flat (counted in BakeStats::samples_unmatched). Empty: no matching,
+  // every ray sees the whole high-poly. The probes that measure the distances see all of it.
+  std::vector<std::uint32_t> low_object_group, high_object_group;
   // Called from the calling thread with the fraction done in [0,1]; return false to cancel
   // (bake_normal_map then throws Cancelled).
   std::function<bool(double)> progress;
@@ -150,6 +157,12 @@ struct BakeStats {
   // Seconds per stage.
   double seconds_prepare = 0, seconds_bvh = 0, seconds_distances = 0, seconds_trace = 0, seconds_padding = 0;
   double cpu_seconds_trace = 0;  // process CPU time of the trace stage (all threads)
+  // Per object (Mesh::objects order): the covered samples of each low-poly object and how many of
+  // them hit, and the hits on each high-poly object.
+  std::vector<std::uint64_t> low_object_samples, low_object_hits, high_object_hits;
+  // Covered samples of low-poly objects without a match (BakeOptions::low_object_group): written
+  // flat, no ray cast; they count as neither hits nor misses.
+  std::uint64_t samples_unmatched = 0;
 };
 
 struct BakeResult {

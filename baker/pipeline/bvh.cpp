@@ -11,6 +11,8 @@ void build_high_scene(HighScene& h, const Prepared& s, const Mesh& high, const s
   h.kept_index.clear();
   h.kept_normals.clear();
   h.kept_facing.clear();
+  h.kept_object.clear();
+  h.object = high.triangle_object.empty() ? nullptr : high.triangle_object.data();
   if (!kept.empty()) {
     std::vector<std::uint32_t> index(3 * kept.size());
     std::vector<glm::vec3> normals(3 * kept.size());
@@ -28,11 +30,46 @@ void build_high_scene(HighScene& h, const Prepared& s, const Mesh& high, const s
     h.index = h.kept_index.data();
     h.normals = h.kept_normals.data();
     h.facing = h.kept_facing.data();
+    if (h.object) {
+      h.kept_object.resize(kept.size());
+      for (std::size_t i = 0; i < kept.size(); ++i) h.kept_object[i] = high.triangle_object[kept[i]];
+      h.object = h.kept_object.data();
+    }
   }
   h.triangles = kept.empty() ? high.triangle_count() : kept.size();
   h.quality = quality;
   h.scene.reset();
   h.scene.emplace(&s.high_pos[0].x, s.high_pos.size(), h.index, h.triangles, quality, threads);
+}
+
+RayGroups ray_groups(const Prepared& s, const HighScene& h, const BakeOptions& opt) {
+  RayGroups g;
+  if (opt.low_object_group.empty()) return g;
+  auto group_of = [](const std::vector<std::uint32_t>& groups, std::uint32_t object) {
+    return object < groups.size() ? groups[object] : kNoMatch;
+  };
+  g.low.resize(s.low_tris.size());
+  for (std::size_t t = 0; t < g.low.size(); ++t) g.low[t] = group_of(opt.low_object_group, s.low_object ? s.low_object[t] : 0u);
+  g.high.resize(h.triangles);
+  // A high-poly object without a match is in no group, not even that of the unmatched low-poly rays.
+  for (std::size_t t = 0; t < g.high.size(); ++t) {
+    const std::uint32_t k = group_of(opt.high_object_group, h.object ? h.object[t] : 0u);
+    g.high[t] = k == kNoMatch ? kNoMatch - 1 : k;
+  }
+  return g;
+}
+
+const raycast::HitRule* trace_rule(const HighScene& h, bool backfaces_skipped, const RayGroups& groups, raycast::HitRule& rule) {
+  if (backfaces_skipped) {
+    rule = h.hit_rule();
+  } else if (groups.active()) {
+    rule = raycast::HitRule{};
+    rule.skip_backfaces = false;
+  } else {
+    return nullptr;
+  }
+  rule.group = groups.active() ? groups.high.data() : nullptr;
+  return &rule;
 }
 
 void turn_inverted_high(Prepared& s, HighScene& h, bool normals_computed) {

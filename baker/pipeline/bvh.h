@@ -28,6 +28,9 @@ struct HighScene {
   std::vector<std::uint32_t> kept_index;
   std::vector<glm::vec3> kept_normals;
   std::vector<std::int8_t> kept_facing;
+  // Per BVH triangle, its high-poly object (Mesh::triangle_object), or null: one object.
+  const std::uint32_t* object = nullptr;
+  std::vector<std::uint32_t> kept_object;
 
   // The rule the trace applies to hits (raycast::HitRule) over these triangles.
   raycast::HitRule hit_rule() const {
@@ -37,6 +40,19 @@ struct HighScene {
     return rule;
   }
 };
+
+// The match groups of a bake (BakeOptions::low_object_group, high_object_group) as rays and hits
+// read them: per low-poly triangle and per BVH triangle; both empty without matching.
+struct RayGroups {
+  std::vector<std::uint32_t> low, high;
+  bool active() const { return !low.empty(); }
+};
+RayGroups ray_groups(const Prepared& s, const HighScene& h, const BakeOptions& opt);
+
+// The rule the trace casts under, or null for none: h.hit_rule() when back faces are skipped
+// (BakeStats::backfaces_skipped); with match groups, the groups too (alone when back faces are
+// kept). `rule` holds it.
+const raycast::HitRule* trace_rule(const HighScene& h, bool backfaces_skipped, const RayGroups& groups, raycast::HitRule& rule);
 
 // Builds (or rebuilds) `h` over the high-poly triangles `kept` (increasing; empty: all of them).
 void build_high_scene(HighScene& h, const Prepared& s, const Mesh& high, const std::vector<std::uint32_t>& kept,

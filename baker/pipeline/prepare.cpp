@@ -141,6 +141,9 @@ void set_cage_reach(Prepared& s, const Mesh& low, double rear, const std::vector
 // Everything the rays and the shading read, from the meshes (prepare.h).
 Prepared prepare(const Mesh& low, const Mesh& high, const Mesh* cage, BakeStats& st) {
   Prepared s;
+  s.low_object = low.triangle_object.empty() ? nullptr : low.triangle_object.data();
+  s.low_objects = low.object_count();
+  s.high_objects = high.object_count();
   s.frames = compute_tangent_frames(low);
   st.degenerate_uv_triangles = s.frames.degenerate_uv_triangles;
   st.degenerate_3d_triangles = s.frames.degenerate_3d_triangles;

@@ -36,6 +36,10 @@ struct Prepared {
   TangentFrames frames;
   std::vector<LowTriangle> low_tris;
   std::vector<CageTriangle> cage_tris;  // per low-poly triangle, with a cage (attach_cage, set_cage_reach)
+  // Per low-poly triangle its object (Mesh::triangle_object), or null: one object; the objects of
+  // each mesh.
+  const std::uint32_t* low_object = nullptr;
+  std::size_t low_objects = 1, high_objects = 1;
 };
 
 // Fills the stats it learns on the way: degenerate counts, centre, coordinate precision, computed

@@ -34,8 +34,9 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
   HighScene scene;
   build_high_scene(scene, s, high, {}, raycast::BuildQuality::low, opt.threads);
   if (st.high_facing == BakeStats::HighFacing::inverted) turn_inverted_high(s, scene, scratch.high_normals_computed);
-  const raycast::HitRule rule = scene.hit_rule();
-  const raycast::HitRule* const hit_rule = st.backfaces_skipped ? &rule : nullptr;
+  const RayGroups groups = ray_groups(s, scene, opt);
+  raycast::HitRule rule;
+  const raycast::HitRule* const hit_rule = trace_rule(scene, st.backfaces_skipped, groups, rule);
   RaySetup ray_setup;
   ray_setup.front = st.front;
   ray_setup.rear = st.rear;
@@ -66,8 +67,12 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
     raycast::RayBatch ray_batch = arrays.rays();
     ray_batch.outward = outward.empty() ? nullptr : outward.data();
     std::vector<float> prefer_lo(arrays.size()), prefer_hi(arrays.size());
-    ray_batch.prefer_lo = prefer_lo.data();
-    ray_batch.prefer_hi = prefer_hi.data();
+    if (st.backfaces_skipped) {
+      ray_batch.prefer_lo = prefer_lo.data();
+      ray_batch.prefer_hi = prefer_hi.data();
+    }
+    std::vector<std::uint32_t> ray_group(groups.active() ? arrays.size() : 0);  // unmatched: kNoMatch, no hit
+    if (groups.active()) ray_batch.group = ray_group.data();
     std::vector<double> signed_base(arrays.size());
     for (std::size_t i0; (i0 = next.fetch_add(kChunk)) < texels.size();) {
       const std::size_t i1 = std::min(texels.size(), i0 + kChunk);
@@ -93,6 +98,7 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
           arrays.set(i, one[j]);
           prefer_lo[i] = lo[j];
           prefer_hi[i] = hi[j];
+          if (groups.active()) ray_group[i] = groups.low[work[r].tri];
         }
       }
       const std::size_t ray_count = work.size() * std::size_t(rays_per_sample);

@@ -23,8 +23,10 @@ constexpr double kSnap = 1e-6;
 
 // One cache line each: the counters change per sample, and shared lines would serialize threads.
 struct alignas(64) ThreadStats {
-  std::uint64_t rays = 0, hits = 0, misses = 0, covered = 0, overlaps = 0, backface_skips = 0, facing_away = 0;
+  std::uint64_t rays = 0, hits = 0, misses = 0, covered = 0, overlaps = 0, backface_skips = 0, facing_away = 0, unmatched = 0;
   double dmin = std::numeric_limits<double>::infinity(), dmax = -std::numeric_limits<double>::infinity();
+  // Per object, with several (BakeStats::low_object_samples, ...).
+  std::vector<std::uint64_t> low_samples, low_hits, high_hits;
 };
 
 // What every thread of the trace reads, and the state they share.
@@ -40,7 +42,15 @@ struct Shared {
         offsets(sample_offsets(opt_.samples)),
         rays_per_sample(setup_.closest ? 2 : 1),
         batched(opt_.space == NormalSpace::tangent && opt_.bitangent == BitangentMode::per_pixel),
-        stats(std::size_t(threads)) {}
+        per_object(s_.low_objects > 1 || s_.high_objects > 1),
+        stats(std::size_t(threads)) {
+    if (per_object)
+      for (ThreadStats& ts : stats) {
+        ts.low_samples.assign(s.low_objects, 0);
+        ts.low_hits.assign(s.low_objects, 0);
+        ts.high_hits.assign(s.high_objects, 0);
+      }
+  }
   const Prepared& s;
   const HighScene& scene;
   const TileBins& bins;
@@ -49,8 +59,11 @@ struct Shared {
   const TraceTargets& out;
   std::vector<glm::dvec2> offsets;
   int rays_per_sample = 1;
-  bool batched = false;  // tangent space, per-pixel bitangent: shade_batch.h shades most samples
+  bool batched = false;     // tangent space, per-pixel bitangent: shade_batch.h shades most samples
+  bool per_object = false;  // several objects: hits counted per object
   const raycast::HitRule* hit_rule = nullptr;
+  bool prefer = false;  // the rule looks at the rays' preferred parts (back faces skipped)
+  RayGroups groups;     // with --match: per low-poly triangle and BVH triangle
   std::vector<ThreadStats> stats;
   // Hit distances summed per tile, then over tiles in order: the mean does not depend on which
   // thread took which tile.
@@ -106,8 +119,14 @@ class TileTracer {
     if (sh.setup.cage) {
       prefer_lo_.assign(rays_.size(), 0.0f);
       prefer_hi_.assign(rays_.size(), 0.0f);
-      batch_.prefer_lo = prefer_lo_.data();
-      batch_.prefer_hi = prefer_hi_.data();
+      if (sh.prefer) {
+        batch_.prefer_lo = prefer_lo_.data();
+        batch_.prefer_hi = prefer_hi_.data();
+      }
+    }
+    if (sh.groups.active()) {
+      ray_group_.assign(rays_.size(), 0);
+      batch_.group = ray_group_.data();
     }
     // Every default-policy ray starts at 0 and reaches front + rear (sample_rays' too).
     if (default_rays_) std::fill(rays_.tfar(), rays_.tfar() + rays_.size(), sh.setup.front + sh.setup.rear);
@@ -152,8 +171,10 @@ class TileTracer {
     const std::size_t sample_count = cover_tile(tile, rect);
     const std::size_t ray_count = sample_count * std::size_t(sh_.rays_per_sample);
     make_rays(sample_count);
+    if (sh_.groups.active()) set_groups(sample_count);
     if (ray_count) {
       sh_.scene.scene->intersect(batch_, hits_, ray_count, sh_.hit_rule);
+      for (const auto& [i, tnear] : unmatched_) rays_.tnear()[i] = tnear;
       if (sh_.hit_rule)
         for (std::size_t r = 0; r < ray_count; ++r) ts_.backface_skips += (hits_.flags[r] & raycast::hit_passed_backface) != 0;
     }
@@ -224,11 +245,28 @@ class TileTracer {
     }
   }
 
+  // Each ray's match group; the rays of unmatched objects are cast empty (tnear past tfar, put
+  // back after the cast).
+  void set_groups(std::size_t sample_count) {
+    const std::size_t per = std::size_t(sh_.rays_per_sample);
+    unmatched_.clear();
+    for (std::size_t r = 0; r < sample_count; ++r) {
+      const std::uint32_t g = sh_.groups.low[std::size_t(sample_tri_[r])];
+      for (std::size_t j = 0; j < per; ++j) {
+        const std::size_t i = r * per + j;
+        ray_group_[i] = g;
+        if (g != kNoMatch) continue;
+        unmatched_.emplace_back(i, rays_.tnear()[i]);
+        rays_.tnear()[i] = std::numeric_limits<float>::infinity();
+      }
+    }
+  }
+
   // In sample order, which ray's hit counts and the hit statistics. Returns the tile's sum of hit
   // distances.
   double count_hits(std::size_t sample_count) {
     std::fill(miss_count_.begin(), miss_count_.end(), 0u);
-    std::size_t tile_hits = 0;
+    std::size_t tile_hits = 0, unmatched = 0;
     // In registers for the tile: the stores below could alias the thread's counters.
     double dsum = 0.0, dmin = ts_.dmin, dmax = ts_.dmax;
     const std::size_t per = std::size_t(sh_.rays_per_sample);
@@ -240,6 +278,19 @@ class TileTracer {
         chosen_tri_[r] = hits_.triangle[h];
         chosen_u_[r] = hits_.u[h];
         chosen_v_[r] = hits_.v[h];
+      }
+      const std::size_t tri = std::size_t(sample_tri_[r]);
+      if (sh_.per_object) {
+        const std::uint32_t lo = sh_.s.low_object ? sh_.s.low_object[tri] : 0u;
+        ++ts_.low_samples[lo];
+        if (hits_.triangle[h] != raycast::no_hit) {
+          ++ts_.low_hits[lo];
+          ++ts_.high_hits[sh_.scene.object ? sh_.scene.object[hits_.triangle[h]] : 0u];
+        }
+      }
+      if (sh_.groups.active() && sh_.groups.low[tri] == kNoMatch) {
+        ++unmatched;
+        continue;
       }
       if (hits_.triangle[h] != raycast::no_hit) {
         if (sh_.hit_rule) ts_.facing_away += (hits_.flags[h] & raycast::hit_normal_disagrees) != 0;
@@ -258,7 +309,8 @@ class TileTracer {
     }
     ts_.covered += sample_count;
     ts_.hits += tile_hits;
-    ts_.misses += sample_count - tile_hits;
+    ts_.misses += sample_count - tile_hits - unmatched;
+    ts_.unmatched += unmatched;
     ts_.dmin = dmin;
     ts_.dmax = dmax;
     return dsum;
@@ -326,6 +378,8 @@ class TileTracer {
   raycast::RayBatch batch_;
   std::vector<std::uint8_t> outward_;
   std::vector<float> prefer_lo_, prefer_hi_;
+  std::vector<std::uint32_t> ray_group_;                  // with --match: per ray
+  std::vector<std::pair<std::size_t, float>> unmatched_;  // rays cast empty, and their tnear
   std::vector<std::int32_t> sample_tri_;
   std::vector<double> sample_b_;
   double* sb_[3];
@@ -403,6 +457,25 @@ void run_tracers(Shared& sh, int threads) {
   if (sh.opt.progress) sh.opt.progress(1.0);
 }
 
+// BakeStats' per-object counts: summed over the threads, or with one object each the totals.
+void count_per_object(const Shared& sh, BakeStats& st) {
+  st.low_object_samples.assign(sh.s.low_objects, 0);
+  st.low_object_hits.assign(sh.s.low_objects, 0);
+  st.high_object_hits.assign(sh.s.high_objects, 0);
+  if (!sh.per_object) {
+    st.low_object_samples[0] = st.samples_covered;
+    st.low_object_hits[0] = st.high_object_hits[0] = st.hits;
+    return;
+  }
+  for (const ThreadStats& ts : sh.stats) {
+    for (std::size_t k = 0; k < ts.low_samples.size(); ++k) {
+      st.low_object_samples[k] += ts.low_samples[k];
+      st.low_object_hits[k] += ts.low_hits[k];
+    }
+    for (std::size_t k = 0; k < ts.high_hits.size(); ++k) st.high_object_hits[k] += ts.high_hits[k];
+  }
+}
+
 }  // namespace
 
 std::vector<raycast::Ray> trace_rays(const Prepared& s, const HighScene& scene, const TileBins& bins, const RaySetup& rays,
@@ -419,8 +492,10 @@ std::vector<raycast::Ray> trace_rays(const Prepared& s, const HighScene& scene, 
 void trace_and_shade(const Prepared& s, const HighScene& scene, const TileBins& bins, const RaySetup& rays,
                      const BakeOptions& opt, int threads, const TraceTargets& out, BakeStats& st) {
   Shared sh(s, scene, bins, rays, opt, out, threads);
-  const raycast::HitRule rule = scene.hit_rule();
-  sh.hit_rule = st.backfaces_skipped ? &rule : nullptr;
+  sh.groups = ray_groups(s, scene, opt);
+  raycast::HitRule rule;
+  sh.hit_rule = trace_rule(scene, st.backfaces_skipped, sh.groups, rule);
+  sh.prefer = st.backfaces_skipped;
   sh.tile_dsum.assign(bins.count(), 0.0);
   run_tracers(sh, threads);
 
@@ -433,6 +508,7 @@ void trace_and_shade(const Prepared& s, const HighScene& scene, const TileBins& 
     total.overlaps += ts.overlaps;
     total.backface_skips += ts.backface_skips;
     total.facing_away += ts.facing_away;
+    total.unmatched += ts.unmatched;
     total.dmin = std::min(total.dmin, ts.dmin);
     total.dmax = std::max(total.dmax, ts.dmax);
   }
@@ -443,6 +519,8 @@ void trace_and_shade(const Prepared& s, const HighScene& scene, const TileBins& 
   st.overlapping_samples = total.overlaps;
   st.backface_skips = total.backface_skips;
   st.hits_facing_away = total.facing_away;
+  st.samples_unmatched = total.unmatched;
+  count_per_object(sh, st);
   if (total.hits) {
     st.hit_distance_min = total.dmin;
     st.hit_distance_max = total.dmax;
