@@ -50,7 +50,7 @@ void Progress::stage(const char* name, bool tick) {
   if (!enabled_) return;
   std::lock_guard<std::mutex> lock(mutex_);
   if (stopped_) return;
-  stage_ = name;
+  stage_ = label_ + name;
   fraction_ = -1.0;
   last_percent_ = -1;
   ticking_ = tick;
@@ -88,6 +88,20 @@ void Progress::finish() {
   }
   wake_.notify_all();
   if (ticker_.joinable()) ticker_.join();
+}
+
+void Progress::hold() {
+  if (!enabled_) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (stopped_) return;
+  clear();
+  stage_.clear();
+  ticking_ = false;
+}
+
+void Progress::label(const std::string& text) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  label_ = text;
 }
 
 void Progress::draw(Clock::time_point now) {

@@ -39,6 +39,10 @@ class Progress {
   void above(const std::function<void()>& print);
   // Clears the line and stops redrawing it, before the summary.
   void finish();
+  // Clears the line until the next stage (a batch's job done, before its summary line).
+  void hold();
+  // Put before every stage's name from now on ("job 3 of 20: "; a batch's one line).
+  void label(const std::string& text);
 
  private:
   void draw(Clock::time_point now);  // with mutex_ held
@@ -50,7 +54,7 @@ class Progress {
   const std::function<bool()> cancelled_;
   std::mutex mutex_;
   std::condition_variable wake_;
-  std::string stage_;
+  std::string stage_, label_;
   double fraction_ = -1.0;
   bool ticking_ = false, stopped_ = false;
   Clock::time_point stage_start_;

@@ -1,0 +1,55 @@
+// The nmbake command's arguments: the options, their help text, and their translation into the
+// library's BakeOptions. A batch file's jobs (batch.h) go through the same parser.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "pipeline/bake.h"
+
+namespace nmbake {
+
+// The exit codes, as --help lists them.
+extern const char* kExitCodes;
+
+struct Args {
+  std::string low, high, output, cage, miss_mask, report, save_cage, suspect_mask;
+  std::vector<std::string> highs;  // every HIGH given; `high` names them in messages
+  std::string size = "2048";
+  int samples = 1;
+  double front = -1.0, rear = -1.0;
+  bool front_given = false, rear_given = false;  // set after parsing: a distance given is never "auto"
+  std::string policy = "cage-first", space = "tangent", green = "up", bitangent = "pixel";
+  int bits = 0;
+  std::string compression;  // --compression: EXR only
+  unsigned uv_set = 0;
+  bool dither = false;
+  int padding = 16;
+  int threads = 0;
+  int quiet = 0;  // times --quiet was given
+  bool no_warnings = false, strict = false, progress = false;
+  bool no_cull = false;
+  bool keep_backfaces = false;
+  bool estimate_error = false;
+  std::string match = "none", match_suffixes;  // --match, --match-suffixes
+};
+
+// The command line's options on `app`, with their help text.
+void add_options(CLI::App& app, Args& a);
+
+// What parsing leaves to be set from `app`: `high` (for messages) and whether --front and --rear
+// were given.
+void finish_args(Args& a, const CLI::App& app);
+
+// The library's options from the flags: translation only (validate_options checks them).
+BakeOptions bake_options(const Args& a);
+
+// Fails early, before a long bake, on outputs that cannot be written.
+void check_outputs(const Args& a, int bits);
+
+// 1234567 as "1.23M".
+std::string human(double v);
+
+}  // namespace nmbake

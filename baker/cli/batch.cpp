@@ -1,0 +1,277 @@
+#include "cli/batch.h"
+
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <set>
+
+#include <unistd.h>
+
+#include <cerrno>
+
+#include "cli/job.h"
+#include "cli/outputs.h"
+#include "cli/progress.h"
+#include "core/errors.h"
+#include "io/text_file.h"
+#include "pipeline/bake.h"
+
+namespace nmbake {
+
+namespace {
+
+// Options whose value is a file: made relative to the jobs file's folder.
+const std::set<std::string> kPathOptions = {"cage", "report", "miss-mask", "suspect-mask", "save-cage"};
+// Keys a job's options may not hold: they are the job's own fields, or the batch's.
+const std::set<std::string> kJobFields = {"low", "high", "highs", "output", "o", "batch", "help", "h", "version"};
+
+std::string resolve(const std::string& dir, const std::string& path) {
+  if (dir.empty() || path.empty() || path.front() == '/') return path;
+  return (std::filesystem::path(dir) / path).string();
+}
+
+std::string job_name(const std::string& path, std::size_t index) { return path + ": job " + std::to_string(index); }
+
+// A string field of a job (or of an option), else UsageError naming it.
+std::string text_of(const nlohmann::json& v, const std::string& where) {
+  if (v.is_string() && !v.get<std::string>().empty()) return v.get<std::string>();
+  throw UsageError(where + " must be a non-empty string, got " + v.dump());
+}
+
+// An option's value as command-line words: a flag is given when true; numbers as JSON writes them.
+void add_option(std::vector<std::string>& argv, const std::string& key, const nlohmann::json& v, const std::string& dir,
+                const std::string& where) {
+  if (kJobFields.count(key)) throw UsageError(where + ": \"" + key + "\" is not an option (a job's own field, or the batch's)");
+  if (key.empty() || key.front() == '-') throw UsageError(where + ": option \"" + key + "\": give it without dashes");
+  const std::string flag = "--" + key;
+  if (v.is_boolean()) {
+    if (v.get<bool>()) argv.push_back(flag);
+  } else if (v.is_number_integer() || v.is_number_float()) {
+    argv.push_back(flag);
+    argv.push_back(v.dump());
+  } else if (v.is_string()) {
+    argv.push_back(flag);
+    argv.push_back(kPathOptions.count(key) ? resolve(dir, v.get<std::string>()) : v.get<std::string>());
+  } else {
+    throw UsageError(where + ": option \"" + key + "\" must be a string, a number or true/false, got " + v.dump());
+  }
+}
+
+const nlohmann::json& object_field(const nlohmann::json& parent, const char* key, const std::string& where) {
+  static const nlohmann::json empty = nlohmann::json::object();
+  const auto it = parent.find(key);
+  if (it == parent.end()) return empty;
+  if (!it->is_object()) throw UsageError(where + ": \"" + key + "\" must be an object of options");
+  return *it;
+}
+
+}  // namespace
+
+std::vector<BatchJob> parse_batch(const std::string& path, const std::string& text, const nlohmann::json& shared) {
+  nlohmann::json doc;
+  try {
+    doc = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    std::string what = e.what();  // "[json.exception.parse_error.101] parse error at line 3, column 5: ..."
+    const auto at = what.find("parse error");
+    throw InputError(path + ": not valid JSON: " + (at == std::string::npos ? what : what.substr(at)));
+  }
+  if (!doc.is_object() || !doc.contains("jobs") || !doc["jobs"].is_array())
+    throw InputError(path + ": expected an object with \"jobs\": [...] (and optionally \"defaults\": {...})");
+  for (const auto& [key, value] : doc.items())
+    if (key != "jobs" && key != "defaults") throw InputError(path + ": unknown field \"" + key + "\" (\"defaults\", \"jobs\")");
+  const nlohmann::json& defaults = object_field(doc, "defaults", path);
+  const std::string dir = std::filesystem::path(path).parent_path().string();
+  std::vector<BatchJob> jobs;
+  if (doc["jobs"].empty()) throw InputError(path + ": \"jobs\" is empty");
+  for (const nlohmann::json& j : doc["jobs"]) {
+    BatchJob job;
+    job.index = jobs.size() + 1;
+    const std::string where = job_name(path, job.index);
+    if (!j.is_object()) throw UsageError(where + " must be an object with \"low\", \"highs\", \"output\" and \"options\"");
+    for (const auto& [key, value] : j.items())
+      if (key != "low" && key != "high" && key != "highs" && key != "output" && key != "options")
+        throw UsageError(where + ": unknown field \"" + key + "\" (\"low\", \"highs\", \"output\", \"options\")");
+    if (!j.contains("low") || !j.contains("output") || (!j.contains("highs") && !j.contains("high")))
+      throw UsageError(where + ": needs \"low\", \"highs\" and \"output\"");
+    job.argv = {"nmbake", resolve(dir, text_of(j["low"], where + ": \"low\""))};
+    const nlohmann::json highs = j.contains("highs") ? j["highs"] : nlohmann::json::array({j["high"]});
+    if (!highs.is_array() || highs.empty()) throw UsageError(where + ": \"highs\" must be an array of files");
+    for (const nlohmann::json& h : highs) job.argv.push_back(resolve(dir, text_of(h, where + ": \"highs\"")));
+    job.argv.push_back("--output");
+    job.argv.push_back(resolve(dir, text_of(j["output"], where + ": \"output\"")));
+    // The job's options, then the defaults it does not set, then the batch's own.
+    nlohmann::json options = object_field(j, "options", where);
+    for (const nlohmann::json* more : {&defaults, &shared})
+      for (const auto& [key, value] : more->items())
+        if (!options.contains(key)) options[key] = value;
+    for (const auto& [key, value] : options.items()) add_option(job.argv, key, value, dir, where);
+    jobs.push_back(std::move(job));
+  }
+  return jobs;
+}
+
+bool wants_batch(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i)
+    if (std::strcmp(argv[i], "--batch") == 0 || std::strncmp(argv[i], "--batch=", 8) == 0) return true;
+  return false;
+}
+
+int parse_batch_args(int argc, char** argv, BatchArgs& b) {
+  CLI::App app{"nmbake --batch: bake the jobs of a JSON file in one process (README \"Batch\").", "nmbake"};
+  app.add_option("--batch", b.file, "The jobs file")->required();
+  app.add_option("--report", b.report, "Write the batch's JSON report: each job's report and a summary");
+  app.add_option("--threads", b.threads, "Worker threads of every job (default: all cores)");
+  app.add_flag("--quiet", b.quiet, "As nmbake's --quiet, for every job");
+  app.add_flag("--progress", b.progress, "Show the progress line even when stderr is not a terminal");
+  app.add_flag("--strict", b.strict, "Any warning fails its job (exit 5 for the batch); the others still run");
+  app.add_flag("--no-warnings", b.no_warnings, "Do not print warnings");
+  app.footer(std::string("\n") + kExitCodes);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    throw UsageError(std::string("--batch: ") + e.what());
+  }
+  return -1;
+}
+
+}  // namespace nmbake
+
+namespace nmbake {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::string read_jobs_file(const std::string& path) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) throw InputError(path + ": cannot read: " + std::strerror(errno));
+  std::string text;
+  char buf[65536];
+  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;) text.append(buf, n);
+  const bool failed = std::ferror(f) != 0;
+  std::fclose(f);
+  if (failed) throw InputError(path + ": cannot read");
+  return text;
+}
+
+// Each job's command line as nmbake parses it; every problem found before the first bake.
+std::vector<Args> check_jobs(const std::string& path, const std::vector<BatchJob>& jobs) {
+  std::vector<Args> all(jobs.size());
+  struct Output {
+    std::string path, what;
+    std::size_t job;
+  };
+  std::vector<Output> outputs;
+  for (std::size_t i = 0; i < jobs.size(); ++i) {
+    const std::string where = path + ": job " + std::to_string(jobs[i].index);
+    CLI::App app{"", "nmbake"};
+    Args& a = all[i];
+    add_options(app, a);
+    std::vector<const char*> argv;
+    for (const std::string& w : jobs[i].argv) argv.push_back(w.c_str());
+    try {
+      app.parse(int(argv.size()), const_cast<char**>(argv.data()));
+    } catch (const CLI::ParseError& e) {
+      throw UsageError(where + ": " + e.what());
+    }
+    finish_args(a, app);
+    try {
+      validate_options(bake_options(a));
+    } catch (const Error& e) {
+      throw UsageError(where + ": " + e.what());
+    }
+    for (const auto& [file, what] : {std::pair{&a.output, "the map"}, std::pair{&a.miss_mask, "the miss mask"},
+                                     std::pair{&a.suspect_mask, "the suspect mask"}, std::pair{&a.save_cage, "the cage"},
+                                     std::pair{&a.report, "the report"}}) {
+      if (file->empty()) continue;
+      for (const Output& o : outputs)
+        if (same_file(o.path, *file))
+          throw UsageError(where + ": " + what + " " + *file + " is also written by job " + std::to_string(jobs[o.job].index) +
+                           " (" + o.what + " " + o.path + "); nothing written");
+      outputs.push_back({*file, what, i});
+    }
+  }
+  return all;
+}
+
+// The batch's options given to every job, as a job's "options" would give them.
+nlohmann::json shared_options(const BatchArgs& b) {
+  nlohmann::json shared = nlohmann::json::object();
+  if (b.threads) shared["threads"] = b.threads;
+  if (b.quiet) shared["quiet"] = true;
+  if (b.quiet > 1 || b.no_warnings) shared["no-warnings"] = true;
+  if (b.strict) shared["strict"] = true;
+  return shared;
+}
+
+}  // namespace
+
+int run_batch(const BatchArgs& b, const std::function<bool()>& interrupted, const char** doing, Clock::time_point start) {
+  const std::vector<BatchJob> jobs = parse_batch(b.file, read_jobs_file(b.file), shared_options(b));
+  const std::vector<Args> args = check_jobs(b.file, jobs);
+  if (!b.report.empty()) check_output_files({{"--batch", b.file, "the jobs"}}, {{"--report", b.report, "the batch report"}});
+  Progress progress(!b.quiet && (b.progress || ::isatty(STDERR_FILENO)), start, interrupted);
+  MeshCache cache;
+  nlohmann::json reports = nlohmann::json::array();
+  int first_failure = 0;
+  std::size_t failed = 0;
+  for (std::size_t i = 0; i < jobs.size(); ++i) {
+    const Args& a = args[i];
+    progress.label("job " + std::to_string(i + 1) + " of " + std::to_string(jobs.size()) + ": ");
+    nlohmann::json report;
+    const JobEnv env{jobs[i].argv, interrupted, doing, progress, Clock::now(), &cache, true, &report};
+    int code = 0;
+    std::string error;
+    const auto t0 = Clock::now();
+    try {
+      bake_job(a, env);
+    } catch (const Cancelled&) {
+      throw;
+    } catch (const Error& e) {
+      code = int(e.code());
+      error = e.what();
+    } catch (const std::bad_alloc&) {
+      code = int(ExitCode::memory);
+      error = std::string("out of memory") + (*doing ? std::string(" while ") + *doing : "");
+    } catch (const std::exception& e) {
+      code = int(ExitCode::input);
+      error = e.what();
+    }
+    if (code) {
+      progress.above([&] {
+        std::fprintf(stderr, "error: %s: job %zu (%s): %s\n", b.file.c_str(), jobs[i].index, a.output.c_str(), error.c_str());
+      });
+      ++failed;
+      if (!first_failure) first_failure = code;
+    }
+    reports.push_back({{"job", jobs[i].index},
+                       {"output", a.output},
+                       {"exit_code", code},
+                       {"error", code ? nlohmann::json(error) : nlohmann::json(nullptr)},
+                       {"seconds", std::chrono::duration<double>(Clock::now() - t0).count()},
+                       {"report", code ? nlohmann::json(nullptr) : report}});
+    if (interrupted()) throw Cancelled();
+  }
+  progress.finish();
+  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  if (!b.report.empty()) {
+    const nlohmann::json summary = {{"batch", b.file},
+                                    {"jobs", reports},
+                                    {"summary",
+                                     {{"jobs", jobs.size()},
+                                      {"baked", jobs.size() - failed},
+                                      {"failed", failed},
+                                      {"high_loads_saved", cache.hits},
+                                      {"seconds", seconds}}}};
+    write_text_atomically(b.report, summary.dump(2) + "\n");
+  }
+  if (!b.quiet)
+    std::printf("nmbake: batch %s: %zu jobs, %zu baked, %zu failed, %.2f s; high-poly files loaded once for %zu jobs\n",
+                b.file.c_str(), jobs.size(), jobs.size() - failed, failed, seconds, cache.hits);
+  return first_failure;
+}
+
+}  // namespace nmbake

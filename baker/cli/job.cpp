@@ -1,0 +1,279 @@
+#include "cli/job.h"
+
+#include <cstdio>
+#include <future>
+#include <tuple>
+
+#include "cli/outputs.h"
+#include "cli/report.h"
+#include "cli/warnings.h"
+#include "core/errors.h"
+#include "core/normals.h"
+#include "core/parallel.h"
+#include "io/image_io.h"
+#include "io/mesh_io.h"
+#include "io/text_file.h"
+#include "pipeline/bake.h"
+#include "pipeline/error_estimate.h"
+
+namespace nmbake {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// One line on how far rays reached, unless --quiet.
+void print_distances(const BakeStats& s) {
+  if (s.cage == BakeStats::CageSource::automatic)
+    std::fprintf(
+        stderr,
+        "nmbake: automatic cage: front %.3g-%.3g (mean %.3g), rear %.3g-%.3g (mean %.3g) per vertex; limited by a neighbouring "
+        "part at %zu and %zu vertices\n",
+        s.vertex_front.min, s.vertex_front.max, s.vertex_front.mean, s.vertex_rear.min, s.vertex_rear.max, s.vertex_rear.mean,
+        s.cage_front_limited, s.cage_rear_limited);
+  else if (s.cage == BakeStats::CageSource::file && s.auto_distances)
+    std::fprintf(stderr, "nmbake: rear distances measured per vertex: %.3g-%.3g (mean %.3g)\n", s.vertex_rear.min,
+                 s.vertex_rear.max, s.vertex_rear.mean);
+  else if (s.auto_distances)
+    std::fprintf(stderr, "nmbake: ray distances measured: --front %.6g --rear %.6g (%.2f%% of probes lie beyond)\n", s.front,
+                 s.rear, 100.0 * s.auto_probe_beyond);
+}
+
+ErrorEstimate estimate_error(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& o, const BakeResult& r,
+                             int bits, Progress& progress) {
+  ErrorEstimateOptions eo;
+  eo.bits = bits;
+  const ErrorEstimate estimate = estimate_bake_error(low, high, cage, o, r, eo);
+  // The estimate compares float values; say what the output's bit depth adds on top.
+  char quant[128] = "float output adds no quantisation";
+  if (bits != 32)
+    std::snprintf(quant, sizeof quant, "%d-bit output adds quantisation of mean %.4f deg, max %.4f deg", bits,
+                  estimate.quantization_mean_deg, estimate.quantization_max_deg);
+  progress.above([&] {
+    std::fprintf(stderr,
+                 "nmbake: error estimate: mean %.4f deg, p95 %.4f deg, max %.4f deg against %d samples on %zu texels "
+                 "(%.2f s); %s\n",
+                 estimate.mean_deg, estimate.p95_deg, estimate.max_deg, estimate.samples, estimate.texels, estimate.seconds,
+                 quant);
+  });
+  return estimate;
+}
+
+// The map, the masks and the cage, each to its temporary file in `outputs`.
+void write_outputs(const JobEnv& env, OutputSet& outputs, const Args& a, const BakeOptions& o, const BakeResult& r,
+                   const Mesh& low, int bits) {
+  auto check_signal = [&env] {
+    if (env.interrupted()) throw Cancelled();
+  };
+  WriteOptions wo;
+  wo.bits = bits;
+  wo.metadata = {
+      {"nmbake:space", to_string(o.space)},
+      {"nmbake:green", o.green_down ? "down" : "up"},
+      {"nmbake:tangent_basis", "mikktspace"},
+      {"nmbake:bitangent", o.bitangent == BitangentMode::per_vertex ? "vertex" : "pixel"},
+      {"nmbake:version", NMBAKE_VERSION},
+      {"ImageDescription",
+       std::string(o.space == NormalSpace::object ? "object-space normal map" : "tangent-space normal map, ") +
+           (o.space == NormalSpace::object ? "" : (o.green_down ? "DirectX (Y-)" : "OpenGL (Y+)")) + ", baked by nmbake"}};
+  wo.compression = a.compression;
+  wo.dither = a.dither;
+  wo.temp_path = outputs.add(a.output);
+  write_image(a.output, r.map, wo);
+  for (const auto& [path, image] : {std::pair{&a.miss_mask, &r.miss_mask}, std::pair{&a.suspect_mask, &r.suspect_mask}}) {
+    if (path->empty()) continue;
+    check_signal();
+    WriteOptions mo;
+    mo.bits = default_bits_for(*path);
+    mo.temp_path = outputs.add(*path);
+    write_image(*path, *image, mo);
+  }
+  if (!a.save_cage.empty()) {
+    check_signal();
+    Mesh cage_mesh;
+    cage_mesh.origin = low.origin;
+    cage_mesh.positions = r.cage_positions;
+    cage_mesh.uvs = low.uvs;
+    cage_mesh.position_index = low.position_index;
+    cage_mesh.uv_index = low.uv_index;
+    write_text_file(a.save_cage, outputs.add(a.save_cage),
+                    obj_text(cage_mesh, "nmbake " NMBAKE_VERSION " automatic cage of " + a.low + " for " + a.high));
+  }
+}
+
+// The job's report, written to --report and handed to the batch.
+void report_job(const JobEnv& env, OutputSet& outputs, const Args& a, const BakeOptions& o, const RunInfo& run,
+                const BakeStats& s, const ErrorEstimate* estimate) {
+  if (a.report.empty() && !env.report) return;
+  nlohmann::json report = make_report(o, s, run);
+  if (estimate)
+    report["error_estimate"] = {{"mean_deg", estimate->mean_deg},
+                                {"p95_deg", estimate->p95_deg},
+                                {"max_deg", estimate->max_deg},
+                                {"texels", estimate->texels},
+                                {"seconds", estimate->seconds}};
+  if (!a.report.empty()) write_text_file(a.report, outputs.add(a.report), report.dump(2) + "\n");
+  if (env.report) *env.report = std::move(report);
+}
+
+void print_summary(const Args& a, const BakeOptions& o, const RunInfo& run, const BakeStats& s, int bits) {
+  std::printf(
+      "nmbake: wrote %s (%dx%d, %d-bit, %s%s): samples %d, rays %s, misses %llu (%.2f%%), coverage %.1f%%, "
+      "seconds: load %.2f prepare %.2f bvh %.2f distances %.2f trace %.2f padding %.2f write %.2f total %.2f\n",
+      a.output.c_str(), o.width, o.height, bits, to_string(o.space),
+      o.space == NormalSpace::tangent ? (o.green_down ? ", green down" : ", green up") : "", o.samples,
+      human(double(s.rays)).c_str(), (unsigned long long)s.misses,
+      s.samples_covered ? 100.0 * double(s.misses) / double(s.samples_covered) : 0.0, 100.0 * s.coverage, run.seconds_load,
+      s.seconds_prepare, s.seconds_bvh, s.seconds_distances, s.seconds_trace, s.seconds_padding, run.seconds_write,
+      run.seconds_total);
+}
+
+// What loading found in several high-poly files, summed (one file: its own).
+MeshLoadInfo combined_info(const std::vector<MeshLoadInfo>& infos) {
+  MeshLoadInfo all = infos.front();
+  for (std::size_t i = 1; i < infos.size(); ++i) {
+    const MeshLoadInfo& f = infos[i];
+    if (all.format.find(f.format) == std::string::npos) all.format += "+" + f.format;
+    all.file_faces += f.file_faces;
+    all.polygons_triangulated += f.polygons_triangulated;
+    all.normals_renormalized += f.normals_renormalized;
+    all.zero_normals += f.zero_normals;
+    all.normals_dropped = all.normals_dropped || f.normals_dropped;
+    all.uvs_dropped = all.uvs_dropped || f.uvs_dropped;
+    all.faces_without_normals += f.faces_without_normals;
+    all.faces_without_uvs += f.faces_without_uvs;
+    all.degenerate_faces_dropped += f.degenerate_faces_dropped;
+    all.largest_coordinate = std::max(all.largest_coordinate, f.largest_coordinate);
+    if (f.unit_scale != all.unit_scale) all.unit_scale = 0.0;  // mixed: high_files gives each
+  }
+  return all;
+}
+
+// What the report says of the run besides the bake's counts (the timings come later).
+RunInfo run_info(const Args& a, const std::vector<std::string>& command, int bits) {
+  RunInfo run;
+  run.low_path = a.low;
+  run.high_path = a.highs.front();
+  run.high_paths = a.highs;
+  run.cage_path = a.cage;
+  run.output_path = a.output;
+  run.miss_mask_path = a.miss_mask;
+  run.suspect_mask_path = a.suspect_mask;
+  run.bits = bits;
+  run.dither = a.dither;
+  run.uv_set = a.uv_set;
+  if (image_io_detail::lower_extension(a.output) == ".exr") run.compression = a.compression.empty() ? "zip" : a.compression;
+  run.command = command;
+  run.started = utc_time_text(report_time());
+  return run;
+}
+
+// The high-poly files merged, from the cache when an earlier job loaded them.
+std::shared_ptr<const LoadedHigh> load_highs(const std::vector<std::string>& paths, const LoadOptions& options,
+                                             MeshCache* cache) {
+  std::string key;
+  for (const std::string& p : paths) key += p + '\n';
+  const glm::dvec3 origin = options.origin ? *options.origin : glm::dvec3(0.0);
+  char at[100];
+  std::snprintf(at, sizeof at, "%.17g %.17g %.17g", origin.x, origin.y, origin.z);
+  key += at;
+  if (cache)
+    if (const auto it = cache->highs.find(key); it != cache->highs.end()) {
+      ++cache->hits;
+      return it->second;
+    }
+  auto loaded = std::make_shared<LoadedHigh>();
+  std::vector<Mesh> meshes;
+  for (const std::string& path : paths) {
+    meshes.push_back(load_mesh(path, options, &loaded->infos.emplace_back()));
+    loaded->triangles.push_back(meshes.back().triangle_count());
+  }
+  loaded->mesh = merge_meshes(std::move(meshes));
+  if (cache) cache->highs[key] = loaded;
+  return loaded;
+}
+
+}  // namespace
+
+void bake_job(const Args& a, const JobEnv& env) {
+  BakeOptions o = bake_options(a);
+  validate_options(o);  // the library's checks, before a long load
+  const int bits = a.bits ? a.bits : default_bits_for(a.output);
+  check_outputs(a, bits);
+  WarningLog warnings(a.quiet < 2 && !a.no_warnings, a.strict);
+
+  // Load.
+  RunInfo run = run_info(a, env.command, bits);
+  *env.doing = "loading the meshes";
+  env.progress.stage("loading");
+  auto t0 = Clock::now();
+  LoadOptions low_opts;
+  low_opts.require_uvs = true;
+  low_opts.uv_set = a.uv_set;
+  Mesh low = load_mesh(a.low, low_opts, &run.low_info);
+  run.origin = {low.origin.x, low.origin.y, low.origin.z};
+  LoadOptions shared;  // the high-poly and the cage share the low-poly's origin (re-centred when far)
+  shared.origin = low.origin;
+  const std::shared_ptr<const LoadedHigh> loaded = load_highs(a.highs, shared, env.cache);
+  run.high_infos = loaded->infos;
+  run.high_triangles = loaded->triangles;
+  run.high_info = combined_info(run.high_infos);
+  const Mesh& high = loaded->mesh;
+  Mesh cage;
+  if (!a.cage.empty()) cage = load_mesh(a.cage, shared, &run.cage_info);
+  const Mesh* cage_mesh = a.cage.empty() ? nullptr : &cage;
+  run.seconds_load = std::chrono::duration<double>(Clock::now() - t0).count();
+  run.low_objects = object_list(low);
+  run.high_objects = object_list(high);
+  if (a.match == "names") run.match = match_by_names(run.low_objects, run.high_objects, a.match_suffixes, o);
+  env.progress.above([&] {
+    warnings.add(load_warnings(run.low_info, a.low));
+    for (std::size_t i = 0; i < a.highs.size(); ++i) warnings.add(load_warnings(run.high_infos[i], a.highs[i]));
+    if (cage_mesh) warnings.add(load_warnings(run.cage_info, a.cage));
+    warnings.add(match_warnings(run.match, run.low_objects, run.high_objects, a.low, a.high));
+  });
+  warnings.check_strict();  // before a long bake
+  if (env.interrupted()) throw Cancelled();
+
+  o.progress = [&](double f) { return env.progress.fraction(f); };
+  o.on_stage = [&](const char* stage) { env.progress.stage(stage); };
+  *env.doing = "baking";
+  const BakeResult r = bake_normal_map(low, high, cage_mesh, o);
+  const BakeStats& s = r.stats;
+  // Topology checks are only reported: they run beside the image write, which uses one core
+  // (about 0.3-0.6 s CPU per 400k triangles; beside the bake they took time from its threads).
+  auto topology = std::async(std::launch::async, [&high] { return inspect_topology(high); });
+  if (!a.quiet) env.progress.above([&] { print_distances(s); });
+  o.on_stage = nullptr;  // the estimate's re-bake is one stage
+  if (env.interrupted()) throw Cancelled();
+  ErrorEstimate estimate;
+  *env.doing = "estimating the error";
+  if (a.estimate_error) {
+    env.progress.stage("estimating the error");
+    estimate = estimate_error(low, high, cage_mesh, o, r, bits, env.progress);
+  }
+
+  // Every output to its temporary file, then all renamed into place together.
+  OutputSet outputs;
+  *env.doing = "writing the outputs";
+  env.progress.stage("writing", false);  // not redrawn while the encoders' stderr is redirected
+  t0 = Clock::now();
+  write_outputs(env, outputs, a, o, r, low, bits);
+  run.seconds_write = std::chrono::duration<double>(Clock::now() - t0).count();
+  *env.doing = "checking the high-poly's topology";
+  run.high_topology = topology.get();
+  if (env.keep_progress) env.progress.hold();
+  else env.progress.finish();
+  warnings.add(bake_warnings(s, run.high_topology, a.low, a.high));
+  warnings.check_strict();
+  run.warnings = warnings.all();
+  run.seconds_total = std::chrono::duration<double>(Clock::now() - env.start).count();
+  run.peak_memory_bytes = peak_memory_bytes();
+  run.threads_used = unsigned(worker_threads(a.threads));
+  *env.doing = "writing the report";
+  report_job(env, outputs, a, o, run, s, a.estimate_error ? &estimate : nullptr);
+  outputs.commit(env.interrupted);
+  if (!a.quiet) print_summary(a, o, run, s, bits);
+}
+
+}  // namespace nmbake
