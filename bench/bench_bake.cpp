@@ -16,8 +16,8 @@
 // $TMPDIR/nmbake-bench); each run's maps and reports go to a subfolder removed at the end.
 //
 // The sections live in bench_tracing.cpp (1, 2), bench_commands.cpp (3, 6), bench_scaling.cpp
-// (4, 5) and bench_floods.cpp (7); this file parses the arguments, prints the machine, generates the scenes (0) and prints
-// the targets.
+// (4, 5), bench_floods.cpp (7) and bench_batch.cpp (8); this file parses the arguments, prints the machine, generates the scenes
+// (0) and prints the targets.
 #include <unistd.h>
 
 #include <algorithm>
@@ -180,6 +180,7 @@ int main(int argc, char** argv) {
   run_scaling(run, scenes, m1_2k);
   run_far_geometry(run, scenes);
   run_floods(run, scenes);
+  run_batch(run, scenes);
   print_targets(run, start);
   std::error_code ec;
   fs::remove_all(run.run_dir, ec);

@@ -90,5 +90,6 @@ void run_loading(BenchRun& run, const Scenes& scenes);                          
 void run_scaling(BenchRun& run, const Scenes& scenes, const CommandRun& m1_2k);  // 5
 void run_far_geometry(BenchRun& run, const Scenes& scenes);                      // 6
 void run_floods(BenchRun& run, const Scenes& scenes);                            // 7 (bench_floods.cpp)
+void run_batch(BenchRun& run, const Scenes& scenes);                             // 8 (bench_batch.cpp)
 
 }  // namespace nmbake::bench
