@@ -1,5 +1,7 @@
 #include "pipeline/bake.h"
 
+#include "pipeline/bake_stages.h"
+
 #include <time.h>
 
 #include <algorithm>
@@ -31,11 +33,15 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
+}  // namespace
+
 double process_cpu_seconds() {
   timespec ts{};
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
   return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
+
+namespace {
 
 // Refuses coordinates, and ray starts, beyond kMaxCoordinate (exit 2).
 void check_coordinate_range(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt) {
@@ -63,8 +69,11 @@ void check_coordinate_range(const Mesh& low, const Mesh& high, const Mesh* cage,
   }
 }
 
+}  // namespace
+
 // Options and inputs a bake refuses (bake.h).
-void check_bake_inputs(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt) {
+void check_bake_inputs(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt, std::uint64_t maps,
+                       const std::string& what) {
   validate_options(opt);
   if (!low.has_uvs()) throw InputError(low.source + ": the low-poly mesh has no UVs");
   if (low.triangle_count() == 0) throw InputError(low.source + ": no faces");
@@ -76,50 +85,26 @@ void check_bake_inputs(const Mesh& low, const Mesh& high, const Mesh* cage, cons
                      std::to_string(low.triangle_count()) + " and " + std::to_string(low.positions.size()) + ")");
   check_coordinate_range(low, high, cage, opt);
   {
-    const std::uint64_t need = estimate_bake_bytes(opt);
+    // Saturating: absurd counts of maps are refused, never wrapped round.
+    const std::uint64_t one = estimate_bake_bytes(opt);
+    const std::uint64_t need = maps > 1 && one > UINT64_MAX / maps ? UINT64_MAX : one * maps;
     const std::uint64_t avail = opt.memory_limit ? opt.memory_limit : memory_budget_bytes();
     if (need > avail)
-      throw ResourceError("--size " + std::to_string(opt.width) + "x" + std::to_string(opt.height) + " needs about " +
+      throw ResourceError("--size " + std::to_string(opt.width) + "x" + std::to_string(opt.height) + what + " needs about " +
                           std::to_string(need >> 20) + " MiB for its buffers but only " + std::to_string(avail >> 20) +
                           " MiB are available");
   }
 }
 
-// The output buffers, allocated by a helper thread while prepare runs on one core: the system
-// zeroes each fresh page at its first touch (18-40 ms for a 2048^2 map on our 2-core VM), work that
-// would otherwise fall between the trace's rays. Starting a thread waits while another thread of
-// the process is loading a shared library (glibc's loader lock; the CLI loads its image module in
-// the background, up to 0.2 s): in prepare's time, where it shows.
-class OutputAllocation {
- public:
-  OutputAllocation(const BakeOptions& opt, BakeResult& result, std::vector<std::uint8_t>& disagree)
-      : thread_([&opt, &result, &disagree, this] {
-          try {
-            const std::size_t texels = std::size_t(opt.width) * std::size_t(opt.height);
-            result.map =
-                Image(opt.width, opt.height, 3, Image::Unset{});  // the trace writes the covered texels, padding the rest
-            result.map.fault_in();
-            result.coverage.assign(texels, 0);
-            if (opt.miss_mask) result.miss_mask = Image(opt.width, opt.height, 1, 0.0f);
-            if (opt.samples > 1) disagree.assign(texels, 0);
-          } catch (...) {
-            error_ = std::current_exception();
-          }
-        }) {}
-  ~OutputAllocation() {
-    if (thread_.joinable()) thread_.join();
-  }
-  void wait() {
-    thread_.join();
-    if (error_) std::rethrow_exception(error_);
-  }
-
- private:
-  std::exception_ptr error_;
-  std::thread thread_;
-};
-
-}  // namespace
+// One map's buffers (bake_stages.h).
+void allocate_outputs(const BakeOptions& opt, BakeResult& result, std::vector<std::uint8_t>& disagree) {
+  const std::size_t texels = std::size_t(opt.width) * std::size_t(opt.height);
+  result.map = Image(opt.width, opt.height, 3, Image::Unset{});  // the trace writes the covered texels, padding the rest
+  result.map.fault_in();
+  result.coverage.assign(texels, 0);
+  if (opt.miss_mask) result.miss_mask = Image(opt.width, opt.height, 1, 0.0f);
+  if (opt.samples > 1) disagree.assign(texels, 0);
+}
 
 std::vector<glm::dvec2> sample_offsets(int samples) {
   std::vector<glm::dvec2> out;
@@ -158,25 +143,15 @@ std::uint64_t estimate_bake_bytes(const BakeOptions& o) {
   return texels * per_texel;
 }
 
-namespace {
-
-// The stages up to the trace's (prepare, select, BVH, distances and a narrower selection once they
-// are known): what the trace reads, but the tiles.
-struct TraceInputs {
-  Prepared s;
-  HighScene scene;
-  RaySetup rays;
-};
-
-void announce(const BakeOptions& opt, const char* stage) {
+void announce_stage(const BakeOptions& opt, const char* stage) {
   if (opt.on_stage) opt.on_stage(stage);
 }
 
-// `stage` says what runs, for an out-of-memory message (bake_normal_map).
+// The stages before the trace (bake_stages.h).
 void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt, int threads, TraceInputs& in,
                    BakeResult& result, std::string& stage) {
   BakeStats& st = result.stats;
-  announce(opt, "preparing");
+  announce_stage(opt, "preparing");
   stage = "preparing " + std::to_string(low.triangle_count()) + " low-poly and " + std::to_string(high.triangle_count()) +
           " high-poly triangles";
   st.low_triangles = low.triangle_count();
@@ -195,14 +170,14 @@ void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const Ba
     kept = select_reachable(
         s, high, mode.probing ? mode.reach * 1.01 + 1e-6 * s.diagonal : ray_margin(s, mode.any_cage, opt.front, opt.rear));
   st.high_duplicates_skipped = drop_duplicate_floods(s, high, threads, kept);
-  announce(opt, "building the BVH");
+  announce_stage(opt, "building the BVH");
   stage = "building the BVH of " + std::to_string(kept.empty() ? high.triangle_count() : kept.size()) + " high-poly triangles";
   HighScene& scene = in.scene;
   build_high_scene(scene, s, high, kept, bvh_quality_for(opt, kept.empty() ? high.triangle_count() : kept.size()), opt.threads);
   st.seconds_bvh = seconds_since(t0);
 
   t0 = Clock::now();
-  announce(opt, "measuring distances");
+  announce_stage(opt, "measuring distances");
   stage = "measuring the ray distances";
   measure_reach(mode, low, opt, threads, s, scene, result);
   st.seconds_distances = seconds_since(t0);
@@ -230,9 +205,7 @@ void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const Ba
 // Tiles of 32 x 32 texels up to 4 samples, else 16 x 16: a triangle's rows within a tile are
 // longer with the larger ones (less set-up per texel), and a tile's samples stay within the cache
 // with the smaller.
-int tile_side(const BakeOptions& opt) { return opt.samples <= 4 ? 2 * kTileSide : kTileSide; }
-
-}  // namespace
+int trace_tile_side(const BakeOptions& opt) { return opt.samples <= 4 ? 2 * kTileSide : kTileSide; }
 
 void validate_options(const BakeOptions& o) {
   // As --size takes it: N for a square map, WxH otherwise.
@@ -269,21 +242,21 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     BakeResult result;
     BakeStats& st = result.stats;
     std::vector<std::uint8_t> disagree;  // per texel: its samples disagree (suspect), with several samples
-    OutputAllocation outputs(opt, result, disagree);
+    OutputAllocation outputs([&opt, &result, &disagree] { allocate_outputs(opt, result, disagree); });
     TraceInputs in;
     prepare_trace(low, high, cage, opt, threads, in, result, stage);
 
-    announce(opt, "tracing");
+    announce_stage(opt, "tracing");
     stage = "tracing (" + texels + ")";
     auto t0 = Clock::now();
     const double cpu0 = process_cpu_seconds();
-    const TileBins bins = bin_triangles(low, opt.width, opt.height, tile_side(opt));
+    const TileBins bins = bin_triangles(low, opt.width, opt.height, trace_tile_side(opt));
     outputs.wait();
     trace_and_shade(in.s, in.scene, bins, in.rays, opt, threads, {result.map, result.coverage, result.miss_mask, disagree}, st);
     st.seconds_trace = seconds_since(t0);
     st.cpu_seconds_trace = process_cpu_seconds() - cpu0;
 
-    announce(opt, "padding");
+    announce_stage(opt, "padding");
     stage = "padding (" + texels + ")";
     t0 = Clock::now();
     pad_map(opt, disagree, threads, result);
@@ -304,7 +277,7 @@ BakeRays bake_rays(const Mesh& low, const Mesh& high, const Mesh* cage, const Ba
   TraceInputs in;
   std::string stage;
   prepare_trace(low, high, cage, opt, worker_threads(opt.threads), in, result, stage);
-  const TileBins bins = bin_triangles(low, opt.width, opt.height, tile_side(opt));
+  const TileBins bins = bin_triangles(low, opt.width, opt.height, trace_tile_side(opt));
   return {trace_rays(in.s, in.scene, bins, in.rays, opt), result.stats};
 }
 

@@ -2,7 +2,7 @@
 
 namespace nmbake {
 
-TileBins bin_triangles(const Mesh& low, int width, int height, int side) {
+TileBins bin_triangles(const Mesh& low, int width, int height, int side, const UvTileFilter* only) {
   TileBins b;
   b.side = side;
   b.tiles_x = (width + side - 1) / side;
@@ -15,8 +15,11 @@ TileBins bin_triangles(const Mesh& low, int width, int height, int side) {
     for (int ty = tt.ymin / side; ty <= tt.ymax / side; ++ty)
       for (int tx = tt.xmin / side; tx <= tt.xmax / side; ++tx) fn(std::size_t(ty) * std::size_t(b.tiles_x) + std::size_t(tx));
   };
+  const glm::vec2 shift = only ? glm::vec2(float(only->u), float(only->v)) : glm::vec2(0.0f);
   for (std::size_t t = 0; t < low.triangle_count(); ++t) {
-    b.texel_tris[t] = setup_texel_triangle(low.corner_uv(t, 0), low.corner_uv(t, 1), low.corner_uv(t, 2), width, height);
+    if (only && (*only->tile_of)[t] != only->id) continue;  // left invalid: no bin
+    b.texel_tris[t] = setup_texel_triangle(low.corner_uv(t, 0) - shift, low.corner_uv(t, 1) - shift, low.corner_uv(t, 2) - shift,
+                                           width, height);
     for_each_tile(b.texel_tris[t], [&](std::size_t i) { ++b.start[i + 1]; });
   }
   for (std::size_t i = 0; i < tile_count; ++i) b.start[i + 1] += b.start[i];

@@ -1,0 +1,255 @@
+#include "pipeline/udim.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <new>
+#include <optional>
+#include <string>
+
+#include "core/parallel.h"
+#include "core/rasterize.h"
+#include "pipeline/bake_stages.h"
+#include "pipeline/pad.h"
+#include "pipeline/tiles.h"
+#include "pipeline/trace.h"
+
+namespace nmbake {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// The tile holding triangle t's UV centroid as u + 10 v, or -1 when none does (NaN fails every
+// comparison, so a non-finite UV lands in no tile).
+int centroid_cell(const Mesh& low, std::size_t t) {
+  const glm::dvec2 c =
+      (glm::dvec2(low.corner_uv(t, 0)) + glm::dvec2(low.corner_uv(t, 1)) + glm::dvec2(low.corner_uv(t, 2))) / 3.0;
+  const double u = std::floor(c.x), v = std::floor(c.y);
+  if (!(u >= 0.0 && u < kUdimColumns && v >= 0.0 && v < kUdimRows)) return -1;
+  return int(u) + kUdimColumns * int(v);
+}
+
+bool straddles(const Mesh& low, std::size_t t, int u, int v) {
+  for (int k = 0; k < 3; ++k) {
+    const glm::vec2 uv = low.corner_uv(t, k);
+    if (!(uv.x >= float(u) && uv.x <= float(u + 1) && uv.y >= float(v) && uv.y <= float(v + 1))) return true;
+  }
+  return false;
+}
+
+// Texel centres covered by the triangles of tile `id` (listed in `tris`), moved into 0-1, in a
+// width x height map; `mask` (width x height, zeros) is left zeroed again.
+std::size_t count_tile_texels(const Mesh& low, const std::vector<std::uint32_t>& tris, const UdimTile& tile, int width,
+                              int height, std::vector<std::uint8_t>& mask) {
+  const glm::vec2 shift(float(tile.u), float(tile.v));
+  std::size_t covered = 0;
+  std::vector<TexelTriangle> setups;
+  setups.reserve(tris.size());
+  for (std::uint32_t t : tris) {
+    setups.push_back(setup_texel_triangle(low.corner_uv(t, 0) - shift, low.corner_uv(t, 1) - shift, low.corner_uv(t, 2) - shift,
+                                          width, height));
+    const TexelTriangle& tri = setups.back();
+    if (!tri.valid()) continue;
+    for (int y = tri.ymin; y <= tri.ymax; ++y)
+      for (int x = tri.xmin; x <= tri.xmax; ++x) {
+        double bary[3];
+        std::uint8_t& m = mask[std::size_t(y) * std::size_t(width) + std::size_t(x)];
+        if (m || !covers(tri, sample_point(x, y, 0.5, 0.5), bary)) continue;
+        m = 1;
+        ++covered;
+      }
+  }
+  // Only the boxes the triangles touched hold ones: cheaper than clearing the whole mask per tile.
+  for (const TexelTriangle& tri : setups)
+    if (tri.valid())
+      for (int y = tri.ymin; y <= tri.ymax; ++y)
+        if (tri.xmax >= tri.xmin)
+          std::fill_n(mask.begin() + std::ptrdiff_t(std::size_t(y) * std::size_t(width) + std::size_t(tri.xmin)),
+                      tri.xmax - tri.xmin + 1, std::uint8_t(0));
+  return covered;
+}
+
+// Per-object counts summed element by element (the tiles' vectors have the objects' length).
+void add_counts(std::vector<std::uint64_t>& total, const std::vector<std::uint64_t>& tile) {
+  if (total.size() < tile.size()) total.resize(tile.size(), 0);
+  for (std::size_t i = 0; i < tile.size(); ++i) total[i] += tile[i];
+}
+
+// The tiles' trace and padding stats summed into `total` (UdimBake::stats).
+void sum_tile_stats(const std::vector<TileBake>& tiles, BakeStats& total) {
+  double dsum = 0.0;
+  bool any_hit = false;
+  for (const TileBake& tb : tiles) {
+    const BakeStats& s = tb.result.stats;
+    total.rays += s.rays;
+    total.hits += s.hits;
+    total.misses += s.misses;
+    total.samples_covered += s.samples_covered;
+    total.overlapping_samples += s.overlapping_samples;
+    total.backface_skips += s.backface_skips;
+    total.hits_facing_away += s.hits_facing_away;
+    total.samples_unmatched += s.samples_unmatched;
+    add_counts(total.low_object_samples, s.low_object_samples);
+    add_counts(total.low_object_hits, s.low_object_hits);
+    add_counts(total.high_object_hits, s.high_object_hits);
+    total.texels_total += s.texels_total;
+    total.texels_covered += s.texels_covered;
+    total.texels_padded += s.texels_padded;
+    total.texels_facing_away += s.texels_facing_away;
+    total.suspect_texels += s.suspect_texels;
+    total.seconds_trace += s.seconds_trace;
+    total.cpu_seconds_trace += s.cpu_seconds_trace;
+    total.seconds_padding += s.seconds_padding;
+    if (!s.hits) continue;
+    total.hit_distance_min = any_hit ? std::min(total.hit_distance_min, s.hit_distance_min) : s.hit_distance_min;
+    total.hit_distance_max = any_hit ? std::max(total.hit_distance_max, s.hit_distance_max) : s.hit_distance_max;
+    dsum += s.hit_distance_mean * double(s.hits);
+    any_hit = true;
+  }
+  if (total.hits) total.hit_distance_mean = dsum / double(total.hits);
+  total.coverage = total.texels_total ? double(total.texels_covered) / double(total.texels_total) : 0.0;
+  total.suspect_share = total.texels_covered ? double(total.suspect_texels) / double(total.texels_covered) : 0.0;
+}
+
+}  // namespace
+
+std::size_t UdimLayout::triangles_beyond_first() const {
+  std::size_t n = 0;
+  for (const UdimTile& t : tiles) n += t.number == kUdimFirst ? 0 : t.triangles;
+  return n;
+}
+
+std::size_t UdimLayout::texels_beyond_first() const {
+  std::size_t n = 0;
+  for (const UdimTile& t : tiles) n += t.number == kUdimFirst ? 0 : t.texels;
+  return n;
+}
+
+UdimLayout find_udim_tiles(const Mesh& low, int width, int height) {
+  UdimLayout out;
+  const std::size_t tris = low.triangle_count();
+  std::vector<std::int32_t> cell(tris);
+  std::vector<std::size_t> per_cell(std::size_t(kUdimColumns) * kUdimRows, 0);
+  for (std::size_t t = 0; t < tris; ++t) {
+    cell[t] = centroid_cell(low, t);
+    if (cell[t] < 0) ++out.outside_triangles;
+    else ++per_cell[std::size_t(cell[t])];
+  }
+  // Tiles by increasing number: cell u + 10 v is tile 1001 + u + 10 v, so cell order is number order.
+  std::vector<std::int32_t> index_of_cell(per_cell.size(), -1);
+  for (std::size_t c = 0; c < per_cell.size(); ++c) {
+    if (!per_cell[c]) continue;
+    index_of_cell[c] = std::int32_t(out.tiles.size());
+    UdimTile tile;
+    tile.u = int(c) % kUdimColumns;
+    tile.v = int(c) / kUdimColumns;
+    tile.number = udim_number(tile.u, tile.v);
+    tile.triangles = per_cell[c];
+    out.tiles.push_back(tile);
+  }
+  out.tile_of.resize(tris);
+  for (std::size_t t = 0; t < tris; ++t) {
+    out.tile_of[t] = cell[t] < 0 ? -1 : index_of_cell[std::size_t(cell[t])];
+    if (out.tile_of[t] < 0) continue;
+    UdimTile& tile = out.tiles[std::size_t(out.tile_of[t])];
+    if (straddles(low, t, tile.u, tile.v)) ++tile.straddling, ++out.straddling_triangles;
+  }
+  if (width <= 0 || height <= 0 || out.tiles.empty()) return out;
+  try {
+    std::vector<std::vector<std::uint32_t>> members(out.tiles.size());
+    for (std::size_t t = 0; t < tris; ++t)
+      if (out.tile_of[t] >= 0) members[std::size_t(out.tile_of[t])].push_back(std::uint32_t(t));
+    std::vector<std::uint8_t> mask(std::size_t(width) * std::size_t(height), 0);
+    for (std::size_t i = 0; i < out.tiles.size(); ++i)
+      out.tiles[i].texels = count_tile_texels(low, members[i], out.tiles[i], width, height, mask);
+  } catch (const std::bad_alloc&) {
+    throw ResourceError("out of memory while counting the texels of " + std::to_string(out.tiles.size()) + " UDIM tiles (" +
+                        std::to_string(width) + "x" + std::to_string(height) + ")");
+  }
+  return out;
+}
+
+UdimBake bake_udim_tiles(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt) {
+  if (!share_origin(low, high, cage)) {  // loaded each on its own (nmbake loads them on one origin)
+    const std::optional<Mesh> moved_cage = cage ? std::optional<Mesh>(with_origin(*cage, low.origin)) : std::nullopt;
+    return bake_udim_tiles(low, with_origin(high, low.origin), moved_cage ? &*moved_cage : nullptr, opt);
+  }
+  const UdimLayout layout = low.has_uvs() ? find_udim_tiles(low) : UdimLayout{};  // no UVs: check_bake_inputs says so
+  const std::size_t n = layout.tiles.size();
+  check_bake_inputs(low, high, cage, opt, std::max<std::size_t>(n, 1),
+                    n > 1 ? " for " + std::to_string(n) + " UDIM tiles" : std::string());
+  if (n == 0)
+    throw InputError(low.source + ": no triangle has its UV centroid in a UDIM tile (u 0 to 10, v 0 to " +
+                     std::to_string(kUdimRows) + "): nothing to bake");
+  const int threads = worker_threads(opt.threads);
+  const std::string texels = std::to_string(opt.width) + "x" + std::to_string(opt.height) + " texels, " +
+                             std::to_string(opt.samples) + (opt.samples == 1 ? " sample" : " samples");
+  const std::string allocating = "allocating the maps of " + std::to_string(n) + " UDIM tiles (" + texels + " each)";
+  std::string stage = allocating;
+  try {
+    UdimBake out;
+    out.tiles.resize(n);
+    std::vector<std::vector<std::uint8_t>> disagree(n);  // per tile, per texel: its samples disagree
+    OutputAllocation outputs([&opt, &out, &disagree] {
+      for (std::size_t i = 0; i < out.tiles.size(); ++i) allocate_outputs(opt, out.tiles[i].result, disagree[i]);
+    });
+    BakeResult shared;
+    TraceInputs in;
+    prepare_trace(low, high, cage, opt, threads, in, shared, stage);
+
+    // Trace: every tile with the shared scene, its own bins. Progress runs over all tiles.
+    announce_stage(opt, "tracing");
+    BakeOptions tile_opt = opt;
+    for (std::size_t i = 0; i < n; ++i) {
+      TileBake& tb = out.tiles[i];
+      tb.tile = layout.tiles[i];
+      BakeStats& st = tb.result.stats;
+      st = shared.stats;
+      st.uv_outside_triangles = tb.tile.straddling;
+      st.uv_outside_entirely_triangles = 0;
+      stage = "tracing UDIM tile " + std::to_string(tb.tile.number) + " (" + texels + ")";
+      if (opt.progress) tile_opt.progress = [&opt, i, n](double f) { return opt.progress((double(i) + f) / double(n)); };
+      const auto t0 = Clock::now();
+      const double cpu0 = process_cpu_seconds();
+      const UvTileFilter only{&layout.tile_of, std::int32_t(i), tb.tile.u, tb.tile.v};
+      const TileBins bins = bin_triangles(low, opt.width, opt.height, trace_tile_side(opt), &only);
+      if (i == 0) {  // the maps are allocated while the stages before the trace run
+        const std::string tracing = stage;
+        stage = allocating;
+        outputs.wait();
+        stage = tracing;
+      }
+      trace_and_shade(in.s, in.scene, bins, in.rays, tile_opt, threads,
+                      {tb.result.map, tb.result.coverage, tb.result.miss_mask, disagree[i]}, st);
+      st.seconds_trace = seconds_since(t0);
+      st.cpu_seconds_trace = process_cpu_seconds() - cpu0;
+    }
+
+    announce_stage(opt, "padding");
+    for (std::size_t i = 0; i < n; ++i) {
+      TileBake& tb = out.tiles[i];
+      stage = "padding UDIM tile " + std::to_string(tb.tile.number) + " (" + texels + ")";
+      const auto t0 = Clock::now();
+      pad_map(opt, disagree[i], threads, tb.result);
+      tb.result.stats.seconds_padding = seconds_since(t0);
+      std::vector<std::uint8_t>().swap(disagree[i]);
+    }
+
+    out.stats = shared.stats;
+    out.stats.uv_outside_triangles = layout.straddling_triangles;
+    out.stats.uv_outside_entirely_triangles = layout.outside_triangles;
+    sum_tile_stats(out.tiles, out.stats);
+    out.outside_triangles = layout.outside_triangles;
+    out.straddling_triangles = layout.straddling_triangles;
+    out.cage_positions = std::move(shared.cage_positions);
+    out.vertex_rear = std::move(shared.vertex_rear);
+    out.vertex_search = std::move(shared.vertex_search);
+    return out;
+  } catch (const std::bad_alloc&) {
+    throw ResourceError("out of memory while " + stage);
+  }
+}
+
+}  // namespace nmbake
