@@ -3,6 +3,7 @@
 // the single-map bake of the same meshes with that tile's UVs moved into 0-1 and the other
 // triangles' UVs moved out of the map; overlap is counted per tile; triangles in no tile are
 // counted; degenerate and mirrored UVs in a tile stay finite.
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <functional>
@@ -13,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "core/rasterize.h"
+#include "io/mesh_io.h"
 #include "pipeline/bake.h"
 #include "pipeline/udim.h"
 #include "test_support.h"
@@ -434,4 +436,59 @@ TEST(Udim, NoTriangleInAnyTileIsAnInputError) {
   Mesh low = three_tile_low();
   for (glm::vec2& uv : low.uvs) uv.x -= 12.0f;
   EXPECT_THROW(bake_udim_tiles(low, bumpy_high(), nullptr, options(16)), InputError);
+}
+
+namespace {
+
+// The three-tile scene as files, for the command line (normals computed from the faces).
+std::string write_three_tile_scene(const std::string& dir) {
+  test::write_file(dir + "/low.obj", obj_text(three_tile_low(), "three UDIM tiles"));
+  test::write_file(dir + "/high.obj", obj_text(flat_bumpy_high(), "bumps"));
+  return "low.obj high.obj --size 64";
+}
+
+}  // namespace
+
+// -o with <UDIM>: one map (and mask) per tile, each the command's single-tile bake; the report's
+// "udim" lists the tiles; without <UDIM> the warning names the tiles it leaves out.
+TEST(UdimCommand, OneMapPerTile) {
+  const std::string dir = test::scratch_dir();
+  const std::string scene = write_three_tile_scene(dir);
+  const test::CliRun r = test::run_nmbake(scene + " -o 'n.<UDIM>.png' --miss-mask 'm.<UDIM>.png' --report r.json", "", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(test::contains(r.out, "3 UDIM tiles: 1001, 1002, 1011")) << r.out;
+  const nlohmann::json& tiles = r.report["udim"]["tiles"];
+  ASSERT_EQ(tiles.size(), 3u);
+  const Mesh low = load_mesh(dir + "/low.obj");
+  const UdimLayout layout = find_udim_tiles(low);
+  for (std::size_t k = 0; k < 3; ++k) {
+    const int n = layout.tiles[k].number;
+    EXPECT_EQ(tiles[k]["tile"], n);
+    EXPECT_EQ(tiles[k]["file"], "n." + std::to_string(n) + ".png");
+    EXPECT_GT(tiles[k]["coverage"].get<double>(), 0.3);
+    EXPECT_TRUE(test::exists(dir + "/m." + std::to_string(n) + ".png"));
+    // The tile's map is the command's bake of the tile moved into 0-1, the rest moved away.
+    test::write_file(dir + "/ref.obj", obj_text(single_tile_reference(low, layout, k), "one tile"));
+    const test::CliRun single = test::run_nmbake("ref.obj high.obj --size 64 -o single.png", "", dir);
+    ASSERT_EQ(single.code, 0) << single.err;
+    EXPECT_TRUE(test::read_file(dir + "/n." + std::to_string(n) + ".png") == test::read_file(dir + "/single.png")) << n;
+  }
+  // Without <UDIM>: the unit square only, and the warning says what <UDIM> would add.
+  const test::CliRun plain = test::run_nmbake(scene + " -o plain.png", "", dir);
+  ASSERT_EQ(plain.code, 0) << plain.err;
+  EXPECT_TRUE(test::contains(plain.err, "lie in UDIM tiles 1002, 1011: -o with <UDIM>")) << plain.err;
+  EXPECT_TRUE(test::read_file(dir + "/plain.png") == test::read_file(dir + "/n.1001.png"));
+}
+
+TEST(UdimCommand, TilesWhereTheyCannotGoAreRefused) {
+  const std::string dir = test::scratch_dir();
+  const std::string scene = write_three_tile_scene(dir);
+  for (const char* args :
+       {"-o 'sub<UDIM>/n.png'", "-o 'n.<UDIM>.png' --report 'r.<UDIM>.json'", "-o 'n.<UDIM>.png' --save-cage 'c.<UDIM>.obj'",
+        "-o 'n.<UDIM>.png' --miss-mask m.png", "-o n.png --suspect-mask 's.<UDIM>.png'", "-o 'n.<UDIM>.png' --estimate-error"}) {
+    const test::CliRun r = test::run_nmbake(scene + " " + args, "", dir);
+    EXPECT_EQ(r.code, 1) << args << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    for (const char* file : {"n.1001.png", "n.png", "m.png", "r.json"}) EXPECT_FALSE(test::exists(dir + "/" + file)) << args;
+  }
 }

@@ -2,10 +2,12 @@
 
 #include <cstdio>
 #include <future>
+#include <optional>
 #include <tuple>
 
 #include "cli/outputs.h"
 #include "cli/report.h"
+#include "cli/udim_outputs.h"
 #include "cli/warnings.h"
 #include "core/errors.h"
 #include "core/normals.h"
@@ -59,9 +61,36 @@ ErrorEstimate estimate_error(const Mesh& low, const Mesh& high, const Mesh* cage
   return estimate;
 }
 
-// The map, the masks and the cage, each to its temporary file in `outputs`.
+// A map and its masks, and the files they go to (one set, or one per UDIM tile).
+struct MapFiles {
+  const BakeResult* result;
+  std::string map, miss_mask, suspect_mask;
+};
+
+std::vector<MapFiles> map_files(const Args& a, const BakeResult& r, const UdimBake* udim) {
+  if (!udim) return {{&r, a.output, a.miss_mask, a.suspect_mask}};
+  std::vector<MapFiles> files;
+  auto tile_path = [](const std::string& pattern, int n) { return pattern.empty() ? pattern : udim_path(pattern, n); };
+  for (const TileBake& t : udim->tiles)
+    files.push_back({&t.result, udim_path(a.output, t.tile.number), tile_path(a.miss_mask, t.tile.number),
+                     tile_path(a.suspect_mask, t.tile.number)});
+  return files;
+}
+
+// The UDIM tiles' files may not be inputs or each other (checked with the pattern before the bake).
+void check_tile_files(const Args& a, const std::vector<MapFiles>& files) {
+  std::vector<NamedFile> inputs{{"", a.low, "the low-poly"}, {"--cage", a.cage, "the cage"}}, outputs;
+  for (const std::string& h : a.highs) inputs.push_back({"", h, "the high-poly"});
+  for (const MapFiles& f : files)
+    for (const auto& [option, path] :
+         {std::pair{"--output", &f.map}, std::pair{"--miss-mask", &f.miss_mask}, std::pair{"--suspect-mask", &f.suspect_mask}})
+      outputs.push_back({option, *path, "a UDIM tile"});
+  check_output_files(inputs, outputs);
+}
+
+// The maps, the masks and the cage, each to its temporary file in `outputs`.
 void write_outputs(const JobEnv& env, OutputSet& outputs, const Args& a, const BakeOptions& o, const BakeResult& r,
-                   const Mesh& low, int bits) {
+                   const UdimBake* udim, const Mesh& low, int bits) {
   auto check_signal = [&env] {
     if (env.interrupted()) throw Cancelled();
   };
@@ -78,15 +107,21 @@ void write_outputs(const JobEnv& env, OutputSet& outputs, const Args& a, const B
            (o.space == NormalSpace::object ? "" : (o.green_down ? "DirectX (Y-)" : "OpenGL (Y+)")) + ", baked by nmbake"}};
   wo.compression = a.compression;
   wo.dither = a.dither;
-  wo.temp_path = outputs.add(a.output);
-  write_image(a.output, r.map, wo);
-  for (const auto& [path, image] : {std::pair{&a.miss_mask, &r.miss_mask}, std::pair{&a.suspect_mask, &r.suspect_mask}}) {
-    if (path->empty()) continue;
+  const std::vector<MapFiles> files = map_files(a, r, udim);
+  if (udim) check_tile_files(a, files);
+  for (const MapFiles& f : files) {
     check_signal();
-    WriteOptions mo;
-    mo.bits = default_bits_for(*path);
-    mo.temp_path = outputs.add(*path);
-    write_image(*path, *image, mo);
+    wo.temp_path = outputs.add(f.map);
+    write_image(f.map, f.result->map, wo);
+    for (const auto& [path, image] :
+         {std::pair{&f.miss_mask, &f.result->miss_mask}, std::pair{&f.suspect_mask, &f.result->suspect_mask}}) {
+      if (path->empty()) continue;
+      check_signal();
+      WriteOptions mo;
+      mo.bits = default_bits_for(*path);
+      mo.temp_path = outputs.add(*path);
+      write_image(*path, *image, mo);
+    }
   }
   if (!a.save_cage.empty()) {
     check_signal();
@@ -117,10 +152,16 @@ void report_job(const JobEnv& env, OutputSet& outputs, const Args& a, const Bake
 }
 
 void print_summary(const Args& a, const BakeOptions& o, const RunInfo& run, const BakeStats& s, int bits) {
+  std::string tiles;
+  if (run.udim.is_object()) {
+    for (const nlohmann::json& t : run.udim["tiles"]) tiles += (tiles.empty() ? "" : ", ") + std::to_string(t["tile"].get<int>());
+    tiles = std::to_string(run.udim["tiles"].size()) + (run.udim["tiles"].size() == 1 ? " UDIM tile: " : " UDIM tiles: ") +
+            tiles + ", ";
+  }
   std::printf(
-      "nmbake: wrote %s (%dx%d, %d-bit, %s%s): samples %d, rays %s, misses %llu (%.2f%%), coverage %.1f%%, "
+      "nmbake: wrote %s (%s%dx%d, %d-bit, %s%s): samples %d, rays %s, misses %llu (%.2f%%), coverage %.1f%%, "
       "seconds: load %.2f prepare %.2f bvh %.2f distances %.2f trace %.2f padding %.2f write %.2f total %.2f\n",
-      a.output.c_str(), o.width, o.height, bits, to_string(o.space),
+      a.output.c_str(), tiles.c_str(), o.width, o.height, bits, to_string(o.space),
       o.space == NormalSpace::tangent ? (o.green_down ? ", green down" : ", green up") : "", o.samples,
       human(double(s.rays)).c_str(), (unsigned long long)s.misses,
       s.samples_covered ? 100.0 * double(s.misses) / double(s.samples_covered) : 0.0, 100.0 * s.coverage, run.seconds_load,
@@ -199,6 +240,7 @@ void bake_job(const Args& a, const JobEnv& env) {
   BakeOptions o = bake_options(a);
   validate_options(o);  // the library's checks, before a long load
   const int bits = a.bits ? a.bits : default_bits_for(a.output);
+  check_udim_outputs(a);
   check_outputs(a, bits);
   WarningLog warnings(a.quiet < 2 && !a.no_warnings, a.strict);
 
@@ -238,7 +280,16 @@ void bake_job(const Args& a, const JobEnv& env) {
   o.progress = [&](double f) { return env.progress.fraction(f); };
   o.on_stage = [&](const char* stage) { env.progress.stage(stage); };
   *env.doing = "baking";
-  const BakeResult r = bake_normal_map(low, high, cage_mesh, o);
+  BakeResult r;
+  std::optional<UdimBake> udim;
+  if (has_udim(a.output)) {
+    udim = bake_udim_tiles(low, high, cage_mesh, o);
+    r.stats = udim->stats;
+    r.cage_positions = std::move(udim->cage_positions);
+    run.udim = udim_report(*udim, a.output);
+  } else {
+    r = bake_normal_map(low, high, cage_mesh, o);
+  }
   const BakeStats& s = r.stats;
   // Topology checks are only reported: they run beside the image write, which uses one core
   // (about 0.3-0.6 s CPU per 400k triangles; beside the bake they took time from its threads).
@@ -258,13 +309,13 @@ void bake_job(const Args& a, const JobEnv& env) {
   *env.doing = "writing the outputs";
   env.progress.stage("writing", false);  // not redrawn while the encoders' stderr is redirected
   t0 = Clock::now();
-  write_outputs(env, outputs, a, o, r, low, bits);
+  write_outputs(env, outputs, a, o, r, udim ? &*udim : nullptr, low, bits);
   run.seconds_write = std::chrono::duration<double>(Clock::now() - t0).count();
   *env.doing = "checking the high-poly's topology";
   run.high_topology = topology.get();
   if (env.keep_progress) env.progress.hold();
   else env.progress.finish();
-  warnings.add(bake_warnings(s, run.high_topology, a.low, a.high));
+  warnings.add(bake_warnings(s, run.high_topology, a.low, a.high, uv_tiles_note(low, a, o.width, o.height)));
   warnings.check_strict();
   run.warnings = warnings.all();
   run.seconds_total = std::chrono::duration<double>(Clock::now() - env.start).count();

@@ -36,6 +36,7 @@ struct RunInfo {
   std::array<double, 3> origin{};        // the point the meshes were re-centred on (Mesh::origin), 0 when not
   ObjectList low_objects, high_objects;  // every object of the low-poly and of the high-poly files
   MatchInfo match;                       // --match
+  nlohmann::json udim;                   // -o with <UDIM>: udim_report (udim_outputs.h); else null
 };
 
 const char* to_string(RayPolicy p);

@@ -46,8 +46,8 @@ void WarningLog::check_strict() const {
                     ", the first: " + first + "; nothing written");
 }
 
-std::vector<std::string> bake_warnings(const BakeStats& s, const MeshTopology& t, const std::string& low,
-                                       const std::string& high) {
+std::vector<std::string> bake_warnings(const BakeStats& s, const MeshTopology& t, const std::string& low, const std::string& high,
+                                       const UvTilesNote& uv_tiles) {
   std::vector<std::string> out;
   if (s.degenerate_uv_triangles)
     out.push_back(format("warning: %s: %zu triangles have zero UV area (they cover no texels and give no tangent)", low.c_str(),
@@ -55,11 +55,26 @@ std::vector<std::string> bake_warnings(const BakeStats& s, const MeshTopology& t
   if (s.degenerate_3d_triangles)
     out.push_back(format("warning: %s: %zu triangles have zero area (their texels take the normal found from a point or a line)",
                          low.c_str(), s.degenerate_3d_triangles));
-  if (s.uv_outside_triangles)
+  if (uv_tiles.udim) {  // udim.h: uv_outside_* count the triangles cut at their tile's edge and those in no tile
+    if (s.uv_outside_triangles)
+      out.push_back(
+          format("warning: %s: %zu triangles reach beyond their UDIM tile (by their UV centroid) and are cut at its edge",
+                 low.c_str(), s.uv_outside_triangles));
+    if (s.uv_outside_entirely_triangles)
+      out.push_back(format("warning: %s: %zu triangles lie in no UDIM tile (u below 0 or from 10 on, v below 0): not baked",
+                           low.c_str(), s.uv_outside_entirely_triangles));
+  } else if (s.uv_outside_triangles) {
+    std::string tiles;
+    if (uv_tiles.beyond_triangles)
+      tiles = format(
+          "; %zu triangles (%zu texels) lie in UDIM tiles %s: -o with <UDIM> (normal.<UDIM>.png) bakes them, one "
+          "map per tile",
+          uv_tiles.beyond_triangles, uv_tiles.beyond_texels, uv_tiles.beyond_tiles.c_str());
     out.push_back(
         format("warning: %s: %zu triangles have UVs outside [0,1] (%zu entirely outside, not baked); only the part inside "
-               "the map is baked, UVs are not wrapped",
-               low.c_str(), s.uv_outside_triangles, s.uv_outside_entirely_triangles));
+               "the map is baked, UVs are not wrapped%s",
+               low.c_str(), s.uv_outside_triangles, s.uv_outside_entirely_triangles, tiles.c_str()));
+  }
   if (s.overlapping_samples)
     out.push_back(format("warning: %s: UV islands overlap (%llu samples covered twice; the lower face number wins)", low.c_str(),
                          (unsigned long long)s.overlapping_samples));

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "cli/udim_outputs.h"
 #include "pipeline/bake.h"
 #include "core/errors.h"
 #include "core/mesh.h"
@@ -17,7 +18,7 @@ constexpr double kMissShareWarn = 0.01;
 constexpr double kFacingAwayShareWarn = 0.2;
 
 std::vector<std::string> bake_warnings(const BakeStats& stats, const MeshTopology& high_topology, const std::string& low_path,
-                                       const std::string& high_path);
+                                       const std::string& high_path, const UvTilesNote& uv_tiles = {});
 
 // What loading a mesh dropped: the file's normals (or UVs) when only some faces had them, or
 // (normals) one had length 0. `path` names the file.
