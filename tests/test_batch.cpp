@@ -8,6 +8,8 @@
 #include <gtest/gtest.h>
 
 #include "io/image_io.h"
+#include "io/mesh_io.h"
+#include "pipeline/bake.h"
 #include "test_support.h"
 
 namespace nmbake {
@@ -54,6 +56,9 @@ TEST(Batch, JobsBakeWhatTheirCommandsBake) {
   EXPECT_EQ(report["summary"]["baked"], 3);
   EXPECT_EQ(report["summary"]["failed"], 0);
   EXPECT_EQ(report["summary"]["high_loads_saved"], 2);
+  EXPECT_EQ(report["summary"]["bvh_reused"], 2);
+  EXPECT_EQ(report["jobs"][0]["report"]["bvh_reused"], false);
+  EXPECT_EQ(report["jobs"][2]["report"]["bvh_reused"], true);
   ASSERT_EQ(report["jobs"].size(), 3u);
   EXPECT_EQ(report["jobs"][1]["report"]["options"]["samples"], 4);
   EXPECT_EQ(report["jobs"][2]["report"]["options"]["keep_backfaces"], true);
@@ -130,6 +135,40 @@ TEST(Batch, AWrongFileStopsEverythingBeforeTheFirstBake) {
   EXPECT_EQ(missing.code, 2);
   EXPECT_TRUE(contains(missing.err, "nothing.json: cannot read")) << missing.err;
   EXPECT_EQ(run_nmbake("--batch jobs.json --samples 4", "", dir).code, 1) << "job options belong in the file";
+}
+
+// The BVH a bake keeps for the next bakes from the same high-poly: built over every triangle, taken
+// by a bake on the same scene centre, and the maps are those of bakes that build their own.
+TEST(Batch, AKeptBvhGivesTheSameMaps) {
+  const Mesh low = load_mesh(kLow), high = load_mesh(kHigh);
+  BakeOptions o;
+  o.width = o.height = 64;
+  const BakeResult plain = bake_normal_map(low, high, nullptr, o);
+  BvhCache cache;
+  o.bvh_cache = &cache;
+  const BakeResult first = bake_normal_map(low, high, nullptr, o);
+  ASSERT_TRUE(cache.scene != nullptr);
+  EXPECT_FALSE(first.stats.bvh_reused);
+  EXPECT_EQ(first.stats.high_triangles_culled, 0u) << "a kept BVH holds every triangle";
+  for (const bool keep_backfaces : {false, true}) {
+    o.keep_backfaces = keep_backfaces;
+    o.samples = keep_backfaces ? 4 : 1;
+    BakeOptions own = o;
+    own.bvh_cache = nullptr;
+    const BakeResult again = bake_normal_map(low, high, nullptr, o), alone = bake_normal_map(low, high, nullptr, own);
+    EXPECT_TRUE(again.stats.bvh_reused);
+    EXPECT_TRUE(again.map.pixels == alone.map.pixels) << "keep_backfaces " << keep_backfaces;
+  }
+  EXPECT_TRUE(first.map.pixels == plain.map.pixels);
+  EXPECT_EQ(cache.reused, 2u);
+  // A low-poly reaching beyond the high-poly's bounds moves the scene's centre: that bake builds its own.
+  Mesh moved = low;
+  for (glm::vec3& p : moved.positions) p.x += 0.5f;
+  o.keep_backfaces = false;
+  o.samples = 1;
+  const BakeResult other = bake_normal_map(moved, high, nullptr, o);
+  EXPECT_FALSE(other.stats.bvh_reused);
+  EXPECT_EQ(cache.reused, 2u);
 }
 
 }  // namespace

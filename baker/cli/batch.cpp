@@ -257,6 +257,8 @@ int run_batch(const BatchArgs& b, const std::function<bool()>& interrupted, cons
   }
   progress.finish();
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  std::size_t bvh_reused = 0;
+  for (const auto& [key, high] : cache.highs) bvh_reused += high->bvh.reused;
   if (!b.report.empty()) {
     const nlohmann::json summary = {{"batch", b.file},
                                     {"jobs", reports},
@@ -265,12 +267,15 @@ int run_batch(const BatchArgs& b, const std::function<bool()>& interrupted, cons
                                       {"baked", jobs.size() - failed},
                                       {"failed", failed},
                                       {"high_loads_saved", cache.hits},
+                                      {"bvh_reused", bvh_reused},
                                       {"seconds", seconds}}}};
     write_text_atomically(b.report, summary.dump(2) + "\n");
   }
   if (!b.quiet)
-    std::printf("nmbake: batch %s: %zu jobs, %zu baked, %zu failed, %.2f s; high-poly files loaded once for %zu jobs\n",
-                b.file.c_str(), jobs.size(), jobs.size() - failed, failed, seconds, cache.hits);
+    std::printf(
+        "nmbake: batch %s: %zu jobs, %zu baked, %zu failed, %.2f s; high-poly files loaded once for %zu jobs, a BVH reused by "
+        "%zu\n",
+        b.file.c_str(), jobs.size(), jobs.size() - failed, failed, seconds, cache.hits, bvh_reused);
   return first_failure;
 }
 

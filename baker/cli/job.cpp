@@ -277,6 +277,7 @@ void bake_job(const Args& a, const JobEnv& env) {
   warnings.check_strict();  // before a long bake
   if (env.interrupted()) throw Cancelled();
 
+  if (env.cache) o.bvh_cache = &loaded->bvh;  // a batch: the next job from this high-poly may trace its BVH
   o.progress = [&](double f) { return env.progress.fraction(f); };
   o.on_stage = [&](const char* stage) { env.progress.stage(stage); };
   *env.doing = "baking";

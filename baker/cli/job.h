@@ -14,6 +14,7 @@
 #include "cli/args.h"
 #include "cli/progress.h"
 #include "core/mesh.h"
+#include "pipeline/bake.h"
 
 namespace nmbake {
 
@@ -23,6 +24,7 @@ struct LoadedHigh {
   Mesh mesh;                           // the files merged (merge_meshes)
   std::vector<MeshLoadInfo> infos;     // each file's
   std::vector<std::size_t> triangles;  // each file's
+  mutable BvhCache bvh;                // its BVH, built by the first job and reused by the next (bake.h)
 };
 struct MeshCache {
   std::map<std::string, std::shared_ptr<const LoadedHigh>> highs;

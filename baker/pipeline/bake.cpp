@@ -163,17 +163,30 @@ void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const Ba
   st.seconds_prepare = seconds_since(t0);
 
   // The high-poly triangles some ray can reach: before the distances are known, within the
-  // probes' reach (or the distances given).
+  // probes' reach (or the distances given). A BVH kept for later bakes holds them all.
   t0 = Clock::now();
-  std::vector<std::uint32_t> kept;  // increasing; empty: all
-  if (opt.cull_far)
-    kept = select_reachable(
-        s, high, mode.probing ? mode.reach * 1.01 + 1e-6 * s.diagonal : ray_margin(s, mode.any_cage, opt.front, opt.rear));
-  st.high_duplicates_skipped = drop_duplicate_floods(s, high, threads, kept);
-  announce_stage(opt, "building the BVH");
-  stage = "building the BVH of " + std::to_string(kept.empty() ? high.triangle_count() : kept.size()) + " high-poly triangles";
+  BvhCache* const cache = opt.bvh_cache;
+  const bool reuse = cache && cache->scene && cache->high == &high && cache->centre == s.centre && cache->diagonal == s.diagonal;
+  const bool keep = cache && !cache->scene;
   HighScene& scene = in.scene;
-  build_high_scene(scene, s, high, kept, bvh_quality_for(opt, kept.empty() ? high.triangle_count() : kept.size()), opt.threads);
+  std::vector<std::uint32_t> kept;  // increasing; empty: all
+  if (reuse) {
+    announce_stage(opt, "building the BVH");
+    kept = cache->kept;
+    st.high_duplicates_skipped = cache->duplicates_skipped;
+    build_high_scene(scene, s, high, kept, cache->quality, opt.threads, cache->scene);
+    st.bvh_reused = true;
+    ++cache->reused;
+  } else {
+    if (opt.cull_far && !keep)
+      kept = select_reachable(
+          s, high, mode.probing ? mode.reach * 1.01 + 1e-6 * s.diagonal : ray_margin(s, mode.any_cage, opt.front, opt.rear));
+    st.high_duplicates_skipped = drop_duplicate_floods(s, high, threads, kept);
+    announce_stage(opt, "building the BVH");
+    stage = "building the BVH of " + std::to_string(kept.empty() ? high.triangle_count() : kept.size()) + " high-poly triangles";
+    build_high_scene(scene, s, high, kept, bvh_quality_for(opt, kept.empty() ? high.triangle_count() : kept.size()), opt.threads);
+    if (keep) *cache = {scene.scene, &high, s.centre, s.diagonal, kept, st.high_duplicates_skipped, scene.quality, 0};
+  }
   st.seconds_bvh = seconds_since(t0);
 
   t0 = Clock::now();
@@ -182,7 +195,7 @@ void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const Ba
   measure_reach(mode, low, opt, threads, s, scene, result);
   st.seconds_distances = seconds_since(t0);
 
-  if (opt.cull_far && mode.probing) {
+  if (opt.cull_far && mode.probing && !reuse && !keep) {
     // Rays from a cage reach the rear distance beyond P and, where they search beyond the cage,
     // as far out as they search: the BVH is rebuilt only if that leaves out a fifth of it or more.
     t0 = Clock::now();

@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -51,6 +52,22 @@ constexpr double kMixedShare = 0.2;
 // BakeOptions::low_object_group: a low-poly object matched to no high-poly object.
 constexpr std::uint32_t kNoMatch = 0xffffffffu;
 
+// A high-poly's BVH kept for the next bakes from the same high-poly mesh (nmbake --batch). The
+// first bake given an empty cache builds its BVH over every triangle (none culled: the map is the
+// same) and keeps it; a later bake from the same mesh whose scene has the same centre and diagonal
+// (its low-poly lies within the high-poly's bounds, or is the same) traces that BVH instead of
+// building one. The maps are the same either way.
+struct BvhCache {
+  std::shared_ptr<const raycast::Scene> scene;
+  const Mesh* high = nullptr;
+  glm::dvec3 centre{0.0};
+  double diagonal = 0.0;
+  std::vector<std::uint32_t> kept;  // the triangles in it (increasing; empty: all)
+  std::size_t duplicates_skipped = 0;
+  raycast::BuildQuality quality = raycast::BuildQuality::medium;
+  std::size_t reused = 0;  // bakes that took it
+};
+
 struct BakeOptions {
   int width = 2048;     // map width in texels
   int height = 2048;    // map height in texels
@@ -81,6 +98,8 @@ struct BakeOptions {
   // casts no ray and is written flat (counted in BakeStats::samples_unmatched). Empty: no matching,
   // every ray sees the whole high-poly. The probes that measure the distances see all of it.
   std::vector<std::uint32_t> low_object_group, high_object_group;
+  // A BVH to reuse or to keep for later bakes from the same high-poly (BvhCache); null: none.
+  BvhCache* bvh_cache = nullptr;
   // Called from the calling thread with the fraction done in [0,1]; return false to cancel
   // (bake_normal_map then throws Cancelled).
   std::function<bool(double)> progress;
@@ -106,6 +125,7 @@ struct BakeStats {
   std::size_t high_triangles_culled = 0;    // left out of the BVH: out of every ray's reach
   std::size_t high_duplicates_skipped = 0;  // of those, repeats in a stack of identical triangles (select.h)
   raycast::BuildQuality bvh_quality = raycast::BuildQuality::medium;  // of the BVH traced (bvh_quality_for)
+  bool bvh_reused = false;  // the BVH of an earlier bake from the same high-poly (BakeOptions::bvh_cache)
   std::size_t degenerate_uv_triangles = 0, degenerate_3d_triangles = 0, corners_without_tangent = 0;
   std::size_t uv_outside_triangles = 0;           // low-poly triangles with a UV outside [0,1]
   std::size_t uv_outside_entirely_triangles = 0;  // of those, UV bounding box outside [0,1]^2: not baked

@@ -3,7 +3,7 @@
 namespace nmbake {
 
 void build_high_scene(HighScene& h, const Prepared& s, const Mesh& high, const std::vector<std::uint32_t>& kept,
-                      raycast::BuildQuality quality, int threads) {
+                      raycast::BuildQuality quality, int threads, std::shared_ptr<const raycast::Scene> reuse) {
   h.positions = s.high_pos.data();
   h.index = high.position_index.data();
   h.normals = s.high_corner_normals.data();
@@ -39,7 +39,9 @@ void build_high_scene(HighScene& h, const Prepared& s, const Mesh& high, const s
   h.triangles = kept.empty() ? high.triangle_count() : kept.size();
   h.quality = quality;
   h.scene.reset();
-  h.scene.emplace(&s.high_pos[0].x, s.high_pos.size(), h.index, h.triangles, quality, threads);
+  h.scene =
+      reuse ? std::move(reuse)
+            : std::make_shared<const raycast::Scene>(&s.high_pos[0].x, s.high_pos.size(), h.index, h.triangles, quality, threads);
 }
 
 RayGroups ray_groups(const Prepared& s, const HighScene& h, const BakeOptions& opt) {

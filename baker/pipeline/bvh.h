@@ -4,7 +4,7 @@
 #pragma once
 
 #include <cstdint>
-#include <optional>
+#include <memory>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -16,8 +16,8 @@
 namespace nmbake {
 
 struct HighScene {
-  std::optional<raycast::Scene> scene;
-  const glm::vec3* positions = nullptr;  // re-centred, Prepared::high_pos
+  std::shared_ptr<const raycast::Scene> scene;  // shared with later bakes through a BvhCache
+  const glm::vec3* positions = nullptr;         // re-centred, Prepared::high_pos
   // 3 vertex indices, 3 corner normals and a facing code per BVH triangle. They point into the
   // mesh and Prepared, or, when some triangles are left out, into the kept_ copies.
   const std::uint32_t* index = nullptr;
@@ -55,8 +55,9 @@ RayGroups ray_groups(const Prepared& s, const HighScene& h, const BakeOptions& o
 const raycast::HitRule* trace_rule(const HighScene& h, bool backfaces_skipped, const RayGroups& groups, raycast::HitRule& rule);
 
 // Builds (or rebuilds) `h` over the high-poly triangles `kept` (increasing; empty: all of them).
+// With `reuse`, its BVH (built over the same triangles `kept`, on the same centre) is taken instead.
 void build_high_scene(HighScene& h, const Prepared& s, const Mesh& high, const std::vector<std::uint32_t>& kept,
-                      raycast::BuildQuality quality, int threads);
+                      raycast::BuildQuality quality, int threads, std::shared_ptr<const raycast::Scene> reuse = nullptr);
 
 // The high-poly found inverted (BakeStats::HighFacing): fronts are taken the other way round, and
 // normals nmbake computed itself are turned outwards with them (a file's normals are kept: the map
