@@ -22,6 +22,7 @@
 #include "core/errors.h"
 #include "core/memory_budget.h"
 #include "io/image_io.h"
+#include "io/mesh_io.h"
 #include "gl_context.h"
 #include "interactive.h"
 #include "renderer.h"
@@ -38,6 +39,7 @@ struct Options {
   std::string show;
   bool no_map = false;
   bool compare = false;
+  unsigned uv_set = 0;  // the low-poly's UV set the map was baked into (nmbake --uv-set)
   nmview::DecodingOverrides decoding;
 };
 
@@ -104,7 +106,7 @@ int run(const Options& o) {
   parse_show(o.show, io.toggles);
   io.toggles.map = !o.no_map;
 
-  const nmview::Scene scene = nmview::load_scene(o.low, o.map, o.high, std::cerr, o.decoding);
+  const nmview::Scene scene = nmview::load_scene(o.low, o.map, o.high, std::cerr, o.decoding, o.uv_set);
   check_renderer_headroom();
 
   if (!o.compare && o.screenshot.empty()) {
@@ -154,7 +156,7 @@ int run_command_line(int argc, char** argv) {
       "nmview: the low-poly with its baked tangent-space normal map beside the high-poly, "
       "lit alike from one camera"};
   Options o;
-  app.add_option("low", o.low, "Low-poly mesh with UVs (OBJ, PLY, OFF, STL), as given to nmbake")->required();
+  app.add_option("low", o.low, "Low-poly mesh with UVs (OBJ, PLY, OFF, STL, glTF, FBX, DAE...), as given to nmbake")->required();
   app.add_option("map", o.map, "Normal map baked for it (any size; its nmbake:* metadata says how it was baked)")->required();
   app.add_option("high", o.high, "High-poly mesh (its normals, else computed ones)")->required();
   app.add_option("--screenshot", o.screenshot,
@@ -183,6 +185,11 @@ int run_command_line(int argc, char** argv) {
   app.add_option("--bitangent", o.decoding.bitangent,
                  "Tangent-space map's bitangent: pixel = sign*cross(N,T) per pixel (MikkTSpace), vertex = "
                  "interpolated per-corner B (default: nmbake:bitangent metadata, else pixel)");
+  app.add_option("--uv-set", o.uv_set,
+                 "The low-poly's UV set the map was baked into, from 0, as given to nmbake --uv-set (glTF, FBX, DAE "
+                 "may have several)")
+      ->check(CLI::Range(0u, nmbake::kMaxUvSets - 1))
+      ->capture_default_str();
   app.add_option("--show", o.show, "Start with toggles on: wire,diff,tangent,specular,nolabels");
 
   try {

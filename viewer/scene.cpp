@@ -11,7 +11,7 @@
 namespace nmview {
 
 Scene load_scene(const std::string& low_path, const std::string& map_path, const std::string& high_path, std::ostream& log,
-                 const DecodingOverrides& overrides) {
+                 const DecodingOverrides& overrides, unsigned uv_set) {
   Scene scene;
   scene.low_name = low_path;
   scene.map_name = map_path;
@@ -20,6 +20,7 @@ Scene load_scene(const std::string& low_path, const std::string& map_path, const
   // Inputs are read in command-line order so the first bad one is the one reported.
   nmbake::LoadOptions low_options;
   low_options.require_uvs = true;
+  low_options.uv_set = uv_set;
   nmbake::Mesh low = nmbake::load_mesh(low_path, low_options);
 
   scene.map = nmbake::read_image(map_path);

@@ -29,8 +29,10 @@ struct Scene {
 // Throws nmbake::InputError (from the loaders, or "<map>: has N channel(s); a normal map needs
 // RGB") on bad input, nmbake::UsageError for a bad override. Notes (the map's decoding and where it
 // came from, normals computed, a tangent-space map that does not look like one) go to `log`.
+// `uv_set` is the low-poly's UV set the map was baked into (nmbake --uv-set, LoadOptions::uv_set:
+// 0 the first, below nmbake::kMaxUvSets); its UVs and tangent frames are the ones shown.
 Scene load_scene(const std::string& low_path, const std::string& map_path, const std::string& high_path, std::ostream& log,
-                 const DecodingOverrides& overrides = {});
+                 const DecodingOverrides& overrides = {}, unsigned uv_set = 0);
 
 // Writes the RGB of `image` with nmbake::write_image (8-bit for PNG). Throws nmbake::OutputError.
 void write_screenshot(const std::string& path, const Rgba8Image& image);

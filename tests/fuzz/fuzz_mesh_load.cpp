@@ -2,8 +2,10 @@
 // then the checks every later stage relies on, then the stages that consume a loaded mesh first
 // (smooth normals, tangent frames).
 //
-// Input: byte 0 picks the reader ('o' OBJ, 'p' PLY, 'f' OFF, 's' STL; any other byte: byte % 4 in
-// that order), the rest is the file. A refusal must be an InputError or ResourceError of one line
+// Input: byte 0 picks the reader by the file name it gives ('o' OBJ, 'p' PLY, 'f' OFF, 's' STL,
+// through Assimp 'g' glTF JSON, 'b' GLB, 'd' COLLADA, 'x' FBX; any other byte: byte % 8 in that
+// order), the rest is the file. From memory a .gltf has no side files: its buffers are data URIs
+// (Assimp looks any other URI up relative to the working folder). A refusal must be an InputError or ResourceError of one line
 // naming the file; anything else (another exception, a broken invariant, a NaN) aborts, which
 // libFuzzer reports as a crash. ASan/UBSan catch memory errors and undefined behaviour.
 #include <cmath>
@@ -11,6 +13,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <string>
 #include <string_view>
 
@@ -80,14 +83,17 @@ void check_message(const std::string& message, const std::string& name) {
 
 }  // namespace
 
+// LeakSanitizer (ASan builds): Assimp 5.2 leaks on the error paths of several readers (README,
+// open/leak_*); those leaks are its own, and without this a fuzzing run stops at the first one.
+extern "C" const char* __lsan_default_suppressions() { return "leak:libassimp.so\n"; }
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size == 0) return 0;
-  static const char* const kNames[] = {"fuzz.obj", "fuzz.ply", "fuzz.off", "fuzz.stl"};
-  int reader = data[0] % 4;
-  if (data[0] == 'o') reader = 0;
-  if (data[0] == 'p') reader = 1;
-  if (data[0] == 'f') reader = 2;
-  if (data[0] == 's') reader = 3;
+  static const char kLetters[] = "opfsgbdx";
+  static const char* const kNames[] = {"fuzz.obj",  "fuzz.ply", "fuzz.off", "fuzz.stl",
+                                       "fuzz.gltf", "fuzz.glb", "fuzz.dae", "fuzz.fbx"};
+  const char* letter = data[0] ? std::strchr(kLetters, data[0]) : nullptr;
+  const std::size_t reader = letter ? std::size_t(letter - kLetters) : data[0] % 8u;
   const std::string name = kNames[reader];
   const std::string_view bytes(reinterpret_cast<const char*>(data + 1), size - 1);
   try {

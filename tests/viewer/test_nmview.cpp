@@ -26,6 +26,7 @@
 
 #include "core/image.h"
 #include "io/image_io.h"
+#include "io/mesh_io.h"
 #include "scene_maker.h"
 #include "test_support.h"
 
@@ -450,6 +451,80 @@ TEST(NmviewInputs, MapOfAnySizeIsFine) {
   Result r = nmview(dir, quote(s.low) + " " + quote(dir + "/odd.png") + " " + quote(s.low) + " --compare --size 200x100");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_GE(parse_summary(r.out).within2, 0.99);
+}
+
+// --- --uv-set: the low-poly's UV set the map was baked into ------------------------------------
+
+// Mean |a - b| of the 8-bit channels of two same-size screenshots over the left (pane 0) or the
+// right (pane 1) half.
+double pane_difference(const std::string& a_path, const std::string& b_path, int pane) {
+  int aw = 0, ah = 0, bw = 0, bh = 0;
+  const std::vector<int> a = read_rgb8(a_path, aw, ah), b = read_rgb8(b_path, bw, bh);
+  EXPECT_TRUE(aw == bw && ah == bh);
+  if (aw != bw || ah != bh) return 0.0;
+  double sum = 0.0;
+  const int x0 = pane * aw / 2, x1 = x0 + aw / 2;
+  for (int y = 0; y < ah; ++y)
+    for (int x = x0; x < x1; ++x)
+      for (int c = 0; c < 3; ++c) sum += std::abs(a[3 * (std::size_t(y) * aw + x) + c] - b[3 * (std::size_t(y) * aw + x) + c]);
+  return sum / (3.0 * (x1 - x0) * ah);
+}
+
+// A UV sphere (32 x 16 quads, outward normals) of `radius` around `centre`, as OBJ.
+void write_sphere_obj(const std::string& path, glm::dvec3 centre, double radius) {
+  std::ofstream out(path);
+  const int segments = 32, rings = 16;
+  for (int r = 0; r <= rings; ++r)
+    for (int s = 0; s <= segments; ++s) {
+      const double theta = M_PI * r / rings, phi = 2.0 * M_PI * s / segments;
+      const glm::dvec3 n(std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi));
+      const glm::dvec3 p = centre + radius * n;
+      out << "v " << p.x << " " << p.y << " " << p.z << "\nvn " << n.x << " " << n.y << " " << n.z << "\n";
+    }
+  for (int r = 0; r < rings; ++r)
+    for (int s = 0; s < segments; ++s) {
+      const int a = r * (segments + 1) + s + 1, b = a + segments + 1;  // OBJ counts from 1
+      out << "f " << a << "//" << a << " " << a + 1 << "//" << a + 1 << " " << b + 1 << "//" << b + 1 << " " << b << "//" << b
+          << "\n";
+    }
+}
+
+// cube_with_2UVs.DAE has two UV layouts of one cube. A map baked into set 0 (the cube against a
+// sphere through its faces, so every face shades from its middle out) is another picture on the
+// left pane when nmview reads set 1, and the same one with --uv-set 0 as without; the high-poly's
+// pane does not change. Sets from 8 on are refused as a usage error, a set the file lacks as bad
+// input (the baker's errors).
+TEST(NmviewUvSet, SetOneOfATwoSetCubeRendersDifferently) {
+  const std::string dir = scratch_dir();
+  const std::string cube = nmbake::test::data_path("assimp/cube_with_2UVs.DAE");
+  const nmbake::Mesh mesh = nmbake::load_mesh(cube);
+  glm::dvec3 lo(1e30), hi(-1e30);
+  for (const glm::vec3& p : mesh.positions) {
+    lo = glm::min(lo, glm::dvec3(p));
+    hi = glm::max(hi, glm::dvec3(p));
+  }
+  // 0.6 of the half diagonal: out of the face middles (0.58), inside the edges (0.82) and corners.
+  write_sphere_obj(dir + "/sphere.obj", 0.5 * (lo + hi) + mesh.origin, 0.6 * 0.5 * glm::length(hi - lo));
+  const std::string map = dir + "/map_baked_into_set0.png";
+  bake(dir, cube, dir + "/sphere.obj", map);
+  if (HasFatalFailure()) return;
+  const std::string inputs = quote(cube) + " " + quote(map) + " " + quote(cube) + " --size 320x160 --screenshot ";
+  for (const std::string& run :
+       {std::string("default.png"), std::string("set0.png --uv-set 0"), std::string("set1.png --uv-set 1")}) {
+    Result r = nmview(dir, inputs + quote(dir) + "/" + run);
+    ASSERT_EQ(r.exit_code, 0) << run << ": " << r.err;
+  }
+  const double same = pane_difference(dir + "/default.png", dir + "/set0.png", 0);
+  const double low_pane = pane_difference(dir + "/set0.png", dir + "/set1.png", 0);
+  const double high_pane = pane_difference(dir + "/set0.png", dir + "/set1.png", 1);
+  std::printf("mean |set 0 - set 1| (8-bit): low pane %.3f, high pane %.3f; default vs --uv-set 0: %.3f\n", low_pane, high_pane,
+              same);
+  EXPECT_EQ(same, 0.0);
+  EXPECT_GE(low_pane, 2.0) << "--uv-set 1 shows the map as set 0 does";
+  EXPECT_EQ(high_pane, 0.0);
+  expect_error(nmview(dir, inputs + quote(dir + "/x.png") + " --uv-set 8"), 1, "--uv-set");
+  expect_error(nmview(dir, inputs + quote(dir + "/x.png") + " --uv-set 2"), 2, "(UV set 2) has no UVs");
+  EXPECT_FALSE(fs::exists(dir + "/x.png"));
 }
 
 }  // namespace
