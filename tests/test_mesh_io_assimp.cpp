@@ -233,3 +233,29 @@ TEST(AssimpFormats, MirroringTransformsKeepTheWinding) {
 
 }  // namespace
 }  // namespace nmbake
+
+namespace nmbake {
+namespace {
+
+// Bytes of another format under an Assimp extension are refused before Assimp reads them (its
+// fallback to reading by signature took a broken PLY named .gltf into a reader that never ends).
+TEST(AssimpFormats, ContentsMustFitTheExtension) {
+  const std::string ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n";
+  for (const char* name : {"a.gltf", "a.glb", "a.fbx", "a.dae"}) {
+    try {
+      load_mesh_from_memory(name, ply);
+      ADD_FAILURE() << name << " loaded";
+    } catch (const InputError& e) {
+      EXPECT_TRUE(test::contains(e.what(), std::string(name) + ": is not a ." + (std::string(name).substr(2)) + " file"))
+          << e.what();
+    }
+  }
+  // A glTF whose node hides its mesh by a scale of 0: finite normals (replaced by computed ones).
+  const std::string hidden = test::read_file(test::data_path("../tests/fuzz/corpus/crash_gltf_node_scale_zero"));
+  ASSERT_FALSE(hidden.empty());
+  const Mesh m = load_mesh_from_memory("hidden.gltf", hidden.substr(1));
+  for (const glm::vec3& n : m.normals) EXPECT_TRUE(std::isfinite(n.x) && std::isfinite(n.y) && std::isfinite(n.z));
+}
+
+}  // namespace
+}  // namespace nmbake

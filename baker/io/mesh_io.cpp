@@ -175,7 +175,7 @@ void settle_normals(ParsedMesh& parsed, MeshLoadInfo& info) {
       // overflows float, and dividing by an infinite length would give a zero normal.
       const glm::dvec3 n(m.normals[i]);
       const double length = glm::length(n);
-      if (length < kZeroNormalLength) {
+      if (!(length >= kZeroNormalLength)) {  // NaN too
         ++info.zero_normals;
         continue;
       }

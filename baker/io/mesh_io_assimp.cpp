@@ -10,14 +10,18 @@
 // per corner, so hard edges and seams are kept as in an OBJ file. Points and lines are left out.
 // Each node with meshes is an object named after the node (Mesh::objects); a node name met twice
 // is one object.
+#include <assimp/DefaultLogger.hpp>
 #include <assimp/Importer.hpp>
+#include <assimp/LogStream.hpp>
 #include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
+#include <mutex>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -116,10 +120,17 @@ class SceneReader {
         const aiVector3D& n = m.mNormals[v];
         glm::dvec3 w = normal_matrix * glm::dvec3(n.x, n.y, n.z);
         const double length = glm::length(w);
-        if (length > 0.0 && std::isfinite(length)) w /= length;
+        // A singular transform (a node scaled by 0, as glTF hides nodes) leaves no direction: a
+        // zero normal, which load_mesh replaces by computed ones.
+        w = length > 0.0 && std::isfinite(length) ? w / length : glm::dvec3(0.0);
         out_.mesh.normals.emplace_back(w);
       }
-      if (out_.corner_uvs) out_.mesh.uvs.emplace_back(m.mTextureCoords[uv_set_][v].x, m.mTextureCoords[uv_set_][v].y);
+      if (out_.corner_uvs) {
+        const aiVector3D& t = m.mTextureCoords[uv_set_][v];
+        if (!std::isfinite(t.x) || !std::isfinite(t.y))
+          fail(path_, name + ": vertex " + std::to_string(v) + " has a non-finite texture coordinate");
+        out_.mesh.uvs.emplace_back(t.x, t.y);
+      }
     }
     std::vector<Corner> corners;
     for (unsigned f = 0; f < m.mNumFaces; ++f) {
@@ -152,6 +163,59 @@ class SceneReader {
   std::unordered_map<glm::dvec3, std::uint32_t, PositionHash> weld_;
 };
 
+// Assimp's warnings while a file is read. Some tell of data it dropped and read on without (faces
+// with indices out of range, the vertices of an incomplete triangle): such a file is refused, not
+// baked with holes. One logger for the process (Assimp's is global), collecting while a read runs.
+class DroppedDataLog : public Assimp::LogStream {
+ public:
+  static DroppedDataLog& instance() {
+    static DroppedDataLog* log = [] {
+      auto* l = new DroppedDataLog;  // owned by Assimp's logger from here on
+      Assimp::DefaultLogger::create("", Assimp::Logger::NORMAL, 0);
+      Assimp::DefaultLogger::get()->attachStream(l, Assimp::Logger::Warn | Assimp::Logger::Err);
+      return l;
+    }();
+    return *log;
+  }
+  void write(const char* message) override {
+    const std::string m = message;
+    if (first_.empty() && (m.find("out-of-range indices") != std::string::npos ||
+                           m.find("not compatible with the TRIANGLES mode") != std::string::npos)) {
+      const std::size_t colon = m.find(": ");  // after "Warn,  T0"
+      first_ = colon == std::string::npos ? m : m.substr(colon + 2);
+      while (!first_.empty() && (first_.back() == '\n' || first_.back() == '\r')) first_.pop_back();
+    }
+  }
+  // Runs `read` alone and returns what it dropped ("" for nothing).
+  template <typename Read>
+  std::string collect(Read&& read) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    first_.clear();
+    read();
+    return first_;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::string first_;
+};
+
+// Whether the bytes can be a file of this extension: Assimp tries every reader on a file its own
+// refuses, and one of them (PLY) loops for ever on some inputs named .gltf.
+bool signature_fits(const std::string& ext, std::string_view bytes) {
+  const std::string_view head = bytes.substr(0, 65536);
+  std::size_t first = 0;
+  if (head.substr(0, 3) == "\xEF\xBB\xBF") first = 3;
+  while (first < head.size() && std::isspace(static_cast<unsigned char>(head[first]))) ++first;
+  const char lead = first < head.size() ? head[first] : '\0';
+  if (ext == "glb") return head.substr(0, 4) == "glTF";
+  if (ext == "gltf") return lead == '{';
+  if (ext == "fbx")
+    return head.substr(0, 18) == "Kaydara FBX Binary" || lead == ';' || head.find("FBXHeaderExtension") != std::string_view::npos;
+  if (ext == "dae") return head.find("COLLADA") != std::string_view::npos;
+  return true;
+}
+
 }  // namespace
 
 bool assimp_reads(const std::string& ext) {
@@ -165,9 +229,14 @@ ParsedMesh parse_assimp(const std::string& path, const std::string& ext, std::st
   // Points and lines are dropped by the reader; the scene is checked for indices out of range.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
   const unsigned flags = aiProcess_ValidateDataStructure | aiProcess_SortByPType;
+  if (!signature_fits(ext, bytes)) fail(path, "is not a ." + ext + " file (its first bytes say otherwise)");
   // A file beside others (a .gltf and its .bin) is read by name; bytes alone for the fuzz target.
-  const aiScene* scene =
-      read_path ? importer.ReadFile(path, flags) : importer.ReadFileFromMemory(bytes.data(), bytes.size(), flags, ext.c_str());
+  const aiScene* scene = nullptr;
+  const std::string dropped = DroppedDataLog::instance().collect([&] {
+    scene =
+        read_path ? importer.ReadFile(path, flags) : importer.ReadFileFromMemory(bytes.data(), bytes.size(), flags, ext.c_str());
+  });
+  if (scene && !dropped.empty()) fail(path, "malformed: " + dropped);
   if (!scene || !scene->mRootNode) {
     std::string why = importer.GetErrorString();
     for (char& c : why)

@@ -46,9 +46,9 @@ cases=$(
 2 2 invalid/malformed2.obj            a face without corners (and a material that does not exist)
 2 0 glTF2/BoxBadNormals-glTF-Binary/BoxBadNormals.glb      zero normals: dropped with a warning, smooth ones computed; no UVs
 2 2 glTF2/BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb infinite coordinates
-2 gap glTF2/IncorrectVertexArrays/Cube.gltf                 vertex arrays of 35 (not 3n) for triangles and lines: Assimp drops the partial triangle; no UVs
+2 2 glTF2/IncorrectVertexArrays/Cube.gltf                   vertex arrays of 35 (not 3n) for triangles and lines: Assimp drops the partial triangle (refused: "malformed")
 2 2 glTF2/IndexOutOfRange/AllIndicesOutOfRange.gltf         every index out of range
-2 gap glTF2/IndexOutOfRange/IndexOutOfRange.gltf            one index out of range: Assimp drops that triangle (11 of 12 bake); no UVs
+2 2 glTF2/IndexOutOfRange/IndexOutOfRange.gltf              one index out of range: Assimp drops that triangle (refused: "malformed")
 2 2 glTF2/MissingBin/BoxTextured.gltf                       its .bin is missing
 2 2 glTF2/RecursiveNodes/RecursiveNodes.gltf                a node cycle
 2 2 glTF2/SchemaFailures/sceneWrongType.gltf                "scene" of the wrong JSON type
