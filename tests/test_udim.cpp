@@ -16,6 +16,7 @@
 #include "core/rasterize.h"
 #include "io/mesh_io.h"
 #include "pipeline/bake.h"
+#include "pipeline/tiles.h"
 #include "pipeline/udim.h"
 #include "test_support.h"
 
@@ -203,6 +204,38 @@ TEST(Udim, ThreeTilesEqualThreeSingleTileBakes) {
 }
 
 // A layout entirely in 1001 bakes the same map as bake_normal_map, bit for bit.
+// The error estimate's re-bake of a tile (its triangles alone, UVs moved into 0-1) gives the tile's
+// own values, with the automatic cage the bake keeps once for all tiles.
+TEST(Udim, RebakedTileTexelsMatchTheTile) {
+  const Mesh low = three_tile_low(), high = bumpy_high();
+  const BakeOptions o = options(48);
+  UdimBake udim = bake_udim_tiles(low, high, nullptr, o);
+  const UdimLayout layout = find_udim_tiles(low);
+  ASSERT_EQ(udim.tiles.size(), layout.tiles.size());
+  for (std::size_t k = 0; k < udim.tiles.size(); ++k) {
+    BakeResult r = udim.tiles[k].result;
+    r.cage_positions = udim.cage_positions;
+    r.vertex_rear = udim.vertex_rear;
+    r.vertex_search = udim.vertex_search;
+    std::vector<std::uint32_t> texels;
+    for (std::uint32_t i = 0; i < r.coverage.size(); ++i)
+      if (r.coverage[i]) texels.push_back(i);
+    ASSERT_GT(texels.size(), 500u);
+    const UvTileFilter filter{&layout.tile_of, std::int32_t(k), layout.tiles[k].u, layout.tiles[k].v};
+    const std::vector<glm::dvec3> v = bake_texel_values(low, high, nullptr, o, r, texels, o.samples, &filter);
+    double worst = 0.0;
+    for (std::size_t i = 0; i < texels.size(); ++i)
+      worst = std::max(worst, test::angle_deg(test::decode_rgb(&r.map.pixels[3 * std::size_t(texels[i])]), v[i]));
+    EXPECT_LT(worst, 1e-3) << "tile " << layout.tiles[k].number;  // float encoding only
+  }
+  const std::vector<ErrorEstimate> e = estimate_udim_errors(low, high, nullptr, o, udim);
+  ASSERT_EQ(e.size(), udim.tiles.size());
+  EXPECT_EQ(udim.cage_positions.size(), low.positions.size()) << "the kept cage is put back";
+  const ErrorEstimate all = combine_estimates(e);
+  EXPECT_EQ(all.texels, e[0].texels + e[1].texels + e[2].texels);
+  EXPECT_GE(all.max_deg, std::max({e[0].max_deg, e[1].max_deg, e[2].max_deg}));
+}
+
 TEST(Udim, OneTileInTheUnitSquareIsThePlainBake) {
   const Mesh low = test::make_height_field(10, 10, dome, dome_normal), high = bumpy_high();
   const BakeOptions o = options(64);
@@ -473,6 +506,19 @@ TEST(UdimCommand, OneMapPerTile) {
     ASSERT_EQ(single.code, 0) << single.err;
     EXPECT_TRUE(test::read_file(dir + "/n." + std::to_string(n) + ".png") == test::read_file(dir + "/single.png")) << n;
   }
+  // The error estimate, per tile: each tile's map against a re-bake of its own texels.
+  const test::CliRun estimated = test::run_nmbake(scene + " -o 'e.<UDIM>.png' --estimate-error --report r.json", "", dir);
+  ASSERT_EQ(estimated.code, 0) << estimated.err;
+  EXPECT_TRUE(test::contains(estimated.err, "error estimate: mean")) << estimated.err;
+  for (const nlohmann::json& t : estimated.report["udim"]["tiles"]) {
+    EXPECT_GT(t["error_estimate"]["texels"].get<int>(), 500) << t;
+    EXPECT_LT(t["error_estimate"]["mean_deg"].get<double>(), 2.0) << t;
+  }
+  EXPECT_EQ(estimated.report["error_estimate"]["texels"].get<int>(), [&] {
+    int n = 0;
+    for (const nlohmann::json& t : estimated.report["udim"]["tiles"]) n += t["error_estimate"]["texels"].get<int>();
+    return n;
+  }());
   // Without <UDIM>: the unit square only, and the warning says what <UDIM> would add.
   const test::CliRun plain = test::run_nmbake(scene + " -o plain.png", "", dir);
   ASSERT_EQ(plain.code, 0) << plain.err;
@@ -485,7 +531,7 @@ TEST(UdimCommand, TilesWhereTheyCannotGoAreRefused) {
   const std::string scene = write_three_tile_scene(dir);
   for (const char* args :
        {"-o 'sub<UDIM>/n.png'", "-o 'n.<UDIM>.png' --report 'r.<UDIM>.json'", "-o 'n.<UDIM>.png' --save-cage 'c.<UDIM>.obj'",
-        "-o 'n.<UDIM>.png' --miss-mask m.png", "-o n.png --suspect-mask 's.<UDIM>.png'", "-o 'n.<UDIM>.png' --estimate-error"}) {
+        "-o 'n.<UDIM>.png' --miss-mask m.png", "-o n.png --suspect-mask 's.<UDIM>.png'"}) {
     const test::CliRun r = test::run_nmbake(scene + " " + args, "", dir);
     EXPECT_EQ(r.code, 1) << args << ": " << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;

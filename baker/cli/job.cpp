@@ -41,11 +41,23 @@ void print_distances(const BakeStats& s) {
                  s.rear, 100.0 * s.auto_probe_beyond);
 }
 
+// With <UDIM>, each tile's estimate goes into the report's udim tiles and the line gives them combined.
 ErrorEstimate estimate_error(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& o, const BakeResult& r,
-                             int bits, Progress& progress) {
+                             UdimBake* udim, RunInfo& run, int bits, Progress& progress) {
   ErrorEstimateOptions eo;
   eo.bits = bits;
-  const ErrorEstimate estimate = estimate_bake_error(low, high, cage, o, r, eo);
+  ErrorEstimate estimate;
+  if (udim) {
+    const std::vector<ErrorEstimate> tiles = estimate_udim_errors(low, high, cage, o, *udim, eo);
+    for (std::size_t k = 0; k < tiles.size() && k < run.udim["tiles"].size(); ++k)
+      run.udim["tiles"][k]["error_estimate"] = {{"mean_deg", tiles[k].mean_deg},
+                                                {"p95_deg", tiles[k].p95_deg},
+                                                {"max_deg", tiles[k].max_deg},
+                                                {"texels", tiles[k].texels}};
+    estimate = combine_estimates(tiles);
+  } else {
+    estimate = estimate_bake_error(low, high, cage, o, r, eo);
+  }
   // The estimate compares float values; say what the output's bit depth adds on top.
   char quant[128] = "float output adds no quantisation";
   if (bits != 32)
@@ -286,7 +298,7 @@ void bake_job(const Args& a, const JobEnv& env) {
   if (has_udim(a.output)) {
     udim = bake_udim_tiles(low, high, cage_mesh, o);
     r.stats = udim->stats;
-    r.cage_positions = std::move(udim->cage_positions);
+    r.cage_positions = udim->cage_positions;  // --save-cage; the estimate reads the tiles' copy
     run.udim = udim_report(*udim, a.output);
   } else {
     r = bake_normal_map(low, high, cage_mesh, o);
@@ -302,7 +314,7 @@ void bake_job(const Args& a, const JobEnv& env) {
   *env.doing = "estimating the error";
   if (a.estimate_error) {
     env.progress.stage("estimating the error");
-    estimate = estimate_error(low, high, cage_mesh, o, r, bits, env.progress);
+    estimate = estimate_error(low, high, cage_mesh, o, r, udim ? &*udim : nullptr, run, bits, env.progress);
   }
 
   // Every output to its temporary file, then all renamed into place together.

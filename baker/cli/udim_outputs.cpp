@@ -29,7 +29,6 @@ void check_udim_outputs(const Args& a) {
                        (udim ? ": the map has <UDIM>, so its masks need it too (one per tile)"
                              : ": <UDIM> in a mask needs it in the map's name (-o) too"));
   }
-  if (udim && a.estimate_error) throw UsageError("--estimate-error is not available with <UDIM> output yet");
 }
 
 UvTilesNote uv_tiles_note(const Mesh& low, const Args& a, int width, int height) {

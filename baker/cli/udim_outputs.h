@@ -21,7 +21,7 @@ std::string udim_path(const std::string& pattern, int number);
 
 // Refuses (UsageError) <UDIM> where tiles cannot go: in a folder's name, in --report or
 // --save-cage (one file for the whole bake), in a mask when the map has none (or the other way
-// round), with --estimate-error (not available for tiles yet).
+// round).
 void check_udim_outputs(const Args& a);
 
 // What the UV layout holds beyond the unit square, for the warnings (warnings.h).

@@ -242,13 +242,15 @@ std::vector<glm::vec3> low_ray_normals(const Mesh& low);
 std::vector<glm::dvec2> sample_offsets(int samples);
 
 // ---- Re-baking chosen texels (for the error estimate, error_estimate.h) ----
+struct UvTileFilter;  // tiles.h: one UDIM tile's triangles, their UVs moved into 0-1
 // The unit values bake_normal_map gives texels `texels` (indices y * width + x) with `samples`
 // sample points each (sample_offsets), using the ray distances, cage and centre of a finished bake
 // (`baked`) and otherwise the same rays, shading and averaging as the bake (tangent space with
 // --green down applied, or object space), as n in [-1,1]^3 (not encoded, not snapped to 0).
 // A texel none of whose samples falls in the UV layout gets (0,0,0). Builds its own BVH.
 std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& options,
-                                          const BakeResult& baked, const std::vector<std::uint32_t>& texels, int samples);
+                                          const BakeResult& baked, const std::vector<std::uint32_t>& texels, int samples,
+                                          const UvTileFilter* tile = nullptr);
 // ---- end of re-baking chosen texels ----
 
 }  // namespace nmbake

@@ -57,7 +57,7 @@ ErrorEstimate estimate_bake_error(const Mesh& low, const Mesh& high, const Mesh*
   }
   std::sort(texels.begin(), texels.end());
 
-  const std::vector<glm::dvec3> reference = bake_texel_values(low, high, cage, options, result, texels, e.samples);
+  const std::vector<glm::dvec3> reference = bake_texel_values(low, high, cage, options, result, texels, e.samples, eo.tile);
   std::vector<double> err;
   err.reserve(texels.size());
   double sum = 0.0, qsum = 0.0;

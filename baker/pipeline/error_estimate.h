@@ -16,11 +16,16 @@
 
 namespace nmbake {
 
+struct UvTileFilter;  // tiles.h
+
 struct ErrorEstimateOptions {
   std::size_t texels = 4096;   // covered texels re-baked (all of them when fewer are covered)
   int samples = 64;            // samples per re-baked texel; at least 4x the bake's, at most kMaxSamples
   std::uint64_t seed = 12111;  // texel choice (fixed: the same bake gives the same estimate)
   int bits = 32;               // output bit depth: 8, 16, or 32 (float, no quantisation)
+  // A UDIM tile's map (udim.h): its triangles alone, their UVs moved into 0-1; null: the map of the
+  // whole layout.
+  const UvTileFilter* tile = nullptr;
 };
 
 struct ErrorEstimate {

@@ -17,7 +17,8 @@ namespace nmbake {
 // The bake's own preparation, rays and shading (prepare, sample_rays, chosen_hit, shade_sample)
 // for a list of texels; tests/test_error_estimate.cpp checks both agree texel for texel.
 std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt,
-                                          const BakeResult& baked, const std::vector<std::uint32_t>& texels, int samples) {
+                                          const BakeResult& baked, const std::vector<std::uint32_t>& texels, int samples,
+                                          const UvTileFilter* tile) {
   const BakeStats& st = baked.stats;
   std::vector<glm::dvec3> out(texels.size(), glm::dvec3(0.0));
   if (texels.empty() || low.triangle_count() == 0 || high.triangle_count() == 0 || !low.has_uvs()) return out;
@@ -45,7 +46,7 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
   ray_setup.diagonal = s.diagonal;
   const int rays_per_sample = ray_setup.closest ? 2 : 1;
 
-  const TileBins bins = bin_triangles(low, W, H, kTileSide);
+  const TileBins bins = bin_triangles(low, W, H, kTileSide, tile);  // a UDIM tile's texels: its triangles alone
 
   const std::vector<glm::dvec2> offsets = sample_offsets(samples);
   std::vector<std::uint8_t> covered(texels.size(), 0);  // each entry written by one thread only

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <new>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 #include "core/parallel.h"
@@ -250,6 +251,55 @@ UdimBake bake_udim_tiles(const Mesh& low, const Mesh& high, const Mesh* cage, co
   } catch (const std::bad_alloc&) {
     throw ResourceError("out of memory while " + stage);
   }
+}
+
+std::vector<ErrorEstimate> estimate_udim_errors(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt,
+                                                UdimBake& bake, const ErrorEstimateOptions& eo) {
+  const UdimLayout layout = find_udim_tiles(low);  // the bake's, tile for tile
+  std::vector<ErrorEstimate> out;
+  for (TileBake& t : bake.tiles) {
+    std::size_t k = 0;
+    while (k < layout.tiles.size() && layout.tiles[k].number != t.tile.number) ++k;
+    if (k == layout.tiles.size()) throw std::logic_error("estimate_udim_errors: the bake's tiles are not the mesh's");
+    const UvTileFilter filter{&layout.tile_of, std::int32_t(k), layout.tiles[k].u, layout.tiles[k].v};
+    ErrorEstimateOptions tile_options = eo;
+    tile_options.tile = &filter;
+    // The re-bake reads the automatic cage and the distances, which the bake keeps once for all tiles.
+    std::swap(t.result.cage_positions, bake.cage_positions);
+    std::swap(t.result.vertex_rear, bake.vertex_rear);
+    std::swap(t.result.vertex_search, bake.vertex_search);
+    struct SwapBack {
+      TileBake& t;
+      UdimBake& b;
+      ~SwapBack() {
+        std::swap(t.result.cage_positions, b.cage_positions);
+        std::swap(t.result.vertex_rear, b.vertex_rear);
+        std::swap(t.result.vertex_search, b.vertex_search);
+      }
+    } swap_back{t, bake};
+    out.push_back(estimate_bake_error(low, high, cage, opt, t.result, tile_options));
+  }
+  return out;
+}
+
+ErrorEstimate combine_estimates(const std::vector<ErrorEstimate>& tiles) {
+  ErrorEstimate all;
+  double sum = 0.0, qsum = 0.0;
+  for (const ErrorEstimate& e : tiles) {
+    sum += e.mean_deg * double(e.texels);
+    qsum += e.quantization_mean_deg * double(e.texels);
+    all.texels += e.texels;
+    all.samples = std::max(all.samples, e.samples);
+    all.seconds += e.seconds;
+    all.p95_deg = std::max(all.p95_deg, e.p95_deg);
+    all.max_deg = std::max(all.max_deg, e.max_deg);
+    all.quantization_max_deg = std::max(all.quantization_max_deg, e.quantization_max_deg);
+  }
+  if (all.texels) {
+    all.mean_deg = sum / double(all.texels);
+    all.quantization_mean_deg = qsum / double(all.texels);
+  }
+  return all;
 }
 
 }  // namespace nmbake

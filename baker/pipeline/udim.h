@@ -23,6 +23,7 @@
 
 #include "core/mesh.h"
 #include "pipeline/bake.h"
+#include "pipeline/error_estimate.h"
 
 namespace nmbake {
 
@@ -94,5 +95,15 @@ struct UdimBake {
 // memory check asks for estimate_bake_bytes(options) times the tile count. Throws what
 // bake_normal_map throws, and InputError when no triangle lies in a tile.
 UdimBake bake_udim_tiles(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& options);
+
+// The error estimate (error_estimate.h) of each tile of `bake` (made by bake_udim_tiles with these
+// meshes and options): the tile's map against a re-bake of its texels from its own triangles. In
+// the order of bake.tiles; `estimate` as for one map (its `tile` is set here).
+std::vector<ErrorEstimate> estimate_udim_errors(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& options,
+                                                UdimBake& bake, const ErrorEstimateOptions& estimate = {});
+
+// The tiles' estimates as one: the mean weighted by the texels compared, and the largest p95, max
+// and quantisation max (an upper bound of the whole's p95); the texels and seconds summed.
+ErrorEstimate combine_estimates(const std::vector<ErrorEstimate>& tiles);
 
 }  // namespace nmbake
