@@ -62,7 +62,7 @@ const Defect kDefects[] = {
     {"binary_garbage.obj", {"zero byte", "not an OBJ"}},
     {"utf16.obj", {"looks like UTF-16 text; save it as UTF-8"}},
     {"unknown_extension.xyz", {"unknown file type '.xyz'", ".obj .ply .off .stl", ".gltf .glb .fbx .dae .3ds"}},
-    {"not_a_mesh.fbx", {"cannot read as .fbx: FBX-Parser"}},
+    {"not_a_mesh.fbx", {"is not a .fbx file"}},
     {"inf_vertex.ply", {"vertex 1 has a non-finite coordinate"}},
     {"nan_normal.ply", {"vertex 2 has a non-finite normal"}},
     {"negative_count.ply", {"face", "negative count -5"}},
@@ -252,9 +252,9 @@ TEST(MeshIo, OffCommentsAndCountsOnTheHeaderLine) {
   EXPECT_EQ(m.position_index, (std::vector<std::uint32_t>{0, 1, 2, 0, 2, 3, 0, 2, 3}));
 }
 
-// Found by the fuzzer (tests/fuzz/corpus/oom_off_face_trailing_tokens): OpenMesh's reader left
-// what follows a face's indices for the next face's corner count; 2552147483648 made it push 2^32
-// corners (1.6 GB). Face colours and other trailing tokens are now dropped before it reads.
+// Found by the fuzzer (tests/fuzz/corpus/oom_off_face_trailing_tokens): OpenMesh's reader, which
+// nmbake used then, left what follows a face's indices for the next face's corner count;
+// 2552147483648 made it push 2^32 corners (1.6 GB). Face colours and other trailing tokens are ignored.
 TEST(MeshIo, OffFaceColoursAndTrailingTokensAreIgnored) {
   MeshLoadInfo info;
   Mesh m = load_mesh(data_path("defects/face_colours.off"), {}, &info);
@@ -264,7 +264,7 @@ TEST(MeshIo, OffFaceColoursAndTrailingTokensAreIgnored) {
   EXPECT_EQ(m.position_index, (std::vector<std::uint32_t>{0, 1, 2, 0, 2, 3, 0, 1, 2, 0, 2, 3}));
 }
 
-// OpenMesh's reader learns N and ST from the magic only in a private call, so it read neither.
+// NOFF normals and STOFF texture coordinates (OpenMesh's reader, used before, read neither).
 TEST(MeshIo, OffNormalsAndTextureCoordinatesAreRead) {
   MeshLoadInfo info;
   Mesh m = load_mesh(data_path("defects/normals_colours_texcoords.off"), {true}, &info);

@@ -124,7 +124,7 @@ TEST(MeshIo, AssimpRepairsAreReported) {
   m = load_mesh(dir + "STL/Spider_binary.stl", {}, &info);
   EXPECT_EQ(info.file_faces, 1368u);
   EXPECT_EQ(info.degenerate_faces_dropped, 56u);
-  EXPECT_EQ(m.positions.size(), 722u);  // welded by OpenMesh
+  EXPECT_EQ(m.positions.size(), 722u);  // welded by value (STL has no shared vertices)
 }
 
 TEST(MeshIo, WusonInThreeFormatsAgrees) {

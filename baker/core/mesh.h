@@ -1,4 +1,4 @@
-// The in-memory triangle mesh every stage works on: flat arrays, no OpenMesh types.
+// The in-memory triangle mesh every stage works on: flat arrays.
 //
 // Coordinates are object space exactly as in the file (never rotated or rescaled). Attributes are
 // indexed per corner, like OBJ: corner c of triangle t uses positions[position_index[3t+c]],
@@ -83,7 +83,7 @@ struct MeshLoadInfo {
   bool uvs_dropped = false;
   std::size_t faces_without_normals = 0;     // counted when only some faces had normals
   std::size_t faces_without_uvs = 0;         // counted when only some faces had UVs
-  std::size_t degenerate_faces_dropped = 0;  // STL facets whose corners welded together (OpenMesh drops them)
+  std::size_t degenerate_faces_dropped = 0;  // STL facets whose corners welded together (dropped)
   double largest_coordinate = 0.0;           // largest |x|, |y| or |z| a face uses, as in the file
   // The scale applied to the file's coordinates: an FBX file's unit to metres (0.01 for
   // centimetres); 1 for every other format (glTF is in metres, OBJ, PLY, OFF and STL say nothing).

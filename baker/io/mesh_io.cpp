@@ -1,6 +1,6 @@
 // load_mesh(): reads the file once into memory, hands it to the reader for its extension, then
 // applies the checks and repairs every format shares. The readers live in mesh_io_obj.cpp,
-// mesh_io_ply.cpp, mesh_io_openmesh.cpp (OFF, STL) and mesh_io_assimp.cpp (glTF, FBX, DAE, 3DS...).
+// mesh_io_ply.cpp, mesh_io_off.cpp, mesh_io_stl.cpp and mesh_io_assimp.cpp (glTF, FBX, DAE, 3DS...).
 #include "io/mesh_io.h"
 
 #include <fcntl.h>

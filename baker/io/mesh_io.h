@@ -1,5 +1,5 @@
-// Loading meshes from OBJ, PLY (ascii and binary), OFF and STL. The only code that includes
-// OpenMesh.
+// Loading meshes: OBJ, PLY (ascii and binary), OFF and STL (ascii and binary) by readers of our own,
+// glTF, FBX, DAE, 3DS and others through Assimp.
 //
 // Every error in the file throws InputError with the file name and the element, e.g.
 // "high.ply: vertex 17 has a non-finite coordinate" or "low.obj: line 812: face index 9001 out of
