@@ -216,6 +216,30 @@ bool signature_fits(const std::string& ext, std::string_view bytes) {
   return true;
 }
 
+// A COLLADA array (<p>, <vcount>, <float_array>, ...) holding bytes that are not text: Assimp's
+// reader takes them for numbers (a fuzzed <p> made it allocate 12 GB over 40 s before it gave up).
+// Returns the problem, or "" when every array holds printable ASCII and white space (exporters
+// write commas and such, which Assimp reads).
+std::string collada_array_problem(std::string_view bytes) {
+  for (const char* tag : {"p", "vcount", "v", "h", "float_array", "int_array", "bool_array"}) {
+    const std::string open = std::string("<") + tag, close = std::string("</") + tag + ">";
+    for (std::size_t at = bytes.find(open); at != std::string_view::npos; at = bytes.find(open, at + 1)) {
+      const std::size_t after = at + open.size();
+      if (after >= bytes.size() || !(bytes[after] == '>' || std::isspace(static_cast<unsigned char>(bytes[after])))) continue;
+      const std::size_t start = bytes.find('>', after);
+      if (start == std::string_view::npos || bytes[start - 1] == '/') continue;
+      const std::size_t end = bytes.find(close, start);
+      for (std::size_t i = start + 1; i < (end == std::string_view::npos ? bytes.size() : end); ++i) {
+        const unsigned char c = static_cast<unsigned char>(bytes[i]);
+        if ((c >= 0x20 && c < 0x7f) || std::isspace(c)) continue;
+        return "<" + std::string(tag) + "> holds a byte that is not text (0x" + "0123456789abcdef"[c >> 4] +
+               "0123456789abcdef"[c & 15] + " at byte " + std::to_string(i) + ")";
+      }
+    }
+  }
+  return "";
+}
+
 }  // namespace
 
 bool assimp_reads(const std::string& ext) {
@@ -230,6 +254,8 @@ ParsedMesh parse_assimp(const std::string& path, const std::string& ext, std::st
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
   const unsigned flags = aiProcess_ValidateDataStructure | aiProcess_SortByPType;
   if (!signature_fits(ext, bytes)) fail(path, "is not a ." + ext + " file (its first bytes say otherwise)");
+  if (ext == "dae")
+    if (const std::string problem = collada_array_problem(bytes); !problem.empty()) fail(path, "malformed: " + problem);
   // A file beside others (a .gltf and its .bin) is read by name; bytes alone for the fuzz target.
   const aiScene* scene = nullptr;
   const std::string dropped = DroppedDataLog::instance().collect([&] {
