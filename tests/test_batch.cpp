@@ -18,31 +18,32 @@ namespace {
 using test::contains;
 using test::run_nmbake;
 
-const std::string kLow = test::data_path("sample/torus_low.obj");
-const std::string kHigh = test::data_path("sample/torus_high.ply");
-
 std::size_t lines(const std::string& s) { return std::size_t(std::count(s.begin(), s.end(), '\n')); }
 
 TEST(Batch, JobsBakeWhatTheirCommandsBake) {
   const std::string dir = test::scratch_dir();
   std::filesystem::create_directories(dir + "/jobs/out");
-  test::write_file(
-      dir + "/jobs/jobs.json", R"({
+  test::write_file(dir + "/jobs/jobs.json",
+                   R"({
     "defaults": {"size": 64, "padding": 4},
     "jobs": [
-      {"low": ")" + kLow + R"(", "highs": [")" +
-                                   kHigh + R"("], "output": "out/a.png", "options": {"report": "out/a.json"}},
-      {"low": ")" + kLow + R"(", "high": ")" +
-                                   kHigh + R"(", "output": "out/b.exr", "options": {"samples": 4, "size": 32}},
-      {"low": ")" + kLow + R"(", "highs": [")" +
-                                   kHigh + R"("], "output": "out/c.tga", "options": {"keep-backfaces": true, "green": "down"}}
+      {"low": ")" + test::sample_low() +
+                       R"(", "highs": [")" + test::sample_high() +
+                       R"("], "output": "out/a.png", "options": {"report": "out/a.json"}},
+      {"low": ")" + test::sample_low() +
+                       R"(", "high": ")" + test::sample_high() +
+                       R"(", "output": "out/b.exr", "options": {"samples": 4, "size": 32}},
+      {"low": ")" + test::sample_low() +
+                       R"(", "highs": [")" + test::sample_high() +
+                       R"("], "output": "out/c.tga", "options": {"keep-backfaces": true, "green": "down"}}
     ]})");
   // Run from another folder: relative paths belong to the jobs file's.
   const test::CliRun batch = run_nmbake("--batch jobs/jobs.json --report batch.json --progress", "", dir);
   ASSERT_EQ(batch.code, 0) << batch.err;
-  const std::string singles[] = {kLow + " " + kHigh + " -o a.png --size 64 --padding 4",
-                                 kLow + " " + kHigh + " -o b.exr --size 32 --padding 4 --samples 4",
-                                 kLow + " " + kHigh + " -o c.tga --size 64 --padding 4 --keep-backfaces --green down"};
+  const std::string singles[] = {
+      test::sample_low() + " " + test::sample_high() + " -o a.png --size 64 --padding 4",
+      test::sample_low() + " " + test::sample_high() + " -o b.exr --size 32 --padding 4 --samples 4",
+      test::sample_low() + " " + test::sample_high() + " -o c.tga --size 64 --padding 4 --keep-backfaces --green down"};
   const char* names[] = {"a.png", "b.exr", "c.tga"};
   for (int i = 0; i < 3; ++i) {
     ASSERT_EQ(run_nmbake(singles[i], "", dir).code, 0);
@@ -72,9 +73,9 @@ TEST(Batch, AFailingJobLeavesTheOthersToRun) {
   const std::string dir = test::scratch_dir();
   test::write_file(dir + "/jobs.json", R"({"defaults": {"size": 32}, "jobs": [
       {"low": "missing.obj", "highs": [")" +
-                                           kHigh + R"("], "output": "a.png"},
-      {"low": ")" + kLow + R"(", "highs": [")" +
-                                           kHigh + R"("], "output": "b.png"}]})");
+                                           test::sample_high() + R"("], "output": "a.png"},
+      {"low": ")" + test::sample_low() + R"(", "highs": [")" +
+                                           test::sample_high() + R"("], "output": "b.png"}]})");
   const test::CliRun r = run_nmbake("--batch jobs.json --report batch.json", "", dir);
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_TRUE(contains(r.err, "error: jobs.json: job 1 (a.png): missing.obj: cannot open")) << r.err;
@@ -86,10 +87,11 @@ TEST(Batch, AFailingJobLeavesTheOthersToRun) {
   EXPECT_EQ(report["summary"]["failed"], 1);
   // --strict: a job with a warning fails with 5 (nothing of it written), the others are baked.
   test::write_file(dir + "/strict.json", R"({"defaults": {"size": 32}, "jobs": [
-      {"low": ")" + kLow + R"(", "highs": [")" +
-                                             kHigh + R"("], "output": "s1.png", "options": {"front": 0.0001, "rear": 0.0001}},
-      {"low": ")" + kLow + R"(", "highs": [")" +
-                                             kHigh + R"("], "output": "s2.png"}]})");
+      {"low": ")" + test::sample_low() + R"(", "highs": [")" +
+                                             test::sample_high() +
+                                             R"("], "output": "s1.png", "options": {"front": 0.0001, "rear": 0.0001}},
+      {"low": ")" + test::sample_low() + R"(", "highs": [")" +
+                                             test::sample_high() + R"("], "output": "s2.png"}]})");
   const test::CliRun strict = run_nmbake("--batch strict.json --strict", "", dir);
   EXPECT_EQ(strict.code, 5) << strict.err;
   EXPECT_FALSE(test::exists(dir + "/s1.png"));
@@ -98,7 +100,7 @@ TEST(Batch, AFailingJobLeavesTheOthersToRun) {
 
 TEST(Batch, AWrongFileStopsEverythingBeforeTheFirstBake) {
   const std::string dir = test::scratch_dir();
-  const std::string job = R"({"low": ")" + kLow + R"(", "highs": [")" + kHigh + R"("], "output": ")";
+  const std::string job = R"({"low": ")" + test::sample_low() + R"(", "highs": [")" + test::sample_high() + R"("], "output": ")";
   struct Case {
     std::string text;
     int code;
@@ -140,7 +142,7 @@ TEST(Batch, AWrongFileStopsEverythingBeforeTheFirstBake) {
 // The BVH a bake keeps for the next bakes from the same high-poly: built over every triangle, taken
 // by a bake on the same scene centre, and the maps are those of bakes that build their own.
 TEST(Batch, AKeptBvhGivesTheSameMaps) {
-  const Mesh low = load_mesh(kLow), high = load_mesh(kHigh);
+  const Mesh low = load_mesh(test::sample_low()), high = load_mesh(test::sample_high());
   BakeOptions o;
   o.width = o.height = 64;
   const BakeResult plain = bake_normal_map(low, high, nullptr, o);

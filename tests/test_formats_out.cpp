@@ -17,9 +17,6 @@ namespace {
 using test::contains;
 using test::run_nmbake;
 
-const std::string kLow = test::data_path("sample/torus_low.obj");
-const std::string kHigh = test::data_path("sample/torus_high.ply");
-
 Image gradient(int w, int h) {
   Image im(w, h, 3, 0.0f);
   for (int y = 0; y < h; ++y)
@@ -62,17 +59,18 @@ TEST(FormatsOut, ExrIsZipByDefaultAndTakesTheCompressionGiven) {
 }
 
 TEST(FormatsOut, CompressionAndDitherAreCheckedAgainstTheOutput) {
-  const test::CliRun png = run_nmbake(kLow + " " + kHigh + " -o m.png --size 16 --compression zip");
+  const test::CliRun png = run_nmbake(test::sample_low() + " " + test::sample_high() + " -o m.png --size 16 --compression zip");
   EXPECT_EQ(png.code, 1) << png.err;
   EXPECT_TRUE(contains(png.err, "--compression zip applies to EXR output")) << png.err;
-  const test::CliRun lzw = run_nmbake(kLow + " " + kHigh + " -o m.exr --size 16 --compression lzw");
+  const test::CliRun lzw = run_nmbake(test::sample_low() + " " + test::sample_high() + " -o m.exr --size 16 --compression lzw");
   EXPECT_EQ(lzw.code, 1) << lzw.err;
-  const test::CliRun exr = run_nmbake(kLow + " " + kHigh + " -o m.exr --size 16 --dither");
+  const test::CliRun exr = run_nmbake(test::sample_low() + " " + test::sample_high() + " -o m.exr --size 16 --dither");
   EXPECT_EQ(exr.code, 1) << exr.err;
   EXPECT_TRUE(contains(exr.err, "--dither applies to 8-bit output")) << exr.err;
-  const test::CliRun tga16 = run_nmbake(kLow + " " + kHigh + " -o m.tga --size 16 --bits 16");
+  const test::CliRun tga16 = run_nmbake(test::sample_low() + " " + test::sample_high() + " -o m.tga --size 16 --bits 16");
   EXPECT_EQ(tga16.code, 1) << tga16.err;
-  const test::CliRun ok = run_nmbake(kLow + " " + kHigh + " -o m.exr --size 16 --compression piz --report r.json");
+  const test::CliRun ok =
+      run_nmbake(test::sample_low() + " " + test::sample_high() + " -o m.exr --size 16 --compression piz --report r.json");
   ASSERT_EQ(ok.code, 0) << ok.err;
   EXPECT_EQ(ok.report["options"]["compression"], "piz");
   EXPECT_EQ(read_image_metadata(ok.dir + "/m.exr")["compression"], "piz");
@@ -104,9 +102,12 @@ TEST(FormatsOut, DitherKeepsTheValueOnAverage) {
 
 TEST(FormatsOut, DitheredMapIsTheSameWhateverTheThreads) {
   const std::string dir = test::scratch_dir();
-  const test::CliRun one = run_nmbake(kLow + " " + kHigh + " -o one.png --size 128 --dither --threads 1", "", dir);
-  const test::CliRun two = run_nmbake(kLow + " " + kHigh + " -o two.png --size 128 --dither --threads 2", "", dir);
-  const test::CliRun plain = run_nmbake(kLow + " " + kHigh + " -o plain.png --size 128 --threads 2", "", dir);
+  const test::CliRun one =
+      run_nmbake(test::sample_low() + " " + test::sample_high() + " -o one.png --size 128 --dither --threads 1", "", dir);
+  const test::CliRun two =
+      run_nmbake(test::sample_low() + " " + test::sample_high() + " -o two.png --size 128 --dither --threads 2", "", dir);
+  const test::CliRun plain =
+      run_nmbake(test::sample_low() + " " + test::sample_high() + " -o plain.png --size 128 --threads 2", "", dir);
   ASSERT_EQ(one.code, 0) << one.err;
   ASSERT_EQ(two.code, 0) << two.err;
   ASSERT_EQ(plain.code, 0) << plain.err;

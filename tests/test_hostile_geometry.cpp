@@ -21,20 +21,18 @@ namespace {
 using test::contains;
 using test::run_nmbake;
 
-const std::string kLow = test::data_path("sample/torus_low.obj");
-const std::string kHigh = test::data_path("sample/torus_high.ply");
-
 TEST(HostileGeometry, DistancesBeyondTheRayTracerAreRefused) {
   for (const char* option : {"--front", "--rear"})
     for (const char* value : {"1.8e18", "1e19", "1e25"}) {
-      const test::CliRun r = run_nmbake(kLow + " " + kHigh + " -o out.png --size 32 " + option + " " + value);
+      const test::CliRun r =
+          run_nmbake(test::sample_low() + " " + test::sample_high() + " -o out.png --size 32 " + option + " " + value);
       EXPECT_EQ(r.code, 2) << option << " " << value;
       EXPECT_TRUE(contains(r.err, std::string("error: ") + option + " ")) << r.err;
       EXPECT_TRUE(contains(r.err, "a bake takes coordinates up to 1e+17")) << r.err;
       EXPECT_FALSE(test::exists(r.dir + "/out.png"));
     }
   // Large but possible: taken (rays that far miss, with the usual warning).
-  EXPECT_EQ(run_nmbake(kLow + " " + kHigh + " -o out.png --size 32 --front 1e16").code, 0);
+  EXPECT_EQ(run_nmbake(test::sample_low() + " " + test::sample_high() + " -o out.png --size 32 --front 1e16").code, 0);
 }
 
 TEST(HostileGeometry, CoordinatesBeyondTheRayTracerAreRefused) {
@@ -42,7 +40,7 @@ TEST(HostileGeometry, CoordinatesBeyondTheRayTracerAreRefused) {
   test::write_file(dir + "/big.obj", "v 0 0 0\nv 1.8e18 0 0\nv 0 1.8e18 0\nf 1 2 3\n");
   test::write_file(dir + "/max.obj", "v 0 0 0\nv 3e38 0 0\nv 0 3e38 0\nf 1 2 3\n");
   for (const char* name : {"big.obj", "max.obj"}) {
-    const test::CliRun r = run_nmbake(kLow + " " + name + " -o out.png --size 32", "", dir);
+    const test::CliRun r = run_nmbake(test::sample_low() + " " + name + " -o out.png --size 32", "", dir);
     EXPECT_EQ(r.code, 2) << name;
     EXPECT_TRUE(contains(r.err, std::string(name) + ": coordinates reach")) << r.err;
     EXPECT_TRUE(contains(r.err, "a bake takes coordinates up to 1e+17")) << r.err;
@@ -128,7 +126,7 @@ TEST(HostileGeometry, ReportGivesSkippedStacksAndTheOrigin) {
   EXPECT_NEAR(origin[0].get<double>(), x0 + 0.5, 1e-9);
   EXPECT_NEAR(origin[1].get<double>(), y0 + 0.5, 1e-9);
 
-  const test::CliRun near = run_nmbake(kLow + " " + kHigh + " -o out.png --size 16 --report r.json");
+  const test::CliRun near = run_nmbake(test::sample_low() + " " + test::sample_high() + " -o out.png --size 16 --report r.json");
   ASSERT_EQ(near.code, 0) << near.err;
   EXPECT_EQ(near.report["origin"], nlohmann::json::array({0.0, 0.0, 0.0}));
   EXPECT_EQ(near.report["high_mesh"]["duplicates_skipped"], 0);
@@ -186,7 +184,7 @@ TEST(HostileGeometry, HugePolygonsAreNotFanned) {
 // ASCII STL of the sample's high-poly bakes exactly as the same triangles in OBJ (both without
 // normals), every time.
 TEST(HostileGeometry, AsciiStlBakesAsTheSameTrianglesInObj) {
-  Mesh high = load_mesh(kHigh);
+  Mesh high = load_mesh(test::sample_high());
   high.normals.clear();
   high.normal_index.clear();
   const std::string dir = test::scratch_dir();
@@ -206,7 +204,7 @@ TEST(HostileGeometry, AsciiStlBakesAsTheSameTrianglesInObj) {
   test::write_file(dir + "/high.obj", obj_text(high, "torus high, no normals"));
   LoadOptions low_options;
   low_options.require_uvs = true;
-  const Mesh low = load_mesh(kLow, low_options);
+  const Mesh low = load_mesh(test::sample_low(), low_options);
   BakeOptions o;
   o.width = o.height = 128;
   const BakeResult from_obj = bake_normal_map(low, load_mesh(dir + "/high.obj"), nullptr, o);

@@ -15,9 +15,6 @@ namespace {
 using test::contains;
 using test::run_nmbake;
 
-const std::string kLow = test::data_path("sample/torus_low.obj");
-const std::string kHigh = test::data_path("sample/torus_high.ply");
-
 TEST(ProgressText, StageWithoutFractionGivesTheElapsedTime) {
   EXPECT_EQ(progress_text("building the BVH", -1.0, 1.234, 0.5), "nmbake: building the BVH, 1.2 s");
   EXPECT_EQ(progress_text("loading", -1.0, 0.0, 0.0), "nmbake: loading, 0.0 s");
@@ -75,7 +72,8 @@ std::string last_terminal_line(const std::string& err) {
 }
 
 TEST(ProgressLine, WithProgressEveryStageIsNamedAndTheLineCleared) {
-  const test::CliRun r = run_nmbake(kLow + " " + kHigh + " -o out.png --size 256 --estimate-error --progress");
+  const test::CliRun r =
+      run_nmbake(test::sample_low() + " " + test::sample_high() + " -o out.png --size 256 --estimate-error --progress");
   ASSERT_EQ(r.code, 0) << r.err;
   const std::vector<std::string> lines = drawn(r.err);
   for (const char* stage : {"loading", "preparing", "building the BVH", "measuring distances", "tracing", "padding",
@@ -94,11 +92,12 @@ TEST(ProgressLine, WithProgressEveryStageIsNamedAndTheLineCleared) {
 }
 
 TEST(ProgressLine, OffWhenStderrIsNotATerminalAndWithQuiet) {
-  const test::CliRun plain = run_nmbake(kLow + " " + kHigh + " -o out.png --size 64");
+  const test::CliRun plain = run_nmbake(test::sample_low() + " " + test::sample_high() + " -o out.png --size 64");
   ASSERT_EQ(plain.code, 0) << plain.err;
   EXPECT_FALSE(contains(plain.err, "\r")) << plain.err;
   EXPECT_TRUE(contains(plain.err, "nmbake: automatic cage: ")) << plain.err;
-  const test::CliRun quiet = run_nmbake(kLow + " " + kHigh + " -o out.png --size 64 --progress --quiet");
+  const test::CliRun quiet =
+      run_nmbake(test::sample_low() + " " + test::sample_high() + " -o out.png --size 64 --progress --quiet");
   ASSERT_EQ(quiet.code, 0) << quiet.err;
   EXPECT_EQ(quiet.err, "");
 }

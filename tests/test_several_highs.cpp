@@ -15,9 +15,6 @@ namespace {
 using test::contains;
 using test::run_nmbake;
 
-const std::string kLow = test::data_path("sample/torus_low.obj");
-const std::string kHigh = test::data_path("sample/torus_high.ply");
-
 // Triangles [first, last) of `m` as OBJ text, with the mesh's normals when `normals`.
 std::string obj_part(const Mesh& m, std::size_t first, std::size_t last, bool normals) {
   std::string text;
@@ -45,14 +42,14 @@ std::string obj_part(const Mesh& m, std::size_t first, std::size_t last, bool no
 
 TEST(SeveralHighs, ASculptSplitInTwoFilesBakesTheWholeMap) {
   const std::string dir = test::scratch_dir();
-  const Mesh high = load_mesh(kHigh);
+  const Mesh high = load_mesh(test::sample_high());
   ASSERT_TRUE(high.has_normals());
   const std::size_t half = high.triangle_count() / 2;
   test::write_file(dir + "/front.obj", obj_part(high, 0, half, true));
   test::write_file(dir + "/back.obj", obj_part(high, half, high.triangle_count(), true));
-  const test::CliRun one = run_nmbake(kLow + " " + kHigh + " -o one.png --size 128", "", dir);
+  const test::CliRun one = run_nmbake(test::sample_low() + " " + test::sample_high() + " -o one.png --size 128", "", dir);
   ASSERT_EQ(one.code, 0) << one.err;
-  const test::CliRun two = run_nmbake(kLow + " front.obj back.obj -o two.png --size 128 --report r.json", "", dir);
+  const test::CliRun two = run_nmbake(test::sample_low() + " front.obj back.obj -o two.png --size 128 --report r.json", "", dir);
   ASSERT_EQ(two.code, 0) << two.err;
   EXPECT_TRUE(test::read_file(dir + "/one.png") == test::read_file(dir + "/two.png")) << "the split sculpt baked another map";
   EXPECT_EQ(two.report["highs"], nlohmann::json::array({"front.obj", "back.obj"}));
@@ -66,22 +63,22 @@ TEST(SeveralHighs, ASculptSplitInTwoFilesBakesTheWholeMap) {
 // A file without normals gets the ones computed for it alone; the other keeps its own.
 TEST(SeveralHighs, FilesWithAndWithoutNormalsMix) {
   const std::string dir = test::scratch_dir();
-  const Mesh high = load_mesh(kHigh);
+  const Mesh high = load_mesh(test::sample_high());
   const std::size_t half = high.triangle_count() / 2;
   test::write_file(dir + "/front.obj", obj_part(high, 0, half, true));
   test::write_file(dir + "/back.obj", obj_part(high, half, high.triangle_count(), false));
-  const test::CliRun r = run_nmbake(kLow + " front.obj back.obj -o m.png --size 64 --report r.json", "", dir);
+  const test::CliRun r = run_nmbake(test::sample_low() + " front.obj back.obj -o m.png --size 64 --report r.json", "", dir);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_FALSE(r.report["high_normals_computed"].get<bool>()) << "the front file's normals were dropped";
 }
 
 TEST(SeveralHighs, NoOutputMayOverwriteAnyOfThem) {
   const std::string dir = test::scratch_dir();
-  const Mesh high = load_mesh(kHigh);
+  const Mesh high = load_mesh(test::sample_high());
   test::write_file(dir + "/a.obj", obj_part(high, 0, 10, false));
   test::write_file(dir + "/b.obj", obj_part(high, 10, 20, false));
   const std::string before = test::read_file(dir + "/b.obj");
-  const test::CliRun r = run_nmbake(kLow + " a.obj b.obj -o m.png --size 16 --report b.obj", "", dir);
+  const test::CliRun r = run_nmbake(test::sample_low() + " a.obj b.obj -o m.png --size 16 --report b.obj", "", dir);
   EXPECT_EQ(r.code, 1) << r.err;
   EXPECT_TRUE(contains(r.err, "b.obj")) << r.err;
   EXPECT_EQ(test::read_file(dir + "/b.obj"), before);

@@ -23,6 +23,16 @@ std::string shared_data_path(const std::string& relative) { return std::string(N
 
 bool exists(const std::string& path) { return std::filesystem::exists(path); }
 
+const std::string& sample_low() {
+  static const std::string path = data_path("sample/torus_low.obj");
+  return path;
+}
+
+const std::string& sample_high() {
+  static const std::string path = data_path("sample/torus_high.ply");
+  return path;
+}
+
 std::string scratch_dir() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
   std::string name = info ? std::string(info->test_suite_name()) + "." + info->name() : "scratch";

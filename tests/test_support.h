@@ -17,6 +17,9 @@ namespace nmbake::test {
 
 std::string data_path(const std::string& relative);         // <repo>/data/<relative>
 std::string shared_data_path(const std::string& relative);  // <repo>/../shared/data/<relative>
+// The bundled sample pair (data/sample): the torus low-poly (OBJ, with UVs) and its sculpt (PLY).
+const std::string& sample_low();
+const std::string& sample_high();
 bool exists(const std::string& path);
 std::string read_file(const std::string& path);                      // the whole file ("" when unreadable)
 void write_file(const std::string& path, const std::string& bytes);  // created or replaced; throws when it cannot
