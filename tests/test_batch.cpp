@@ -137,6 +137,10 @@ TEST(Batch, AWrongFileStopsEverythingBeforeTheFirstBake) {
   EXPECT_EQ(missing.code, 2);
   EXPECT_TRUE(contains(missing.err, "nothing.json: cannot read")) << missing.err;
   EXPECT_EQ(run_nmbake("--batch jobs.json --samples 4", "", dir).code, 1) << "job options belong in the file";
+  const test::CliRun help = run_nmbake("--batch --help", "", dir);
+  EXPECT_EQ(help.code, 0);
+  EXPECT_TRUE(contains(help.out, "--batch TEXT REQUIRED")) << help.out;
+  EXPECT_TRUE(contains(run_nmbake("--help", "", dir).out, "nmbake --batch jobs.json"));
 }
 
 // The BVH a bake keeps for the next bakes from the same high-poly: built over every triangle, taken

@@ -58,7 +58,9 @@ void add_options(CLI::App& app, Args& a) {
   app.footer(std::string("\nInputs: OBJ, PLY (ascii/binary), OFF, STL; glTF (.gltf/.glb), FBX (to metres), DAE, 3DS and\n"
                          "what else Assimp reads. The low-poly must have UVs.\n"
                          "Maps use the OpenGL convention (green = +bitangent, \"Y+\") unless --green down;\n"
-                         "tangent frames follow MikkTSpace (Blender, glTF, Substance, Unity, Unreal).\n\n") +
+                         "tangent frames follow MikkTSpace (Blender, glTF, Substance, Unity, Unreal).\n"
+                         "-o normal.<UDIM>.png bakes one map per UDIM tile. Many bakes in one process:\n"
+                         "nmbake --batch jobs.json (nmbake --batch --help; the file's format is in README, \"Batch\").\n\n") +
              kExitCodes);
   app.get_formatter()->column_width(34);
   app.add_option("low", a.low, "Low-poly mesh with UVs")->required();
