@@ -62,15 +62,10 @@ struct Bake {
 };
 
 Bake bake_files(const std::string& low_path, const std::string& high_path) {
-  LoadOptions with_uvs;
-  with_uvs.require_uvs = true;
-  const Mesh low = load_mesh(low_path, with_uvs);
-  LoadOptions shared;
-  shared.origin = low.origin;
-  const Mesh high = load_mesh(high_path, shared);
+  const test::MeshPair pair = test::load_pair(low_path, high_path);
   BakeOptions o;
   o.width = o.height = kSize;
-  return {bake_normal_map(low, high, nullptr, o).map, diff::uv_layout_mask(low, kSize, kSize)};
+  return {bake_normal_map(pair.low, pair.high, nullptr, o).map, diff::uv_layout_mask(pair.low, kSize, kSize)};
 }
 
 // Mean angle between two maps over the covered texels, degrees.

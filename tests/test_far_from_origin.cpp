@@ -80,15 +80,10 @@ void compare(const BakeResult& a, const BakeResult& b, double& mean, double& wor
 
 // Loads a pair as nmbake does: the high-poly takes the low-poly's origin.
 BakeResult load_and_bake(const std::string& low_path, const std::string& high_path, glm::dvec3* origin = nullptr) {
-  LoadOptions low_options;
-  low_options.require_uvs = true;
-  const Mesh low = load_mesh(low_path, low_options);
-  LoadOptions high_options;
-  high_options.origin = low.origin;
-  const Mesh high = load_mesh(high_path, high_options);
-  EXPECT_EQ(high.origin, low.origin);
-  if (origin) *origin = low.origin;
-  return bake_normal_map(low, high, nullptr, options());
+  const test::MeshPair pair = test::load_pair(low_path, high_path);
+  EXPECT_EQ(pair.high.origin, pair.low.origin);
+  if (origin) *origin = pair.low.origin;
+  return bake_normal_map(pair.low, pair.high, nullptr, options());
 }
 
 TEST(FarFromOrigin, SavedInDoubleBakesAsAtTheOrigin) {

@@ -135,16 +135,11 @@ void export_scene(const std::string& in, const std::string& format, const std::s
 
 Image bake_files(const std::string& low_path, const std::string& high_path, double* unit_scale = nullptr) {
   MeshLoadInfo info;
-  LoadOptions with_uvs;
-  with_uvs.require_uvs = true;
-  const Mesh low = load_mesh(low_path, with_uvs, &info);
+  const test::MeshPair pair = test::load_pair(low_path, high_path, &info);
   if (unit_scale) *unit_scale = info.unit_scale;
-  LoadOptions shared;
-  shared.origin = low.origin;
-  const Mesh high = load_mesh(high_path, shared);
   BakeOptions o;
   o.width = o.height = 256;
-  return bake_normal_map(low, high, nullptr, o).map;
+  return bake_normal_map(pair.low, pair.high, nullptr, o).map;
 }
 
 double mean_difference(const Image& a, const Image& b) {

@@ -14,6 +14,7 @@
 
 #include "core/rasterize.h"
 #include "core/tangent_frames.h"
+#include "io/mesh_io.h"
 
 namespace nmbake::test {
 
@@ -26,6 +27,17 @@ bool exists(const std::string& path) { return std::filesystem::exists(path); }
 const std::string& sample_low() {
   static const std::string path = data_path("sample/torus_low.obj");
   return path;
+}
+
+MeshPair load_pair(const std::string& low_path, const std::string& high_path, MeshLoadInfo* low_info) {
+  LoadOptions with_uvs;
+  with_uvs.require_uvs = true;
+  MeshPair pair;
+  pair.low = load_mesh(low_path, with_uvs, low_info);
+  LoadOptions shared;
+  shared.origin = pair.low.origin;
+  pair.high = load_mesh(high_path, shared);
+  return pair;
 }
 
 const std::string& sample_high() {

@@ -20,6 +20,13 @@ std::string shared_data_path(const std::string& relative);  // <repo>/../shared/
 // The bundled sample pair (data/sample): the torus low-poly (OBJ, with UVs) and its sculpt (PLY).
 const std::string& sample_low();
 const std::string& sample_high();
+
+// A low-poly (UVs required) and a high-poly loaded as nmbake loads them: the high-poly on the
+// low-poly's origin. `low_info` receives what loading the low-poly found, when not null.
+struct MeshPair {
+  Mesh low, high;
+};
+MeshPair load_pair(const std::string& low_path, const std::string& high_path, MeshLoadInfo* low_info = nullptr);
 bool exists(const std::string& path);
 std::string read_file(const std::string& path);                      // the whole file ("" when unreadable)
 void write_file(const std::string& path, const std::string& bytes);  // created or replaced; throws when it cannot
