@@ -5,19 +5,20 @@
 // culling, and degenerate floods (duplicate faces, huge polygons); every target with its measured
 // value and MET / NOT MET. Everything printed is measured in this run; nothing asserts (not a test).
 //
-//   bench_bake SHARED_DATA NMBAKE_EXE [--rounds N] [--trace-rounds N] [--quick] [--scratch DIR]
+//   bench_bake SHARED_DATA NMBAKE_EXE [--rounds N] [--trace-rounds N] [--quick] [--scratch DIR] [--sections LIST]
 //
 // --rounds N: each timed figure is the best of N rounds (default 3; 1 with --quick).
 // --trace-rounds N: rounds of section 1's bake-then-bare-loops comparison at 1 and 4 samples
 // (default 7; --rounds with --quick): the ratio judged there is the closest to the noise-free one
 // with more rounds, and those rounds cost little. 16 samples take --rounds.
 // --quick: fewer rows (1 sample only, no 4096^2 or 4M-triangle commands) as a smoke check.
+// --sections LIST: only these sections (comma-separated numbers; 0, the scenes, always runs).
 // --scratch DIR: where the generated meshes are written once and reused (default
 // $TMPDIR/nmbake-bench); each run's maps and reports go to a subfolder removed at the end.
 //
 // The sections live in bench_tracing.cpp (1, 2), bench_commands.cpp (3, 6), bench_scaling.cpp
-// (4, 5), bench_floods.cpp (7) and bench_batch.cpp (8); this file parses the arguments, prints the machine, generates the scenes
-// (0) and prints the targets.
+// (4, 5), bench_floods.cpp (7), bench_batch.cpp (8) and bench_png.cpp (9); this file parses the arguments, prints the machine,
+// generates the scenes (0) and prints the targets.
 #include <unistd.h>
 
 #include <algorithm>
@@ -96,6 +97,14 @@ void generate_scenes(const BenchRun& run, Scenes& scenes) {
 
 }  // namespace nmbake::bench
 
+namespace {}  // namespace
+
+bool Args::runs(int section) const {
+  if (sections.empty()) return true;
+  const std::string list = "," + sections + ",";
+  return list.find("," + std::to_string(section) + ",") != std::string::npos;
+}
+
 namespace {
 
 Args parse_args(int argc, char** argv) {
@@ -112,13 +121,16 @@ Args parse_args(int argc, char** argv) {
     } else if (s == "--trace-rounds" && i + 1 < argc) {
       a.trace_rounds = std::max(1, std::atoi(argv[++i]));
       trace_rounds_given = true;
+    } else if (s == "--sections" && i + 1 < argc) {
+      a.sections = argv[++i];
     } else if (s == "--scratch" && i + 1 < argc) {
       a.scratch = argv[++i];
     } else if (!s.empty() && s[0] != '-' && positional < 2) {
       (positional++ == 0 ? a.shared : a.exe) = s;
     } else {
       std::fprintf(stderr,
-                   "usage: bench_bake SHARED_DATA NMBAKE_EXE [--rounds N] [--trace-rounds N] [--quick] [--scratch DIR]\n");
+                   "usage: bench_bake SHARED_DATA NMBAKE_EXE [--rounds N] [--trace-rounds N] [--quick] [--scratch DIR] "
+                   "[--sections 3,9]\n");
       std::exit(1);
     }
   }
@@ -173,14 +185,18 @@ int main(int argc, char** argv) {
 
   print_machine(run);
   generate_scenes(run, scenes);
-  std::vector<QualityRow> quality_rows = run_tracing(run);
-  run_bvh_quality(run, scenes, std::move(quality_rows));
-  const CommandRun m1_2k = run_whole_commands(run, scenes);
-  run_loading(run, scenes);
-  run_scaling(run, scenes, m1_2k);
-  run_far_geometry(run, scenes);
-  run_floods(run, scenes);
-  run_batch(run, scenes);
+  if (args.runs(1) || args.runs(2)) {
+    std::vector<QualityRow> quality_rows = run_tracing(run);
+    run_bvh_quality(run, scenes, std::move(quality_rows));
+  }
+  CommandRun m1_2k;
+  if (args.runs(3)) m1_2k = run_whole_commands(run, scenes);
+  if (args.runs(4)) run_loading(run, scenes);
+  if (args.runs(5)) run_scaling(run, scenes, m1_2k);
+  if (args.runs(6)) run_far_geometry(run, scenes);
+  if (args.runs(7)) run_floods(run, scenes);
+  if (args.runs(8)) run_batch(run, scenes);
+  if (args.runs(9)) run_png_settings(run, scenes);
   print_targets(run, start);
   std::error_code ec;
   fs::remove_all(run.run_dir, ec);

@@ -22,6 +22,8 @@ struct Args {
   int rounds = 3;        // each timed figure the best of this many rounds
   int trace_rounds = 7;  // rounds of section 1 at 1 and 4 samples
   bool quick = false;    // fewer rows, as a smoke check
+  std::string sections;  // --sections: the sections to run ("3,9"); empty = all (0, the scenes, always runs)
+  bool runs(int section) const;
 };
 
 // Every target of the issues, with what this run measured (the closing "Targets" table).
@@ -91,5 +93,6 @@ void run_scaling(BenchRun& run, const Scenes& scenes, const CommandRun& m1_2k); 
 void run_far_geometry(BenchRun& run, const Scenes& scenes);                      // 6
 void run_floods(BenchRun& run, const Scenes& scenes);                            // 7 (bench_floods.cpp)
 void run_batch(BenchRun& run, const Scenes& scenes);                             // 8 (bench_batch.cpp)
+void run_png_settings(BenchRun& run, const Scenes& scenes);                      // 9 (bench_png.cpp)
 
 }  // namespace nmbake::bench

@@ -164,6 +164,12 @@ BakeOptions bake_options(const Args& a) {
 }
 
 // Fails early, before a long bake, on outputs that cannot be written.
+bool needs_image_module(const Args& a) {
+  for (const std::string* path : {&a.output, &a.miss_mask, &a.suspect_mask})
+    if (!path->empty() && image_io_detail::lower_extension(*path) != ".png") return true;
+  return false;
+}
+
 void check_outputs(const Args& a, int bits) {
   if (!a.save_cage.empty()) {
     if (!a.cage.empty() || a.front_given || a.rear_given)
@@ -184,7 +190,7 @@ void check_outputs(const Args& a, int bits) {
     throw UsageError("--compression " + a.compression + " applies to EXR output, not " + a.output);
   if (a.dither && bits != 8)
     throw UsageError("--dither applies to 8-bit output; " + a.output + " is " + std::to_string(bits) + "-bit");
-  if (const std::string problem = image_io_problem(); !problem.empty()) {
+  if (const std::string problem = needs_image_module(a) ? image_io_problem() : ""; !problem.empty()) {
     if (problem.rfind("out of memory", 0) == 0) throw ResourceError(a.output + ": " + problem);
     throw OutputError(a.output + ": " + problem);
   }

@@ -29,9 +29,13 @@
 #include <OpenImageIO/imageio.h>
 
 #include "core/errors.h"
+#include "io/image_write.h"
+#include "io/png_write.h"
 
 namespace nmbake {
 namespace {
+
+using image_write::fail_write;
 
 namespace fs = std::filesystem;
 
@@ -41,55 +45,6 @@ std::string one_line(std::string s) {
     if (c == '\n' || c == '\r') c = ' ';
   while (!s.empty() && s.back() == ' ') s.pop_back();
   return s.empty() ? std::string("unknown error") : s;
-}
-
-// value * scale rounded half away from zero, clamped to [0, scale]; NaN becomes 0.
-// For v = value * scale >= 0, round(v) == trunc(v + 0.5) exactly: v is a float times at most
-// 65535, so v + 0.5 is exact in double wherever it can reach 1. Negative and NaN values clamp to 0
-// either way.
-template <typename T, typename Floats>
-std::vector<T> quantize(const Floats& values, double scale) {
-  std::vector<T> out(values.size());
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    double v = static_cast<double>(values[i]) * scale + 0.5;
-    if (!(v > 0.0)) v = 0.0;
-    if (v > scale) v = scale;
-    out[i] = static_cast<T>(v);  // truncation of a value in [0, scale]
-  }
-  return out;
-}
-
-// A value in [0, 1) from a 64-bit key (splitmix64's finaliser): the same for a texel and channel
-// whatever thread writes it.
-double unit_hash(std::uint64_t key) {
-  key += 0x9E3779B97F4A7C15ull;
-  key = (key ^ (key >> 30)) * 0xBF58476D1CE4E5B9ull;
-  key = (key ^ (key >> 27)) * 0x94D049BB133111EBull;
-  key ^= key >> 31;
-  return double(key >> 11) * (1.0 / 9007199254740992.0);
-}
-
-// 8-bit values with triangular noise of one step added before rounding (WriteOptions::dither):
-// the sum of two uniform values in [0, 1) minus 1, seeded by the value's index, so that a gradient
-// finer than a step shows no bands and the average over many texels keeps the float value.
-std::vector<std::uint8_t> quantize_dithered(const Image::Pixels& values) {
-  std::vector<std::uint8_t> out(values.size());
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    const double noise = unit_hash(2 * std::uint64_t(i)) + unit_hash(2 * std::uint64_t(i) + 1) - 1.0;
-    double v = static_cast<double>(values[i]) * 255.0 + 0.5 + noise;
-    if (!(v > 0.0)) v = 0.0;
-    if (v > 255.0) v = 255.0;
-    out[i] = static_cast<std::uint8_t>(v);
-  }
-  return out;
-}
-
-// A temporary beside `target` for write_image without WriteOptions::temp_path (nmdiff, the tests).
-std::string temp_path_for(const fs::path& target) {
-  static std::atomic<unsigned> counter{0};
-  std::string name = "." + target.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) +
-                     target.extension().string();
-  return (target.parent_path() / name).string();
 }
 
 // The encoders' bytes go through this proxy straight to a file descriptor, so that the first
@@ -173,34 +128,6 @@ std::string first_message(const std::string& text) {
   return s;
 }
 
-// The EXR and TIFF writers stamp the current time into "DateTime", so two identical bakes differ
-// in a few bytes. With SOURCE_DATE_EPOCH set (seconds since 1970, the reproducible-builds
-// convention) that time is used instead and identical bakes give identical files.
-std::string reproducible_date_time() {
-  const char* epoch = std::getenv("SOURCE_DATE_EPOCH");
-  if (!epoch || !*epoch) return "";
-  char* end = nullptr;
-  const long long seconds = std::strtoll(epoch, &end, 10);
-  if (*end != '\0' || seconds < 0) return "";
-  const std::time_t t = static_cast<std::time_t>(seconds);
-  std::tm utc{};
-  if (!gmtime_r(&t, &utc)) return "";
-  char text[32];
-  std::strftime(text, sizeof text, "%Y:%m:%d %H:%M:%S", &utc);
-  return text;
-}
-
-// A reason that is memory running out (libpng's "insufficient memory", ENOMEM): exit 4, not 3.
-bool memory_reason(const std::string& reason) {
-  return reason.find("insufficient memory") != std::string::npos || reason.find("out of memory") != std::string::npos ||
-         reason.find("Out of memory") != std::string::npos || reason == std::strerror(ENOMEM);
-}
-
-[[noreturn]] void fail_write(const std::string& path, const std::string& reason) {
-  if (memory_reason(reason)) throw ResourceError(path + ": cannot write: out of memory (" + reason + ")");
-  throw OutputError(path + ": cannot write: " + reason);
-}
-
 // libpng prints its errors on stderr itself ("libpng error: insufficient memory", "libpng error:
 // No IDATs written into file") besides the message OpenImageIO returns, which makes one error
 // three lines. While an encoder runs, stderr goes to a memory file; afterwards its lines go on to
@@ -252,16 +179,10 @@ OIIO::ImageSpec output_spec(const Image& image, OIIO::TypeDesc stored, const std
   // Alpha is coverage, not premultiplication: keep colour values exactly as given.
   spec.attribute("oiio:UnassociatedAlpha", 1);
   for (const auto& [key, value] : options.metadata) spec.attribute(key, value);
-  if (const std::string date = reproducible_date_time(); !date.empty() && spec.get_string_attribute("DateTime").empty())
+  if (const std::string date = image_write::reproducible_date_time();
+      !date.empty() && spec.get_string_attribute("DateTime").empty())
     spec.attribute("DateTime", date);
-  // Measured on a 2048^2 map: PNG at zlib level 6 took 3.3 s, level 1 0.6 s (file ~10% larger);
-  // EXR zip shrank float normals by 1% in 2.3 s, uncompressed takes 0.1 s. With level 1, libpng's
-  // adaptive filter choice costs about a third of the write: the "up" filter alone (0x20) wrote
-  // the torus_s3 map in 0.18-0.27 s instead of 0.31-0.37 s, and 2% smaller (4.97 MB, not 5.08).
-  if (ext == ".png") {
-    spec.attribute("png:compressionLevel", 1);
-    spec.attribute("png:filter", 0x20);
-  }
+  // EXR zip shrank float normals by 1% in 2.3 s (2048^2), uncompressed takes 0.1 s. PNG: png_write.cpp.
   // EXR: ZIP (lossless) unless WriteOptions::compression says otherwise.
   if (ext == ".exr") spec.attribute("compression", options.compression.empty() ? "zip" : options.compression);
   // The TIFF writer drops attributes it does not know; keep them readable (and parsable by
@@ -278,35 +199,25 @@ OIIO::ImageSpec output_spec(const Image& image, OIIO::TypeDesc stored, const std
 }  // namespace
 
 void write_image(const std::string& path, const Image& image, const WriteOptions& options) {
-  const int bits = options.bits ? options.bits : default_bits_for(path);
-  check_output_format(path, bits);
-  assert(image.pixels.size() == static_cast<std::size_t>(image.width) * image.height * image.channels);
-  if (image.width <= 0 || image.height <= 0 || image.channels <= 0)
-    fail_write(path, "empty image (" + std::to_string(image.width) + "x" + std::to_string(image.height) + "x" +
-                         std::to_string(image.channels) + ")");
-
-  // Check the folder first: OpenImageIO would only name the temporary file.
+  const std::string ext = image_io_detail::lower_extension(path);
+  if (ext == ".png") return write_png_image(path, image, options);
+  const int bits = image_write::check_write(path, image, options);
   const fs::path target(path);
-  const fs::path folder = target.parent_path().empty() ? fs::path(".") : target.parent_path();
   std::error_code ec;
-  if (!fs::is_directory(folder, ec)) fail_write(path, "folder '" + folder.string() + "' does not exist");
-  if (::access(folder.c_str(), W_OK) != 0)
-    fail_write(path, "folder '" + folder.string() + "' is not writable (" + std::strerror(errno) + ")");
 
   // Pixels in the stored type: integer formats are quantized here, float goes through as is
   // (OpenImageIO converts float to half for EXR 16).
-  const std::string ext = image_io_detail::lower_extension(path);
   OIIO::TypeDesc stored = OIIO::TypeDesc::FLOAT;
   OIIO::TypeDesc given = OIIO::TypeDesc::FLOAT;
   std::vector<std::uint8_t> data8;
   std::vector<std::uint16_t> data16;
   const void* data = image.pixels.data();
   if (bits == 8) {
-    data8 = options.dither ? quantize_dithered(image.pixels) : quantize<std::uint8_t>(image.pixels, 255.0);
+    data8 = image_write::quantize8(image.pixels, options.dither);
     stored = given = OIIO::TypeDesc::UINT8;
     data = data8.data();
   } else if (bits == 16 && ext != ".exr") {
-    data16 = quantize<std::uint16_t>(image.pixels, 65535.0);
+    data16 = image_write::quantize16(image.pixels);
     stored = given = OIIO::TypeDesc::UINT16;
     data = data16.data();
   } else if (bits == 16) {
@@ -319,7 +230,7 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
   auto out = OIIO::ImageOutput::create(path);
   if (!out) fail_write(path, first_message(OIIO::geterror()));
 
-  const std::string temp = options.temp_path.empty() ? temp_path_for(target) : options.temp_path;
+  const std::string temp = options.temp_path.empty() ? image_write::temp_path_for(path) : options.temp_path;
   const int fd = ::open(temp.c_str(), O_RDWR | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0666);
   if (fd < 0) fail_write(path, std::strerror(errno));
   // Whatever ends the write early (an error, std::bad_alloc from the encoder or the proxy's buffer)

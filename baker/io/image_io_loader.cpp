@@ -27,6 +27,7 @@
 #include "core/memory_budget.h"
 #include "io/image_io.h"
 #include "io/image_io_module.h"
+#include "io/png_write.h"
 
 namespace nmbake {
 namespace {
@@ -178,6 +179,7 @@ std::string image_io_problem() {
 }
 
 void write_image(const std::string& path, const Image& image, const WriteOptions& options) {
+  if (image_io_detail::lower_extension(path) == ".png") return write_png_image(path, image, options);  // no module needed
   std::string error;
   if (const int code = module(path, ExitCode::output).write(path, image, options, &error)) rethrow(code, error);
 }

@@ -1,0 +1,159 @@
+#include "io/image_write.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <system_error>
+
+#include "core/errors.h"
+
+namespace nmbake::image_write {
+namespace {
+
+namespace fs = std::filesystem;
+
+// value * scale rounded half away from zero, clamped to [0, scale]; NaN becomes 0.
+// For v = value * scale >= 0, round(v) == trunc(v + 0.5) exactly: v is a float times at most
+// 65535, so v + 0.5 is exact in double wherever it can reach 1. Negative and NaN values clamp to 0
+// either way.
+template <typename T>
+std::vector<T> quantize(const Image::Pixels& values, double scale) {
+  std::vector<T> out(values.size());
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    double v = static_cast<double>(values[i]) * scale + 0.5;
+    if (!(v > 0.0)) v = 0.0;
+    if (v > scale) v = scale;
+    out[i] = static_cast<T>(v);  // truncation of a value in [0, scale]
+  }
+  return out;
+}
+
+// A value in [0, 1) from a 64-bit key (splitmix64's finaliser): the same for a texel and channel
+// whatever thread writes it.
+double unit_hash(std::uint64_t key) {
+  key += 0x9E3779B97F4A7C15ull;
+  key = (key ^ (key >> 30)) * 0xBF58476D1CE4E5B9ull;
+  key = (key ^ (key >> 27)) * 0x94D049BB133111EBull;
+  key ^= key >> 31;
+  return double(key >> 11) * (1.0 / 9007199254740992.0);
+}
+
+// 8-bit values with triangular noise of one step added before rounding (WriteOptions::dither):
+// the sum of two uniform values in [0, 1) minus 1, seeded by the value's index, so that a gradient
+// finer than a step shows no bands and the average over many texels keeps the float value.
+std::vector<std::uint8_t> quantize_dithered(const Image::Pixels& values) {
+  std::vector<std::uint8_t> out(values.size());
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const double noise = unit_hash(2 * std::uint64_t(i)) + unit_hash(2 * std::uint64_t(i) + 1) - 1.0;
+    double v = static_cast<double>(values[i]) * 255.0 + 0.5 + noise;
+    if (!(v > 0.0)) v = 0.0;
+    if (v > 255.0) v = 255.0;
+    out[i] = static_cast<std::uint8_t>(v);
+  }
+  return out;
+}
+
+// A reason that is memory running out (libpng's "insufficient memory", ENOMEM): exit 4, not 3.
+bool memory_reason(const std::string& reason) {
+  return reason.find("insufficient memory") != std::string::npos || reason.find("out of memory") != std::string::npos ||
+         reason.find("Out of memory") != std::string::npos || reason == std::strerror(ENOMEM);
+}
+
+}  // namespace
+
+int check_write(const std::string& path, const Image& image, const WriteOptions& options) {
+  const int bits = options.bits ? options.bits : default_bits_for(path);
+  check_output_format(path, bits);
+  if (image.width <= 0 || image.height <= 0 || image.channels <= 0 ||
+      image.pixels.size() != std::size_t(image.width) * std::size_t(image.height) * std::size_t(image.channels))
+    fail_write(path, "empty image (" + std::to_string(image.width) + "x" + std::to_string(image.height) + "x" +
+                         std::to_string(image.channels) + ")");
+  // The folder first: an encoder would only name the temporary file.
+  const fs::path target(path);
+  const fs::path folder = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec)) fail_write(path, "folder '" + folder.string() + "' does not exist");
+  if (::access(folder.c_str(), W_OK) != 0)
+    fail_write(path, "folder '" + folder.string() + "' is not writable (" + std::strerror(errno) + ")");
+  return bits;
+}
+
+std::vector<std::uint8_t> quantize8(const Image::Pixels& values, bool dither) {
+  return dither ? quantize_dithered(values) : quantize<std::uint8_t>(values, 255.0);
+}
+
+std::vector<std::uint16_t> quantize16(const Image::Pixels& values) { return quantize<std::uint16_t>(values, 65535.0); }
+
+// The EXR and TIFF writers stamp the current time into "DateTime", so two identical bakes differ
+// in a few bytes. With SOURCE_DATE_EPOCH set (seconds since 1970, the reproducible-builds
+// convention) that time is used instead and identical bakes give identical files.
+std::string reproducible_date_time() {
+  const char* epoch = std::getenv("SOURCE_DATE_EPOCH");
+  if (!epoch || !*epoch) return "";
+  char* end = nullptr;
+  const long long seconds = std::strtoll(epoch, &end, 10);
+  if (*end != '\0' || seconds < 0) return "";
+  const std::time_t t = static_cast<std::time_t>(seconds);
+  std::tm utc{};
+  if (!gmtime_r(&t, &utc)) return "";
+  char text[32];
+  std::strftime(text, sizeof text, "%Y:%m:%d %H:%M:%S", &utc);
+  return text;
+}
+
+[[noreturn]] void fail_write(const std::string& path, const std::string& reason) {
+  if (memory_reason(reason)) throw ResourceError(path + ": cannot write: out of memory (" + reason + ")");
+  throw OutputError(path + ": cannot write: " + reason);
+}
+
+std::string temp_path_for(const std::string& path) {
+  static std::atomic<unsigned> counter{0};
+  const fs::path target(path);
+  std::string name = "." + target.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) +
+                     target.extension().string();
+  return (target.parent_path() / name).string();
+}
+
+void write_file_bytes(const std::string& path, const std::vector<unsigned char>& bytes, const WriteOptions& options) {
+  const std::string temp = options.temp_path.empty() ? temp_path_for(path) : options.temp_path;
+  auto fail = [&](int err) {
+    ::unlink(temp.c_str());
+    fail_write(path, std::strerror(err));
+  };
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0666);
+  if (fd < 0) fail_write(path, std::strerror(errno));
+  for (std::size_t done = 0; done < bytes.size();) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int err = n < 0 ? errno : EIO;
+      ::close(fd);
+      fail(err);
+    }
+    done += std::size_t(n);
+  }
+  // A full disk or a failing device may only show here (delayed allocation, NFS).
+  if (::fsync(fd) != 0) {
+    const int err = errno;
+    ::close(fd);
+    fail(err);
+  }
+  if (::close(fd) != 0) fail(errno);
+  if (!options.temp_path.empty()) return;  // the caller renames it
+  if (std::rename(temp.c_str(), path.c_str()) != 0) {
+    std::string reason = std::strerror(errno);
+    std::error_code ec;
+    if (fs::is_directory(path, ec)) reason = "a folder of that name exists";
+    ::unlink(temp.c_str());
+    fail_write(path, reason);
+  }
+}
+
+}  // namespace nmbake::image_write

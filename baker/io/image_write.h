@@ -1,0 +1,39 @@
+// What every image writer shares (image_io.cpp through OpenImageIO, png_write.cpp through libpng):
+// the checks before a write, quantization to the stored integers, the temporary file and its
+// rename, and the one-line errors. Internal to io/.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/image.h"
+#include "io/image_io.h"
+
+namespace nmbake::image_write {
+
+// Refuses what no writer takes (check_output_format; an empty image) and a folder that does not
+// exist or is not writable; returns the bit depth to store (options.bits, else the path's default).
+int check_write(const std::string& path, const Image& image, const WriteOptions& options);
+
+// value * 255 (or 65535) rounded half away from zero, clamped; NaN becomes 0. quantize8 adds one
+// step of triangular noise first when `dither` is set, seeded by the value's index.
+std::vector<std::uint8_t> quantize8(const Image::Pixels& values, bool dither);
+std::vector<std::uint16_t> quantize16(const Image::Pixels& values);
+
+// "YYYY:MM:DD HH:MM:SS" (UTC) of SOURCE_DATE_EPOCH, or "" when it is unset or malformed.
+std::string reproducible_date_time();
+
+// Throws OutputError "<path>: cannot write: <reason>", or ResourceError (exit 4) when the reason is
+// memory running out.
+[[noreturn]] void fail_write(const std::string& path, const std::string& reason);
+
+// A temporary beside `path` for a write without WriteOptions::temp_path (nmdiff, the tests).
+std::string temp_path_for(const std::string& path);
+
+// `bytes` to the temporary (options.temp_path, else temp_path_for(path)), flushed to disk (fsync),
+// then renamed to `path` unless options.temp_path is given (the caller renames it). Errors name
+// `path` and remove the temporary.
+void write_file_bytes(const std::string& path, const std::vector<unsigned char>& bytes, const WriteOptions& options);
+
+}  // namespace nmbake::image_write

@@ -1,0 +1,40 @@
+// PNG maps and masks written with libpng directly, not through OpenImageIO: the nmbake command
+// writes its default output without loading the image library's ~260 libraries (0.2 s of CPU,
+// and threads that waited on the loader's lock meanwhile). Chunks as OpenImageIO wrote them: one
+// tEXt per metadata item ("ImageDescription" as "Description", which OpenImageIO reads back under
+// its own name), "DateTime" as tIME; 16-bit samples big-endian as PNG stores them.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/image.h"
+#include "io/image_io.h"
+
+namespace nmbake {
+
+// The encoder's settings. The defaults were chosen by measurement (bench section 9, on the 1M
+// sculpt's 2048^2 8-bit map): zlib's RLE strategy after the Paeth filter gave 2.75 MB in 0.11 s,
+// where level 1 with the Up filter (the settings before) gave 3.56 MB in 0.10 s, libpng's own
+// defaults (level 6, adaptive filters) 2.88 MB in 0.76 s and level 9 2.87 MB in 1.8 s. A normal
+// map's rows differ little from their neighbours, so after Paeth prediction most bytes repeat the
+// one before: what RLE codes, and it searches for nothing else.
+struct PngSettings {
+  int level = 1;       // zlib level 0-9 (with the RLE strategy any level from 1 codes the same)
+  int filters = 0x80;  // libpng's PNG_FILTER_* mask (0x08 none, 0x10 sub, 0x20 up, 0x40 avg, 0x80 paeth, 0xF8 all)
+  int strategy = 3;    // zlib strategy: 0 default, 1 filtered, 2 Huffman only, 3 RLE
+};
+
+// The PNG file's bytes for `rows` (height rows of width * channels samples, 1 byte each for
+// bits 8, native-endian uint16 for bits 16; channels 1 to 4: grey, grey + alpha, RGB, RGBA).
+// Empty, with *error set (libpng's message; "insufficient memory" when memory ran out), on failure.
+std::vector<unsigned char> encode_png(const void* rows, int width, int height, int channels, int bits,
+                                      const std::vector<std::pair<std::string, std::string>>& metadata,
+                                      const PngSettings& settings, std::string* error);
+
+// write_image (image_io.h) for a .png path: quantized as every writer does, encoded with the
+// default PngSettings, written to the temporary file and renamed as write_image documents.
+void write_png_image(const std::string& path, const Image& image, const WriteOptions& options);
+
+}  // namespace nmbake
