@@ -48,14 +48,17 @@ struct Args {
   bool quick = false;
   bool check = false;  // exit 1 unless every analytic scene's error falls from the first setting to the last
   std::vector<std::string> scenes;
+  std::vector<double> max_errors{kDefaultMaxErrorDeg};  // --max-errors: the --samples auto rows' thresholds
   std::string out = "docs/accuracy", data = NMBAKE_SHARED_DATA, nmview = NMBAKE_NMVIEW;
   std::string font = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
   std::string command = "nmbake_accuracy";  // the command line as given, for accuracy.md
 };
 
 const char* kUsage =
-    "usage: nmbake_accuracy [--quick] [--scenes a,b] [--out DIR] [--data DIR] [--nmview PATH|none] [--font TTF]\n"
-    "Bakes every scene at sizes 512, 1024, 2048 (height_field also 4096) with 1, 4 and 16 samples and writes\n"
+    "usage: nmbake_accuracy [--quick] [--scenes a,b] [--max-errors 1,2] [--out DIR] [--data DIR] [--nmview PATH|none] [--font "
+    "TTF]\n"
+    "Bakes every scene at sizes 512, 1024, 2048 (height_field also 4096) with 1, 4 and 16 samples, and with\n"
+    "--samples auto at each --max-errors threshold (default: nmbake's), and writes\n"
     "DIR/accuracy.csv, DIR/accuracy.md and DIR/accuracy.png (default DIR: docs/accuracy).\n"
     "Scenes: height_field, displaced_sphere (analytic), suz_L4, torus_s3 (sculpts), bunny00 (scan; needs --data),\n"
     "hard_assets (the known-answer models of tests/procedural at 512 and 1024 with 1 sample and four hit settings;\n"
@@ -85,6 +88,11 @@ Args parse_args(int argc, char** argv) {
       std::stringstream ss(value());
       for (std::string t; std::getline(ss, t, ',');)
         if (!t.empty()) a.scenes.push_back(t);
+    } else if (s == "--max-errors") {
+      a.max_errors.clear();
+      std::stringstream ss(value());
+      for (std::string t; std::getline(ss, t, ',');)
+        if (!t.empty()) a.max_errors.push_back(std::atof(t.c_str()));
     } else if (s == "--out") a.out = value();
     else if (s == "--data") a.data = value();
     else if (s == "--nmview") a.nmview = value();
@@ -173,6 +181,10 @@ void bake_setting(const Args& a, const AccuracyScene& sc, const BakeOptions& o, 
   row.reference = sc.reference;
   row.size = o.width;
   row.samples = o.samples;
+  row.adaptive = o.adaptive;
+  row.max_error = o.max_error_deg;
+  const double texels = double(r.stats.texels_base + r.stats.texels_refined);
+  row.refined = texels > 0 ? double(r.stats.texels_refined) / texels : 0.0;
   row.rays = r.stats.rays;
   row.misses = r.stats.misses;
   row.prepare = r.stats.seconds_prepare;
@@ -197,9 +209,9 @@ void bake_setting(const Args& a, const AccuracyScene& sc, const BakeOptions& o, 
     row.err = measure(r.map, r.coverage, ref.refs, ref_map, frames, bits);
     res.rows.push_back(row);
     std::fprintf(stderr,
-                 "  %-16s %4d x %-2d %2d-bit  mean %.4f  rms %.4f  p95 %.4f  max %.3f deg  >1deg %.2f%%  misses %llu  "
+                 "  %-16s %4d x %-2s %2d-bit  mean %.4f  rms %.4f  p95 %.4f  max %.3f deg  >1deg %.2f%%  misses %llu  "
                  "trace %.2f s  total %.2f s  %.2f Mrays/s%s\n",
-                 sc.name.c_str(), row.size, row.samples, bits, row.err.mean, row.err.rms, row.err.p95, row.err.max,
+                 sc.name.c_str(), row.size, row.sampling().c_str(), bits, row.err.mean, row.err.rms, row.err.p95, row.err.max,
                  100 * row.err.over1, (unsigned long long)row.misses, row.trace, row.total,
                  row.trace > 0 ? 1e-6 * double(row.rays) / row.trace : 0.0,
                  row.appearance >= 0 ? (" appearance rmse " + fmt("%.5f", row.appearance)).c_str() : "");
@@ -227,6 +239,14 @@ void bake_scene(const Args& a, AccuracyScene& sc, const std::string& work, Accur
       if (size >= 4096 && samples > 4) continue;  // 268M rays: minutes on 2 cores for a point that says nothing new
       o.samples = samples;
       bake_setting(a, sc, o, frames, ref, work, res);
+    }
+    if (size >= 4096) continue;
+    for (double e : a.max_errors) {
+      BakeOptions ao = o;
+      ao.adaptive = true;
+      ao.samples = 16;
+      ao.max_error_deg = e;
+      bake_setting(a, sc, ao, frames, ref, work, res);
     }
   }
   if (sc.analytic) res.floor8[sc.name] = f8, res.floor16[sc.name] = f16;

@@ -63,14 +63,41 @@ std::string utc_now() {
   return buf;
 }
 
+std::string AccuracyRow::sampling() const {
+  if (!adaptive) return std::to_string(samples);
+  return "auto " + fmt("%g", max_error) + "deg (" + fmt("%.1f", 100.0 * refined) + "% at " + std::to_string(samples) + ")";
+}
+
 namespace {
+
+// Per scene and size, the adaptive rows against the fixed 16-sample bake (issue 22's target: its
+// error in at most 40% of its time).
+void write_adaptive_summary(std::ofstream& f, const std::vector<AccuracyRow>& rows) {
+  std::string table;
+  for (const AccuracyRow& a : rows) {
+    if (!a.adaptive || a.bits != 32) continue;
+    for (const AccuracyRow& b : rows) {
+      if (b.adaptive || b.bits != 32 || b.scene != a.scene || b.size != a.size || b.samples != a.samples) continue;
+      const double time = a.total / b.total;
+      const bool met = a.err.mean <= b.err.mean && time <= 0.40;
+      table += "| " + a.scene + " | " + std::to_string(a.size) + " | " + a.sampling() + " | " + fmt("%.4f", a.err.mean) + " / " +
+               fmt("%.4f", b.err.mean) + " | " + fmt("%.3f", a.total) + " / " + fmt("%.3f", b.total) +
+               " s = " + fmt("%.0f%%", 100.0 * time) + " | " + (met ? "MET" : "NOT MET") + " |\n";
+    }
+  }
+  if (table.empty()) return;
+  f << "\n### --samples auto against a fixed bake of as many samples\n\nTarget: the fixed bake's mean error in at most 40% of "
+       "its time (both in this run).\n\n| scene | size | adaptive | mean error, adaptive / fixed | seconds, adaptive / fixed | "
+       "target |\n|---|---|---|---|---|---|\n"
+    << table;
+}
 
 void write_csv(const std::string& out, const std::vector<AccuracyRow>& rows) {
   std::ofstream f(fs::path(out) / "accuracy.csv");
   f << "scene,reference,size,samples,bits,texels,mean_deg,rms_deg,p95_deg,max_deg,share_over_1deg,misses,rays,"
        "prepare_s,bvh_s,distances_s,trace_s,padding_s,total_s,rays_per_s,reference_s,appearance_rmse\n";
   for (const AccuracyRow& r : rows)
-    f << r.scene << ',' << r.reference << ',' << r.size << ',' << r.samples << ',' << r.bits << ',' << r.err.texels << ','
+    f << r.scene << ',' << r.reference << ',' << r.size << ',' << r.sampling() << ',' << r.bits << ',' << r.err.texels << ','
       << fmt("%.6f", r.err.mean) << ',' << fmt("%.6f", r.err.rms) << ',' << fmt("%.6f", r.err.p95) << ','
       << fmt("%.6f", r.err.max) << ',' << fmt("%.6f", r.err.over1) << ',' << r.misses << ',' << r.rays << ','
       << fmt("%.4f", r.prepare) << ',' << fmt("%.4f", r.bvh) << ',' << fmt("%.4f", r.distances) << ',' << fmt("%.4f", r.trace)
@@ -106,7 +133,7 @@ void write_markdown(const std::string& out, const std::string& md_name, const Ac
       << (info.nmview ? " view rmse |" : "") << "\n";
     f << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|" << (info.nmview ? "---|" : "") << "\n";
     for (const AccuracyRow& r : res.rows) {
-      f << "| " << r.scene << " | " << r.reference << " | " << r.size << " | " << r.samples << " | "
+      f << "| " << r.scene << " | " << r.reference << " | " << r.size << " | " << r.sampling() << " | "
         << (r.bits == 32 ? std::string("float") : std::to_string(r.bits)) << " | " << fmt("%.4f", r.err.mean) << " | "
         << fmt("%.4f", r.err.rms) << " | " << fmt("%.4f", r.err.p95) << " | " << fmt("%.3f", r.err.max) << " | "
         << fmt("%.2f%%", 100 * r.err.over1) << " | " << r.misses << " | " << fmt("%.3f", r.prepare) << " | " << fmt("%.3f", r.bvh)
@@ -115,6 +142,7 @@ void write_markdown(const std::string& out, const std::string& md_name, const Ac
       if (info.nmview) f << ' ' << (r.appearance >= 0 ? fmt("%.5f", r.appearance) : std::string("-")) << " |";
       f << "\n";
     }
+    write_adaptive_summary(f, res.rows);
   }
   if (!res.hard_rows.empty())
     f << (res.rows.empty() ? "" : "\n") << hard_assets_markdown(res.hard_rows, res.hard_notes, res.hard_seconds);
@@ -128,14 +156,16 @@ void write_plot(const std::string& out, const std::vector<AccuracyRow>& rows, co
   std::map<std::string, std::size_t> index;
   for (const AccuracyRow& r : rows) {
     if (r.bits == 16) continue;
-    const std::string key = r.scene + (r.bits == 8 ? " 8-bit" : "") + (r.reference == "analytic" ? "" : " (vs 64 spp)");
+    const std::string key = r.scene + (r.bits == 8 ? " 8-bit" : "") + (r.reference == "analytic" ? "" : " (vs 64 spp)") +
+                            (r.adaptive ? " auto " + fmt("%g", r.max_error) + " deg" : "");
     if (!index.count(key)) {
       index[key] = series.size();
       series.push_back({key, {}, r.bits == 8});
     }
     PlotSeries& s = series[index[key]];
     if (s.lines.empty() || s.lines.back().front().label.rfind(std::to_string(r.size) + "x", 0) != 0) s.lines.emplace_back();
-    s.lines.back().push_back({r.total, std::max(r.err.mean, 1e-6), std::to_string(r.size) + "x" + std::to_string(r.samples)});
+    s.lines.back().push_back(
+        {r.total, std::max(r.err.mean, 1e-6), std::to_string(r.size) + "x" + (r.adaptive ? "auto" : std::to_string(r.samples))});
   }
   std::vector<PlotHLine> hl;
   for (const auto& [scene, v] : floor8)
@@ -166,7 +196,7 @@ std::string write_accuracy_files(const std::string& out, const AccuracyResults& 
 bool check_error_falls(const std::vector<AccuracyRow>& rows) {
   std::map<std::string, std::pair<double, double>> first_last;  // analytic scene -> (first, last) float mean error
   for (const AccuracyRow& r : rows)
-    if (r.reference == "analytic" && r.bits == 32) {
+    if (r.reference == "analytic" && r.bits == 32 && !r.adaptive) {
       auto it = first_last.find(r.scene);
       if (it == first_last.end()) first_last[r.scene] = {r.err.mean, r.err.mean};
       else it->second.second = r.err.mean;

@@ -22,6 +22,12 @@ struct AccuracyRow {
   double prepare = 0, bvh = 0, distances = 0, trace = 0, padding = 0, total = 0;  // seconds (BakeStats, total: wall)
   double reference_seconds = 0;                                                   // building the reference (not part of the bake)
   double appearance = -1;                                                         // nmview RMSE, < 0: not measured
+  // --samples auto (samples is then the refined count): its --max-error and the share of covered
+  // texels refined.
+  bool adaptive = false;
+  double max_error = 0, refined = 0;
+  // "16", or for adaptive "auto 1deg (12.3% at 16)".
+  std::string sampling() const;
 };
 
 // Everything a run measured.

@@ -67,7 +67,10 @@ void add_options(CLI::App& app, Args& a) {
   app.add_option("high", a.highs, "High-poly mesh (UVs not needed); several: baked as one")->required();
   app.add_option("-o,--output", a.output, "Output map: .png (8-bit), .tif (16-bit), .exr (float)")->required();
   app.add_option("--size", a.size, "Map size N or WxH in texels (default 2048)");
-  app.add_option("--samples", a.samples, "Sample points per texel, 1-1024 (default 1)");
+  app.add_option("--samples", a.samples,
+                 "Sample points per texel, 1-1024, or auto: 4 per texel, and 16 where those disagree (default 1)");
+  app.add_option("--max-error", a.max_error,
+                 "With --samples auto: refine a texel whose 4 samples lie more than DEG degrees from their mean (default 1)");
   app.add_option("--front", a.front,
                  "One ray start distance outside the low-poly for the whole scene, scene units (default: the automatic cage, "
                  "measured per vertex)");
@@ -143,7 +146,21 @@ BakeOptions bake_options(const Args& a) {
       std::snprintf(got, sizeof got, "%g", d);
       throw UsageError(std::string(name) + " must be a distance >= 0 in scene units, got " + got);
     }
-  o.samples = a.samples;
+  if (a.samples == "auto") {
+    o.adaptive = true;
+    o.samples = 16;
+    if (a.max_error_given) o.max_error_deg = a.max_error;  // validate_options refuses NaN, <= 0 and > 90
+  } else {
+    std::size_t used = 0;
+    try {
+      o.samples = std::stoi(a.samples, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != a.samples.size())
+      throw UsageError("--samples takes a number of samples (1-1024) or auto, got '" + a.samples + "'");
+    if (a.max_error_given) throw UsageError("--max-error applies to --samples auto");
+  }
   o.front = a.front_given ? float(a.front) : -1.0f;
   o.rear = a.rear_given ? float(a.rear) : -1.0f;
   o.policy = a.policy == "closest" ? RayPolicy::closest : RayPolicy::cage_first;
@@ -202,6 +219,7 @@ void finish_args(Args& a, const CLI::App& app) {
   a.high = a.highs.front() + (a.highs.size() > 1 ? " and " + std::to_string(a.highs.size() - 1) + " more" : "");
   a.front_given = app.count("--front") > 0;
   a.rear_given = app.count("--rear") > 0;
+  a.max_error_given = app.count("--max-error") > 0;
 }
 
 }  // namespace nmbake

@@ -18,7 +18,9 @@ struct Args {
   std::string low, high, output, cage, miss_mask, report, save_cage, suspect_mask;
   std::vector<std::string> highs;  // every HIGH given; `high` names them in messages
   std::string size = "2048";
-  int samples = 1;
+  std::string samples = "1";     // a count, or "auto" (adaptive)
+  double max_error = 0.0;        // --max-error (with --samples auto), when max_error_given
+  bool max_error_given = false;  // set after parsing
   double front = -1.0, rear = -1.0;
   bool front_given = false, rear_given = false;  // set after parsing: a distance given is never "auto"
   std::string policy = "cage-first", space = "tangent", green = "up", bitangent = "pixel";

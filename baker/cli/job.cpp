@@ -163,6 +163,16 @@ void report_job(const JobEnv& env, OutputSet& outputs, const Args& a, const Bake
   if (env.report) *env.report = std::move(report);
 }
 
+// "4", or with --samples auto "auto (16 at 3.2% of texels)".
+std::string samples_text(const BakeOptions& o, const BakeStats& s) {
+  if (!o.adaptive) return std::to_string(o.samples);
+  const std::uint64_t texels = s.texels_base + s.texels_refined;
+  char text[80];
+  std::snprintf(text, sizeof text, "auto (%d at %.1f%% of texels, 4 elsewhere)", o.samples,
+                texels ? 100.0 * double(s.texels_refined) / double(texels) : 0.0);
+  return text;
+}
+
 void print_summary(const Args& a, const BakeOptions& o, const RunInfo& run, const BakeStats& s, int bits) {
   std::string tiles;
   if (run.udim.is_object()) {
@@ -171,10 +181,10 @@ void print_summary(const Args& a, const BakeOptions& o, const RunInfo& run, cons
             tiles + ", ";
   }
   std::printf(
-      "nmbake: wrote %s (%s%dx%d, %d-bit, %s%s): samples %d, rays %s, misses %llu (%.2f%%), coverage %.1f%%, "
+      "nmbake: wrote %s (%s%dx%d, %d-bit, %s%s): samples %s, rays %s, misses %llu (%.2f%%), coverage %.1f%%, "
       "seconds: load %.2f prepare %.2f bvh %.2f distances %.2f trace %.2f padding %.2f write %.2f total %.2f\n",
       a.output.c_str(), tiles.c_str(), o.width, o.height, bits, to_string(o.space),
-      o.space == NormalSpace::tangent ? (o.green_down ? ", green down" : ", green up") : "", o.samples,
+      o.space == NormalSpace::tangent ? (o.green_down ? ", green down" : ", green up") : "", samples_text(o, s).c_str(),
       human(double(s.rays)).c_str(), (unsigned long long)s.misses,
       s.samples_covered ? 100.0 * double(s.misses) / double(s.samples_covered) : 0.0, 100.0 * s.coverage, run.seconds_load,
       s.seconds_prepare, s.seconds_bvh, s.seconds_distances, s.seconds_trace, s.seconds_padding, run.seconds_write,

@@ -79,7 +79,8 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
       {"miss_mask", r.miss_mask_path.empty() ? json(nullptr) : json(r.miss_mask_path)},
       {"suspect_mask", r.suspect_mask_path.empty() ? json(nullptr) : json(r.suspect_mask_path)},
       {"size", {o.width, o.height}},
-      {"samples", o.samples},
+      {"samples", o.adaptive ? json("auto") : json(o.samples)},
+      {"max_error_deg", o.adaptive ? json(o.max_error_deg) : json(nullptr)},
       {"front", s.front},
       {"rear", s.rear},
       {"front_rear_auto", s.auto_distances},
@@ -125,6 +126,10 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
       {"rays", s.rays},
       {"rays_per_second", s.seconds_trace > 0 ? double(s.rays) / s.seconds_trace : 0.0},
       {"samples_covered", s.samples_covered},
+      // Covered texels by how many samples made them: one row for a fixed count, two with --samples auto.
+      {"samples_histogram", o.adaptive ? json::array({{{"samples", 4}, {"texels", s.texels_base}},
+                                                      {{"samples", o.samples}, {"texels", s.texels_refined}}})
+                                       : json::array({{{"samples", o.samples}, {"texels", s.texels_covered}}})},
       {"hits", s.hits},
       {"misses", s.misses},
       {"texels", {{"total", s.texels_total}, {"covered", s.texels_covered}, {"padded", s.texels_padded}}},

@@ -228,6 +228,14 @@ void validate_options(const BakeOptions& o) {
     throw ResourceError("--size " + size + " refused: the largest supported side is " + std::to_string(kMaxMapSide) + " texels");
   if (o.samples < 1 || o.samples > kMaxSamples)
     throw UsageError("--samples must be between 1 and " + std::to_string(kMaxSamples) + ", got " + std::to_string(o.samples));
+  if (o.adaptive) {
+    const int k = int(std::lround(std::sqrt(double(o.samples))));
+    if (o.samples < 4 || k * k != o.samples)
+      throw UsageError("--samples auto refines texels with a square number of samples (16, 64, ...), got " +
+                       std::to_string(o.samples));
+    if (!(o.max_error_deg > 0.0 && o.max_error_deg <= 90.0))
+      throw UsageError("--max-error must be an angle in degrees above 0 and at most 90");
+  }
   if (o.padding < 0 || o.padding > kMaxMapSide)
     throw UsageError("--padding must be between 0 and " + std::to_string(kMaxMapSide) + ", got " + std::to_string(o.padding));
   if (o.threads < 0 || o.threads > kMaxThreads)

@@ -68,12 +68,22 @@ struct BvhCache {
   std::size_t reused = 0;  // bakes that took it
 };
 
+// --max-error's default (BakeOptions::max_error_deg), chosen on the accuracy bench's sculpts.
+inline constexpr double kDefaultMaxErrorDeg = 1.0;
+
 struct BakeOptions {
-  int width = 2048;     // map width in texels
-  int height = 2048;    // map height in texels
-  int samples = 1;      // sample points per texel; 1 = the texel centre only (no AA loop)
-  float front = -1.0f;  // scene units the ray starts outside the low-poly; < 0 = auto (measured)
-  float rear = -1.0f;   // scene units the ray reaches inside the low-poly; < 0 = auto (measured)
+  int width = 2048;   // map width in texels
+  int height = 2048;  // map height in texels
+  int samples = 1;    // sample points per texel; 1 = the texel centre only (no AA loop)
+  // --samples auto: each texel first takes 4 samples at the 2x2 Gauss-Legendre points (exact for
+  // a normal that varies smoothly, up to cubic terms, across the texel); a texel whose samples
+  // disagree (one lies more than max_error_deg from their mean, or some miss and some hit) is
+  // baked again with `samples` stratified samples (a square number, 16 by default), exactly as a
+  // fixed bake with that many gives it. BakeStats::texels_refined counts them.
+  bool adaptive = false;
+  double max_error_deg = kDefaultMaxErrorDeg;  // with adaptive: the disagreement that refines a texel, degrees
+  float front = -1.0f;                         // scene units the ray starts outside the low-poly; < 0 = auto (measured)
+  float rear = -1.0f;                          // scene units the ray reaches inside the low-poly; < 0 = auto (measured)
   RayPolicy policy = RayPolicy::cage_first;
   NormalSpace space = NormalSpace::tangent;
   bool green_down = false;  // DirectX "Y-" maps: negate the bitangent component
@@ -115,6 +125,9 @@ struct BakeStats {
   double auto_probe_beyond = 0.0;                // share of probe points farther than the chosen distances
   std::uint64_t rays = 0, hits = 0, misses = 0;  // misses/hits count samples, rays count casts
   std::uint64_t samples_covered = 0;
+  // With BakeOptions::adaptive: covered texels baked with the first 4 samples only, and those baked
+  // again with BakeOptions::samples (the report's sample count histogram).
+  std::uint64_t texels_base = 0, texels_refined = 0;
   std::uint64_t overlapping_samples = 0;  // samples covered by more than one UV triangle
   std::size_t texels_total = 0, texels_covered = 0, texels_padded = 0;
   double coverage = 0.0;  // texels_covered / texels_total

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <chrono>
 #include <condition_variable>
 #include <exception>
@@ -21,9 +22,18 @@ constexpr std::size_t kTilesPerGrab = 4;  // consecutive tiles a trace thread ta
 // (128,128,255) and not a coin flip between 127 and 128 decided by float noise.
 constexpr double kSnap = 1e-6;
 
+// The 2x2 Gauss-Legendre points of a texel, (1 -+ 1/sqrt(3)) / 2 on each axis: their equal-weight
+// mean integrates a normal varying as a cubic across the texel exactly, where a stratified 4x4
+// grid leaves an error of 1/384 of the second derivative times the texel size squared.
+std::vector<glm::dvec2> gauss_legendre_offsets() {
+  const double a = 0.5 - 0.5 / std::sqrt(3.0), b = 0.5 + 0.5 / std::sqrt(3.0);
+  return {{a, a}, {b, a}, {a, b}, {b, b}};
+}
+
 // One cache line each: the counters change per sample, and shared lines would serialize threads.
 struct alignas(64) ThreadStats {
   std::uint64_t rays = 0, hits = 0, misses = 0, covered = 0, overlaps = 0, backface_skips = 0, facing_away = 0, unmatched = 0;
+  std::uint64_t base_texels = 0, refined_texels = 0;  // adaptive sampling (BakeStats::texels_base, texels_refined)
   double dmin = std::numeric_limits<double>::infinity(), dmax = -std::numeric_limits<double>::infinity();
   // Per object, with several (BakeStats::low_object_samples, ...).
   std::vector<std::uint64_t> low_samples, low_hits, high_hits;
@@ -39,7 +49,9 @@ struct Shared {
         setup(setup_),
         opt(opt_),
         out(out_),
-        offsets(sample_offsets(opt_.samples)),
+        offsets(opt_.adaptive ? gauss_legendre_offsets() : sample_offsets(opt_.samples)),
+        refine_offsets(opt_.adaptive ? sample_offsets(opt_.samples) : std::vector<glm::dvec2>{}),
+        cos_max_error(std::cos(opt_.max_error_deg * (3.14159265358979323846 / 180.0))),
         rays_per_sample(setup_.closest ? 2 : 1),
         batched(opt_.space == NormalSpace::tangent && opt_.bitangent == BitangentMode::per_pixel),
         per_object(s_.low_objects > 1 || s_.high_objects > 1),
@@ -57,7 +69,9 @@ struct Shared {
   const RaySetup& setup;
   const BakeOptions& opt;
   const TraceTargets& out;
-  std::vector<glm::dvec2> offsets;
+  std::vector<glm::dvec2> offsets;         // every texel's samples (adaptive: the first 4)
+  std::vector<glm::dvec2> refine_offsets;  // adaptive: the samples of a texel baked again; else empty
+  double cos_max_error = 1.0;              // adaptive: a sample farther than this from its texel's mean refines it
   int rays_per_sample = 1;
   bool batched = false;     // tangent space, per-pixel bitangent: shade_batch.h shades most samples
   bool per_object = false;  // several objects: hits counted per object
@@ -86,7 +100,7 @@ class TileTracer {
         ts_(sh.stats[std::size_t(id)]),
         side_(sh.bins.side),
         tile_texels_(std::size_t(side_) * std::size_t(side_)),
-        slot_count_(tile_texels_ * sh.offsets.size()),
+        slot_count_(tile_texels_ * std::max(sh.offsets.size(), sh.refine_offsets.size())),
         default_rays_(!sh.setup.cage && !sh.setup.closest),
         rays_(slot_count_ * std::size_t(sh.rays_per_sample)),
         hits_(rays_.hits()),
@@ -102,7 +116,8 @@ class TileTracer {
         value_(3 * slot_count_),
         one_at_a_time_(slot_count_, 1),
         acc_(4 * tile_texels_),
-        miss_count_(tile_texels_) {
+        miss_count_(tile_texels_),
+        refine_(sh.refine_offsets.empty() ? 0 : tile_texels_) {
     for (int c = 0; c < 3; ++c) {
       sb_[c] = &sample_b_[std::size_t(c) * slot_count_];
       value_c_[c] = &value_[std::size_t(c) * slot_count_];
@@ -136,7 +151,7 @@ class TileTracer {
   void collect_rays(std::vector<raycast::Ray>& out) {
     for (std::size_t tile = 0; tile < sh_.bins.count(); ++tile) {
       if (sh_.bins.start[tile] == sh_.bins.start[tile + 1]) continue;
-      const std::size_t sample_count = cover_tile(tile, rect_of(tile));
+      const std::size_t sample_count = cover_tile(tile, rect_of(tile), sh_.offsets, nullptr);
       make_rays(sample_count);
       for (std::size_t r = 0; r < sample_count * std::size_t(sh_.rays_per_sample); ++r) out.push_back(rays_.ray(r));
     }
@@ -168,7 +183,25 @@ class TileTracer {
 
   void trace_tile(std::size_t tile) {
     const TileRect rect = rect_of(tile);
-    const std::size_t sample_count = cover_tile(tile, rect);
+    sh_.tile_dsum[tile] = trace_pass(tile, rect, sh_.offsets, nullptr);
+    if (!sh_.refine_offsets.empty() && mark_refined()) {
+      // The texels that disagree again with every refined sample; the others keep their first sums.
+      first_acc_ = acc_;
+      first_miss_ = miss_count_;
+      sh_.tile_dsum[tile] += trace_pass(tile, rect, sh_.refine_offsets, refine_.data());
+      for (std::size_t i = 0; i < tile_texels_; ++i) {
+        if (refine_[i]) continue;
+        for (int c = 0; c < 4; ++c) acc_[std::size_t(c) * tile_texels_ + i] = first_acc_[std::size_t(c) * tile_texels_ + i];
+        miss_count_[i] = first_miss_[i];
+      }
+    }
+    write_texels(rect);
+  }
+
+  // One pass over the tile with these sample offsets (only the texels `only` marks, when given):
+  // cover, make and cast the rays, count the hits, shade into sums_. Returns the sum of hit distances.
+  double trace_pass(std::size_t tile, const TileRect& rect, const std::vector<glm::dvec2>& offsets, const std::uint8_t* only) {
+    const std::size_t sample_count = cover_tile(tile, rect, offsets, only);
     const std::size_t ray_count = sample_count * std::size_t(sh_.rays_per_sample);
     make_rays(sample_count);
     if (sh_.groups.active()) set_groups(sample_count);
@@ -179,14 +212,44 @@ class TileTracer {
         for (std::size_t r = 0; r < ray_count; ++r) ts_.backface_skips += (hits_.flags[r] & raycast::hit_passed_backface) != 0;
     }
     ts_.rays += ray_count;
-    sh_.tile_dsum[tile] = count_hits(sample_count);
+    const double dsum = count_hits(sample_count);
     shade(sample_count);
-    write_texels(rect);
+    return dsum;
+  }
+
+  // Adaptive sampling: marks in refine_ the covered texels whose first samples disagree (one lies
+  // more than the maximum error from their mean, some miss and some hit) or that not all of them
+  // cover (an island's edge). Returns whether any is marked.
+  bool mark_refined() {
+    std::fill(refine_.begin(), refine_.end(), 0);
+    const double full = double(sh_.offsets.size()), cos_max = sh_.cos_max_error;
+    for (std::size_t i = 0; i < tile_texels_; ++i) {
+      const double n = sums_.count[i];
+      if (n == 0.0) continue;
+      ++ts_.base_texels;
+      refine_[i] = n < full || (miss_count_[i] > 0 && double(miss_count_[i]) < n);
+    }
+    for (std::size_t r = 0; r < last_sample_count_; ++r) {
+      const std::size_t i = sample_texel_[r];
+      if (refine_[i]) continue;
+      const double m[3] = {sums_.sum[0][i], sums_.sum[1][i], sums_.sum[2][i]};
+      const double v[3] = {value_c_[0][r], value_c_[1][r], value_c_[2][r]};
+      const double dot = m[0] * v[0] + m[1] * v[1] + m[2] * v[2];
+      const double mm = m[0] * m[0] + m[1] * m[1] + m[2] * m[2], vv = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+      // cos(angle) < cos_max, without a division or a square root: dot < cos_max * |m| |v|.
+      refine_[i] = dot <= 0.0 ? mm > 0.0 || vv > 0.0 : dot * dot < cos_max * cos_max * mm * vv;
+    }
+    std::size_t marked = 0;
+    for (std::uint8_t f : refine_) marked += f;
+    ts_.base_texels -= marked;
+    ts_.refined_texels += marked;
+    return marked > 0;
   }
 
   // Rasterize: the covered samples of the tile, compacted (and, for the default policy, their
   // rays). The lowest triangle index wins a sample covered twice (overlapping islands).
-  std::size_t cover_tile(std::size_t tile, const TileRect& rect) {
+  std::size_t cover_tile(std::size_t tile, const TileRect& rect, const std::vector<glm::dvec2>& offsets,
+                         const std::uint8_t* only) {
     const TileBins& bins = sh_.bins;
     const int tx0 = rect.x0, ty0 = rect.y0, tw = rect.w, th = rect.h;
     std::fill(sample_tri_.begin(), sample_tri_.end(), -1);
@@ -202,18 +265,25 @@ class TileTracer {
       const int x0 = std::max(tt.xmin, tx0), x1 = std::min(tt.xmax, tx0 + tw - 1);
       const int y0 = std::max(tt.ymin, ty0), y1 = std::min(tt.ymax, ty0 + th - 1);
       if (x1 < x0 || y1 < y0) continue;
-      for (std::size_t k = 0; k < sh_.offsets.size(); ++k)
-        ts_.overlaps += cover_rect(
-            tt, std::int32_t(t), x0, x1, y0, y1, sh_.offsets[k].x, sh_.offsets[k].y, default_ray_setup, slots,
+      for (std::size_t k = 0; k < offsets.size(); ++k) {
+        const std::size_t taken = cover_rect(
+            tt, std::int32_t(t), x0, x1, y0, y1, offsets[k].x, offsets[k].y, default_ray_setup, slots,
             (k * std::size_t(side_) + std::size_t(y0 - ty0)) * std::size_t(side_) + std::size_t(x0 - tx0), std::size_t(side_));
+        if (!only) ts_.overlaps += taken;  // a refining pass covers again what the first counted
+      }
     }
+    const std::size_t slot_count = tile_texels_ * offsets.size();
+    if (only)
+      for (std::size_t i = 0; i < slot_count; ++i)
+        if (!only[i % tile_texels_]) sample_tri_[i] = -1;
     const CoveredSamples covered{sample_tri_.data(),
                                  {sb_[0], sb_[1], sb_[2]},
                                  sample_texel_.data(),
                                  {slots.org[0], slots.org[1], slots.org[2]},
                                  {slots.dir[0], slots.dir[1], slots.dir[2]},
                                  sample_fallback_.data()};
-    return compact_samples(slots, slot_count_, tile_texels_, default_rays_, covered);
+    last_sample_count_ = compact_samples(slots, slot_count, tile_texels_, default_rays_, covered);
+    return last_sample_count_;
   }
 
   // The rays the coverage did not make: cage rays straight into the arrays, and one at a time the
@@ -396,6 +466,10 @@ class TileTracer {
   std::vector<double> acc_;                  // per texel of the tile: x, y, z sums and covered samples, as arrays
   TexelSums sums_;
   std::vector<std::uint32_t> miss_count_;
+  std::vector<std::uint8_t> refine_;   // adaptive: per texel of the tile, baked again with the refining samples
+  std::size_t last_sample_count_ = 0;  // covered samples of the last cover_tile
+  std::vector<double> first_acc_;      // adaptive: the first pass's sums while the refining pass runs
+  std::vector<std::uint32_t> first_miss_;
 };
 
 // Runs `threads` tracers; the calling thread reports progress every 100 ms. The last worker to
@@ -509,6 +583,8 @@ void trace_and_shade(const Prepared& s, const HighScene& scene, const TileBins& 
     total.backface_skips += ts.backface_skips;
     total.facing_away += ts.facing_away;
     total.unmatched += ts.unmatched;
+    total.base_texels += ts.base_texels;
+    total.refined_texels += ts.refined_texels;
     total.dmin = std::min(total.dmin, ts.dmin);
     total.dmax = std::max(total.dmax, ts.dmax);
   }
@@ -520,6 +596,8 @@ void trace_and_shade(const Prepared& s, const HighScene& scene, const TileBins& 
   st.backface_skips = total.backface_skips;
   st.hits_facing_away = total.facing_away;
   st.samples_unmatched = total.unmatched;
+  st.texels_base = total.base_texels;
+  st.texels_refined = total.refined_texels;
   count_per_object(sh, st);
   if (total.hits) {
     st.hit_distance_min = total.dmin;
