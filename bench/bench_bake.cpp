@@ -2,7 +2,8 @@
 // bare Embree loop over the same rays (same process, same threads), BVH build quality, whole
 // commands on 1M and 4M triangles with peak memory and what the automatic cage and back-face filter
 // cost them, loading against OpenMesh's readers, thread / triangle / texel scaling, and far-geometry
-// culling, and degenerate floods (duplicate faces, huge polygons); every target with its measured
+// culling, degenerate floods (duplicate faces, huge polygons), batches, PNG settings, and the whole
+// command side by side with Blender's Cycles bake of the same pair; every target with its measured
 // value and MET / NOT MET. Everything printed is measured in this run; nothing asserts (not a test).
 //
 //   bench_bake SHARED_DATA NMBAKE_EXE [--rounds N] [--trace-rounds N] [--quick] [--scratch DIR] [--sections LIST]
@@ -17,8 +18,11 @@
 // $TMPDIR/nmbake-bench); each run's maps and reports go to a subfolder removed at the end.
 //
 // The sections live in bench_tracing.cpp (1, 2), bench_commands.cpp (3, 6), bench_scaling.cpp
-// (4, 5), bench_floods.cpp (7), bench_batch.cpp (8) and bench_png.cpp (9); this file parses the arguments, prints the machine,
-// generates the scenes (0) and prints the targets.
+// (4, 5), bench_floods.cpp (7), bench_batch.cpp (8), bench_png.cpp (9) and bench_blender.cpp (10,
+// with blender_bake.py; Blender is $NMBAKE_BLENDER or `blender` on PATH, else nmbake's rows alone);
+// this file parses the arguments, prints the machine, generates the scenes (0) and prints the
+// targets. `bench_bake --measure-child CMD ARGS...` is not for people: section 10 starts each
+// command through it (bench_bake.h).
 #include <unistd.h>
 
 #include <algorithm>
@@ -164,6 +168,7 @@ void print_targets(const BenchRun& run, Clock::time_point start) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc > 1 && std::string(argv[1]) == kMeasureChild) return measure_child(argv + 2);
   BenchRun run;
   run.args = parse_args(argc, argv);
   const Args& args = run.args;
@@ -197,6 +202,7 @@ int main(int argc, char** argv) {
   if (args.runs(7)) run_floods(run, scenes);
   if (args.runs(8)) run_batch(run, scenes);
   if (args.runs(9)) run_png_settings(run, scenes);
+  if (args.runs(10)) run_blender(run, scenes);
   print_targets(run, start);
   std::error_code ec;
   fs::remove_all(run.run_dir, ec);

@@ -94,5 +94,13 @@ void run_far_geometry(BenchRun& run, const Scenes& scenes);                     
 void run_floods(BenchRun& run, const Scenes& scenes);                            // 7 (bench_floods.cpp)
 void run_batch(BenchRun& run, const Scenes& scenes);                             // 8 (bench_batch.cpp)
 void run_png_settings(BenchRun& run, const Scenes& scenes);                      // 9 (bench_png.cpp)
+void run_blender(BenchRun& run, const Scenes& scenes);                           // 10 (bench_blender.cpp)
+
+// `bench_bake --measure-child CMD ARGS...`, the process section 10 starts each command with (a fresh
+// one, so the command's ru_maxrss does not start from the bench's peak): forks and runs CMD (searched on PATH) with this
+// process's stdin, stdout and stderr, waits for it, and prints "bench-measured: status S wall W maxrss_kib K" (S the raw wait
+// status, W seconds). Returns CMD's exit code, 1 when a signal ended it, 127 when it cannot start.
+inline constexpr const char* kMeasureChild = "--measure-child";
+int measure_child(char** argv);  // argv: CMD ARGS..., null-terminated
 
 }  // namespace nmbake::bench
