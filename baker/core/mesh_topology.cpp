@@ -3,25 +3,35 @@
 #include "core/normals.h"
 
 #include <algorithm>
-#include <cmath>
 #include <cstring>
-#include <unordered_map>
+#include <utility>
 
 namespace nmbake {
 
 namespace {
 
+// A position's coordinates as bits, -0 made +0: equal keys are one vertex.
 struct PosKey {
   std::uint32_t bits[3];
-  bool operator==(const PosKey& o) const { return bits[0] == o.bits[0] && bits[1] == o.bits[1] && bits[2] == o.bits[2]; }
+  std::uint32_t id;  // in the weld table: 1 + the vertex id, 0 for an empty slot
 };
-struct PosKeyHash {
-  std::size_t operator()(const PosKey& k) const {
-    std::uint64_t h = 1469598103934665603ull;
-    for (std::uint32_t b : k.bits) h = (h ^ b) * 1099511628211ull;
-    return std::size_t(h ^ (h >> 29));
+
+PosKey key_of(const glm::vec3& p) {
+  PosKey k{};
+  for (int c = 0; c < 3; ++c) {
+    const float v = p[c] + 0.0f;  // -0 -> +0
+    std::memcpy(&k.bits[c], &v, sizeof v);
   }
-};
+  return k;
+}
+
+// The top bits of a multiplicative mix: a table index of `shift` = 64 - log2(table size).
+std::size_t slot_of(const PosKey& k, unsigned shift) {
+  std::uint64_t h = ((std::uint64_t(k.bits[0]) << 32) | k.bits[1]) * 0x9E3779B97F4A7C15ull;
+  h ^= k.bits[2] * 0xC2B2AE3D27D4EB4Full;
+  h = (h ^ (h >> 29)) * 0xBF58476D1CE4E5B9ull;
+  return std::size_t(h >> shift);
+}
 
 // Everything the checks and the normals share: welded corners, duplicate faces, and the faces to
 // turn so that every piece has one winding.
@@ -33,142 +43,247 @@ struct Analysis {
   MeshTopology topo;
 };
 
-Analysis analyze(const Mesh& m) {
-  Analysis a;
-  const std::size_t tris = m.triangle_count();
-  a.weld = weld_positions(m.positions, &a.topo.welded_vertices);
-  a.corner.resize(3 * tris);
-  for (std::size_t c = 0; c < 3 * tris; ++c) a.corner[c] = a.weld[m.position_index[c]];
-  {
-    std::vector<std::uint8_t> used(m.positions.size(), 0);
-    for (std::uint32_t p : m.position_index) used[p] = 1;
-    for (std::uint8_t u : used) a.topo.isolated_vertices += !u;
-    std::vector<std::uint8_t> used_welded(a.topo.welded_vertices, 0);
-    for (std::uint32_t w : a.corner) used_welded[w] = 1;
-    a.topo.welded_vertices = std::size_t(std::count(used_welded.begin(), used_welded.end(), 1));
+// Faces linked across manifold edges, in the order of the edges' (smaller, larger vertex) keys: at
+// most one link per edge of a face, so 3 slots per face.
+struct Adjacency {
+  std::vector<std::uint32_t> face;  // 3 per triangle, `count` of them used: face << 1 | same
+  std::vector<std::uint8_t> count;  // per triangle
+
+  // `same`: the two faces run the edge the same way (one of them is wound against the other).
+  void link(std::uint32_t f, std::uint32_t g, std::uint32_t same) { face[3 * std::size_t(f) + count[f]++] = g << 1 | same; }
+};
+
+// Counting sort: counts in start[key + 2] become, by the prefix sum, the bucket starts at
+// start[key + 1], which the scatter (start[key + 1]++) leaves as bucket key's range [start[key],
+// start[key + 1]). Items scattered in increasing order stay in that order within their bucket.
+void prefix_sum(std::vector<std::uint32_t>& start) {
+  for (std::size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+}
+
+void sort3(std::uint32_t v[3]) {
+  if (v[0] > v[1]) std::swap(v[0], v[1]);
+  if (v[1] > v[2]) std::swap(v[1], v[2]);
+  if (v[0] > v[1]) std::swap(v[0], v[1]);
+}
+
+// Welded vertex ids used by faces, and file vertices no face uses.
+void count_vertices(const Mesh& m, std::size_t ids, Analysis& a) {
+  std::vector<std::uint8_t> used(m.positions.size(), 0);
+  for (std::uint32_t p : m.position_index) used[p] = 1;
+  for (std::uint8_t u : used) a.topo.isolated_vertices += !u;
+  std::vector<std::uint8_t> used_welded(ids, 0);
+  for (std::uint32_t w : a.corner) used_welded[w] = 1;
+  a.topo.welded_vertices = std::size_t(std::count(used_welded.begin(), used_welded.end(), 1));
+}
+
+// Per vertex, the faces (not collapsed) it is the smallest or the middle vertex of, in face order:
+// the faces with an edge from it to a larger vertex. Collapsed faces (two corners welded) are
+// marked skipped: they have no edges and no direction.
+struct VertexFaces {
+  std::vector<std::uint32_t> start;  // vertex v's faces: face[start[v]] .. face[start[v + 1] - 1]
+  std::vector<std::uint32_t> face;
+};
+
+VertexFaces list_faces_by_vertex(std::size_t ids, Analysis& a) {
+  const std::size_t tris = a.skip.size();
+  VertexFaces vf;
+  vf.start.assign(ids + 2, 0);
+  for (std::size_t t = 0; t < tris; ++t) {
+    std::uint32_t v[3] = {a.corner[3 * t], a.corner[3 * t + 1], a.corner[3 * t + 2]};
+    sort3(v);
+    if (v[0] == v[1] || v[1] == v[2]) a.skip[t] = 1;
+    else ++vf.start[v[0] + 2], ++vf.start[v[1] + 2];
   }
-  // Duplicate faces: the same sorted vertex triple as an earlier face.
-  a.skip.assign(tris, 0);
-  {
-    struct Tri {
-      std::uint32_t v[3];
-      std::uint32_t face;
-    };
-    std::vector<Tri> sorted(tris);
-    for (std::size_t t = 0; t < tris; ++t) {
-      std::uint32_t v[3] = {a.corner[3 * t], a.corner[3 * t + 1], a.corner[3 * t + 2]};
-      std::sort(v, v + 3);
-      sorted[t] = {{v[0], v[1], v[2]}, std::uint32_t(t)};
-      if (v[0] == v[1] || v[1] == v[2]) a.skip[t] = 1;  // collapsed: no edges, no direction
-    }
-    std::sort(sorted.begin(), sorted.end(), [](const Tri& x, const Tri& y) {
-      if (x.v[0] != y.v[0]) return x.v[0] < y.v[0];
-      if (x.v[1] != y.v[1]) return x.v[1] < y.v[1];
-      if (x.v[2] != y.v[2]) return x.v[2] < y.v[2];
-      return x.face < y.face;
-    });
-    auto same = [](const Tri& x, const Tri& y) { return x.v[0] == y.v[0] && x.v[1] == y.v[1] && x.v[2] == y.v[2]; };
-    for (std::size_t i = 1; i < tris; ++i)
-      if (same(sorted[i], sorted[i - 1]) && !a.skip[sorted[i].face]) {
-        a.skip[sorted[i].face] = 1;
-        ++a.topo.duplicate_faces;
-      }
-  }
-  // Edges: sorted (undirected key, face, direction) records; runs of one key are one edge.
-  struct Edge {
-    std::uint64_t key;
-    std::uint32_t face;
-    std::uint32_t forward;  // 1 when the face runs from the smaller to the larger vertex
-  };
-  std::vector<Edge> edges;
-  edges.reserve(3 * tris);
+  prefix_sum(vf.start);
+  vf.face.resize(vf.start[ids + 1]);
   for (std::size_t t = 0; t < tris; ++t) {
     if (a.skip[t]) continue;
+    std::uint32_t v[3] = {a.corner[3 * t], a.corner[3 * t + 1], a.corner[3 * t + 2]};
+    sort3(v);
+    vf.face[vf.start[v[0] + 1]++] = std::uint32_t(t);
+    vf.face[vf.start[v[1] + 1]++] = std::uint32_t(t);
+  }
+  return vf;
+}
+
+// Per face whose smallest vertex is the one visited: (middle << 32 | largest vertex, face).
+using FacePairs = std::vector<std::pair<std::uint64_t, std::uint32_t>>;
+
+// Marks the duplicates among `pairs` (in face order): each face whose pair an earlier one has.
+// Whether there were any.
+bool mark_duplicates(FacePairs& pairs, Analysis& a) {
+  const std::size_t before = a.topo.duplicate_faces;
+  auto mark = [&](std::size_t i) {
+    a.skip[pairs[i].second] = 1;
+    ++a.topo.duplicate_faces;
+  };
+  if (pairs.size() <= 32) {  // a handful of faces: compare each with the earlier ones
+    for (std::size_t i = 1; i < pairs.size(); ++i)
+      for (std::size_t j = 0; j < i; ++j)
+        if (pairs[j].first == pairs[i].first) {
+          mark(i);
+          break;
+        }
+  } else {
+    std::sort(pairs.begin(), pairs.end());
+    for (std::size_t i = 1; i < pairs.size(); ++i)
+      if (pairs[i].first == pairs[i - 1].first) mark(i);
+  }
+  return a.topo.duplicate_faces != before;
+}
+
+// At vertex `b`, given `faces` (in face order) it is the smallest or the middle vertex of:
+// - duplicates: among the faces whose smallest vertex is b, a face whose (middle, largest) pair an
+//   earlier one has (the faces a global sort of (sorted triple, face) finds after the first of each
+//   run);
+// - then the edges from b to a larger vertex of the faces left, sorted by (larger vertex, face):
+//   the order of a global sort of all edges by (key, face). Runs of one key are one edge; manifold
+//   edges link two faces.
+// A half-edge is larger vertex << 32 | face << 1 | forward (the face runs from b to the larger
+// vertex); face < 2^31, as the bucket starts count 2 per face in 32 bits. Faces are distinct within
+// one edge, so sorting by value sorts by (key, face).
+void visit_vertex(std::uint32_t b, const std::uint32_t* faces, std::size_t n, Analysis& a, Adjacency& adj,
+                  std::vector<std::uint64_t>& edges, FacePairs& pairs) {
+  edges.clear();
+  pairs.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t t = faces[i];
+    if (a.skip[t]) continue;  // a duplicate, marked at its smallest vertex
+    const std::uint32_t* c = &a.corner[3 * std::size_t(t)];
+    const std::size_t first = edges.size();
     for (int k = 0; k < 3; ++k) {
-      const std::uint32_t p = a.corner[3 * t + k], q = a.corner[3 * t + (k + 1) % 3];
-      const std::uint64_t lo = std::min(p, q), hi = std::max(p, q);
-      edges.push_back({(lo << 32) | hi, std::uint32_t(t), p < q ? 1u : 0u});
+      const std::uint32_t p = c[k], q = c[k == 2 ? 0 : k + 1];
+      if (std::min(p, q) == b) edges.push_back((std::uint64_t(std::max(p, q)) << 32) | (std::uint64_t(t) << 1) | (p < q));
+    }
+    if (edges.size() - first == 2) {  // b is the smallest vertex: the face's other two are its edges' ends
+      const std::uint64_t x = edges[first] >> 32, y = edges[first + 1] >> 32;
+      pairs.emplace_back(x < y ? (x << 32 | y) : (y << 32 | x), t);
     }
   }
-  std::sort(edges.begin(), edges.end(),
-            [](const Edge& x, const Edge& y) { return x.key < y.key || (x.key == y.key && x.face < y.face); });
-  // Manifold edges link two faces; `same` marks a pair running the edge the same way (one of the
-  // two is wound against the other).
-  std::vector<std::uint32_t> adj_start(tris + 1, 0);
-  struct Link {
-    std::uint32_t a, b, same;
-  };
-  std::vector<Link> links;
+  if (pairs.size() >= 2 && mark_duplicates(pairs, a))
+    edges.erase(std::remove_if(edges.begin(), edges.end(), [&](std::uint64_t e) { return a.skip[std::uint32_t(e) >> 1]; }),
+                edges.end());
+  if (edges.size() <= 16) {  // insertion sort: a vertex has a handful of edges
+    for (std::size_t i = 1; i < edges.size(); ++i) {
+      const std::uint64_t e = edges[i];
+      std::size_t j = i;
+      for (; j > 0 && edges[j - 1] > e; --j) edges[j] = edges[j - 1];
+      edges[j] = e;
+    }
+  } else {
+    std::sort(edges.begin(), edges.end());
+  }
   for (std::size_t i = 0; i < edges.size();) {
-    std::size_t j = i;
-    while (j < edges.size() && edges[j].key == edges[i].key) ++j;
-    const std::size_t n = j - i;
-    if (n == 1) ++a.topo.boundary_edges;
-    else if (n > 2) ++a.topo.non_manifold_edges;
-    else if (edges[i].face != edges[i + 1].face)
-      links.push_back({edges[i].face, edges[i + 1].face, edges[i].forward == edges[i + 1].forward});
+    std::size_t j = i + 1;
+    while (j < edges.size() && (edges[j] >> 32) == (edges[i] >> 32)) ++j;
+    if (j - i == 1) ++a.topo.boundary_edges;
+    else if (j - i > 2) ++a.topo.non_manifold_edges;
+    else {
+      const std::uint32_t f = std::uint32_t(edges[i]) >> 1, g = std::uint32_t(edges[i + 1]) >> 1;
+      const std::uint32_t same = (edges[i] & 1) == (edges[i + 1] & 1);
+      adj.link(f, g, same);
+      adj.link(g, f, same);
+    }
     i = j;
   }
-  for (const Link& l : links) ++adj_start[l.a + 1], ++adj_start[l.b + 1];
-  for (std::size_t t = 0; t < tris; ++t) adj_start[t + 1] += adj_start[t];
-  std::vector<std::uint32_t> adj(adj_start[tris]);
-  std::vector<std::uint8_t> adj_same(adj_start[tris]);
-  {
-    std::vector<std::uint32_t> fill(adj_start.begin(), adj_start.end() - 1);
-    for (const Link& l : links) {
-      adj_same[fill[l.a]] = std::uint8_t(l.same);
-      adj[fill[l.a]++] = l.b;
-      adj_same[fill[l.b]] = std::uint8_t(l.same);
-      adj[fill[l.b]++] = l.a;
-    }
+}
+
+// Vertex by vertex in increasing order: the duplicates among the faces it is the smallest vertex
+// of, then the edges from it to larger vertices (a duplicate's edges all start at its smallest or
+// middle vertex, so are seen after it is marked).
+Adjacency link_faces(std::size_t ids, Analysis& a) {
+  const std::size_t tris = a.skip.size();
+  const VertexFaces vf = list_faces_by_vertex(ids, a);
+  Adjacency adj;
+  adj.face.resize(3 * tris);
+  adj.count.assign(tris, 0);
+  FacePairs pairs;
+  std::vector<std::uint64_t> edges;
+  for (std::size_t b = 0; b < ids; ++b) {
+    const std::uint32_t* faces = vf.face.data() + vf.start[b];
+    const std::size_t n = vf.start[b + 1] - vf.start[b];
+    visit_vertex(std::uint32_t(b), faces, n, a, adj, edges, pairs);
   }
-  // Per piece: breadth-first, each face's winding relative to the seed; the minority is flipped.
+  return adj;
+}
+
+// Per piece: breadth-first, each face's winding relative to the seed; the minority is flipped.
+void orient_pieces(const Adjacency& adj, Analysis& a) {
+  const std::size_t tris = a.skip.size();
   a.flip.assign(tris, 0);
   std::vector<std::int8_t> rel(tris, -1);
-  std::vector<std::uint32_t> piece, queue;
+  std::vector<std::uint32_t> queue;
+  queue.reserve(tris);
   for (std::size_t seed = 0; seed < tris; ++seed) {
     if (a.skip[seed] || rel[seed] >= 0) continue;
-    piece.clear();
+    // The queue, once drained, holds the piece.
     queue.assign(1, std::uint32_t(seed));
     rel[seed] = 0;
     std::size_t ones = 0;
     for (std::size_t qi = 0; qi < queue.size(); ++qi) {
+      // Faces leave the queue in an order far from their numbers: fetch a later one's links now.
+      constexpr std::size_t kAhead = 16;
+      if (qi + kAhead < queue.size()) __builtin_prefetch(&adj.face[3 * std::size_t(queue[qi + kAhead])]);
       const std::uint32_t f = queue[qi];
-      piece.push_back(f);
-      ones += rel[f];
-      for (std::uint32_t k = adj_start[f]; k < adj_start[f + 1]; ++k) {
-        const std::uint32_t g = adj[k];
+      ones += std::size_t(rel[f]);
+      for (std::size_t k = 3 * std::size_t(f); k < 3 * std::size_t(f) + adj.count[f]; ++k) {
+        const std::uint32_t g = adj.face[k] >> 1;
         if (rel[g] >= 0) continue;  // a conflict (non-orientable piece) keeps the first assignment
-        rel[g] = std::int8_t(rel[f] ^ adj_same[k]);
+        rel[g] = std::int8_t(rel[f] ^ std::int8_t(adj.face[k] & 1));
         queue.push_back(g);
       }
     }
     // Ties keep the seed's (lowest face number's) winding.
-    const std::int8_t minority = ones * 2 > piece.size() ? 0 : 1;
-    for (std::uint32_t f : piece)
+    const std::int8_t minority = ones * 2 > queue.size() ? 0 : 1;
+    for (std::uint32_t f : queue)
       if (rel[f] == minority) {
         a.flip[f] = 1;
         ++a.topo.inconsistent_winding_faces;
       }
   }
+}
+
+Analysis analyze(const Mesh& m) {
+  Analysis a;
+  const std::size_t tris = m.triangle_count();
+  std::size_t ids = 0;
+  a.weld = weld_positions(m.positions, &ids);
+  a.corner.resize(3 * tris);
+  for (std::size_t c = 0; c < 3 * tris; ++c) a.corner[c] = a.weld[m.position_index[c]];
+  count_vertices(m, ids, a);
+  a.skip.assign(tris, 0);
+  orient_pieces(link_faces(ids, a), a);
   return a;
 }
 
 }  // namespace
 
+// Open addressing with linear probing over a table at most half full; ids in order of first occurrence.
 std::vector<std::uint32_t> weld_positions(const std::vector<glm::vec3>& positions, std::size_t* count) {
-  std::unordered_map<PosKey, std::uint32_t, PosKeyHash> ids;
-  ids.reserve(positions.size());
+  unsigned shift = 64 - 4;
+  while ((std::size_t(1) << (64 - shift)) < 2 * positions.size()) --shift;
+  const std::size_t mask = (std::size_t(1) << (64 - shift)) - 1;
+  std::vector<PosKey> table(mask + 1, PosKey{});
   std::vector<std::uint32_t> out(positions.size());
+  std::uint32_t ids = 0;
   for (std::size_t i = 0; i < positions.size(); ++i) {
-    PosKey k;
-    for (int c = 0; c < 3; ++c) {
-      const float v = positions[i][c] + 0.0f;  // -0 -> +0
-      std::memcpy(&k.bits[c], &v, sizeof v);
+    // The table is larger than the caches: its slot for a position some steps ahead is fetched now.
+    constexpr std::size_t kAhead = 8;
+    if (i + kAhead < positions.size()) __builtin_prefetch(&table[slot_of(key_of(positions[i + kAhead]), shift)]);
+    PosKey k = key_of(positions[i]);
+    for (std::size_t s = slot_of(k, shift);; s = (s + 1) & mask) {
+      PosKey& e = table[s];
+      if (e.id == 0) {
+        k.id = ++ids;
+        e = k;
+      } else if (e.bits[0] != k.bits[0] || e.bits[1] != k.bits[1] || e.bits[2] != k.bits[2]) {
+        continue;
+      }
+      out[i] = e.id - 1;
+      break;
     }
-    out[i] = ids.emplace(k, std::uint32_t(ids.size())).first->second;
   }
-  if (count) *count = ids.size();
+  if (count) *count = ids;
   return out;
 }
 

@@ -1,0 +1,135 @@
+// mesh_topology's exact answers: welded ids in order of first occurrence, the earliest of duplicate
+// faces kept, and the faces turned in a non-orientable piece, which follow the order of the
+// breadth-first walk (faces linked in the order of their edges' (smaller, larger vertex) keys).
+#include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "core/mesh_topology.h"
+#include "core/normals.h"
+
+using namespace nmbake;
+
+namespace {
+
+Mesh make_mesh(std::vector<glm::vec3> positions, std::vector<std::uint32_t> index) {
+  Mesh m;
+  m.positions = std::move(positions);
+  m.position_index = std::move(index);
+  return m;
+}
+
+// A Klein bottle as an nu x nv grid of quads (2 triangles each) on the figure-8 immersion: across
+// the seam i = nu - 1 -> 0 the j direction is reversed. Vertex (i, j) is renumbered
+// ((i * nv + j) * 7) % V and triangle t moved to (t * 5) % T (permutations for V and T = 2V prime to
+// 7 and 5), so that numbers do not follow the grid.
+Mesh make_shuffled_klein_bottle(int nu, int nv) {
+  const std::size_t V = std::size_t(nu * nv), T = 2 * V;
+  const float pi = 3.14159265f;
+  std::vector<glm::vec3> positions(V);
+  for (int i = 0; i < nu; ++i)
+    for (int j = 0; j < nv; ++j) {
+      const float u = 2 * pi * float(i) / float(nu), v = 2 * pi * float(j) / float(nv) + 0.3f;
+      const float r = 3 + std::cos(u / 2) * std::sin(v) - std::sin(u / 2) * std::sin(2 * v);
+      positions[(std::size_t(i * nv + j) * 7) % V] = {r * std::cos(u), r * std::sin(u),
+                                                      std::sin(u / 2) * std::sin(v) + std::cos(u / 2) * std::sin(2 * v)};
+    }
+  auto id = [&](int i, int j) {
+    if (i == nu) i = 0, j = nv - j;
+    return std::uint32_t((std::size_t(i * nv + (j % nv + nv) % nv) * 7) % V);
+  };
+  std::vector<std::uint32_t> index(3 * T);
+  std::size_t t = 0;
+  for (int i = 0; i < nu; ++i)
+    for (int j = 0; j < nv; ++j) {
+      const std::uint32_t quad[2][3] = {{id(i, j), id(i + 1, j), id(i + 1, j + 1)}, {id(i, j), id(i + 1, j + 1), id(i, j + 1)}};
+      for (const auto& tri : quad) {
+        for (int k = 0; k < 3; ++k) index[3 * ((t * 5) % T) + std::size_t(k)] = tri[k];
+        ++t;
+      }
+    }
+  return make_mesh(std::move(positions), std::move(index));
+}
+
+}  // namespace
+
+TEST(MeshTopology, WeldIdsFollowFirstOccurrenceAndSignedZerosMeet) {
+  std::size_t count = 0;
+  const std::vector<std::uint32_t> ids =
+      weld_positions({{1, 0, 0}, {0, 0, 0}, {1, -0.0f, 0}, {-0.0f, 0, -0.0f}, {2, 0, 0}, {1, 0, 0}}, &count);
+  EXPECT_EQ(ids, (std::vector<std::uint32_t>{0, 1, 0, 1, 2, 0}));
+  EXPECT_EQ(count, 3u);
+}
+
+TEST(MeshTopology, DuplicatesKeepTheEarliestFace) {
+  // Position 4 is position 0 again, position 5 is used by no face. Faces 2 and 3 repeat face 1's
+  // vertices (welded), in other orders; face 4 has two corners welded. Face 1 (kept) is wound
+  // against face 0 across edge 1-2: one of the two is turned. Had face 3 been kept instead, the
+  // two would agree.
+  const Mesh m = make_mesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, 0, 0}, {5, 5, 5}},
+                           {1, 3, 2, /**/ 4, 2, 1, /**/ 0, 1, 2, /**/ 1, 2, 4, /**/ 0, 4, 3});
+  const MeshTopology t = inspect_topology(m);
+  EXPECT_EQ(t.welded_vertices, 4u);
+  EXPECT_EQ(t.isolated_vertices, 1u);
+  EXPECT_EQ(t.duplicate_faces, 2u);
+  EXPECT_EQ(t.boundary_edges, 4u);
+  EXPECT_EQ(t.non_manifold_edges, 0u);
+  EXPECT_EQ(t.inconsistent_winding_faces, 1u);
+  // A tie: the seed (face 0) keeps its winding, +z, and so does every corner.
+  std::size_t reoriented = 0;
+  const std::vector<glm::vec3> n = compute_high_corner_normals(m, &reoriented);
+  EXPECT_EQ(reoriented, 1u);
+  for (std::size_t c = 0; c < n.size(); ++c) {
+    EXPECT_NEAR(n[c].x, 0.0f, 1e-6f) << "corner " << c;
+    EXPECT_NEAR(n[c].y, 0.0f, 1e-6f) << "corner " << c;
+    EXPECT_NEAR(n[c].z, 1.0f, 1e-6f) << "corner " << c;
+  }
+}
+
+TEST(MeshTopology, ThreeFacesOnAnEdgeMakeItNonManifoldAndLinkNone) {
+  // Faces 0 and 1 run edge 0-1 the same way; they would be linked (and one turned) across a
+  // manifold edge, but face 2 makes it non-manifold.
+  const Mesh m =
+      make_mesh({{0, 0, 0}, {1, 0, 0}, {0.5f, 1, 0}, {0.5f, -1, 0}, {0.5f, 0, 1}}, {0, 1, 2, /**/ 0, 1, 3, /**/ 1, 0, 4});
+  const MeshTopology t = inspect_topology(m);
+  EXPECT_EQ(t.welded_vertices, 5u);
+  EXPECT_EQ(t.duplicate_faces, 0u);
+  EXPECT_EQ(t.boundary_edges, 6u);
+  EXPECT_EQ(t.non_manifold_edges, 1u);
+  EXPECT_EQ(t.inconsistent_winding_faces, 0u);
+}
+
+TEST(MeshTopology, FacesTurnedInANonOrientablePieceFollowTheEdgeOrder) {
+  // A Klein bottle has no consistent winding: which faces are turned depends on the order the
+  // walk reaches them in. These are the faces the sort-based implementation (all edges sorted by
+  // (key, face)) turned; a change of the links' order changes them (vertices visited in decreasing
+  // order, or a vertex's edges by decreasing larger vertex, turn 10 or 15 faces here).
+  struct Case {
+    int nu, nv;
+    std::vector<std::size_t> turned;
+  };
+  const Case cases[] = {{3, 6, {2, 6, 11, 12, 16, 17, 18, 21, 22, 23, 26, 28, 31, 33}}};
+  for (const Case& k : cases) {
+    SCOPED_TRACE(std::to_string(k.nu) + " x " + std::to_string(k.nv));
+    const Mesh m = make_shuffled_klein_bottle(k.nu, k.nv);
+    const MeshTopology t = inspect_topology(m);
+    ASSERT_EQ(t.welded_vertices, m.positions.size());
+    EXPECT_EQ(t.boundary_edges, 0u);
+    EXPECT_EQ(t.non_manifold_edges, 0u);
+    EXPECT_EQ(t.duplicate_faces, 0u);
+    EXPECT_EQ(t.inconsistent_winding_faces, k.turned.size());
+    // The normals are those of exactly these faces turned (positions are distinct, so welded ids
+    // are position numbers).
+    std::vector<std::uint8_t> flip(m.triangle_count(), 0), skip(m.triangle_count(), 0);
+    for (std::size_t f : k.turned) flip[f] = 1;
+    const std::vector<glm::dvec3> sum = angle_weighted_sums(m, &m.position_index, m.positions.size(), &skip, &flip);
+    std::size_t reoriented = 0;
+    const std::vector<glm::vec3> n = compute_high_corner_normals(m, &reoriented);
+    EXPECT_EQ(reoriented, k.turned.size());
+    ASSERT_EQ(n.size(), m.position_index.size());
+    for (std::size_t c = 0; c < n.size(); ++c) EXPECT_EQ(n[c], unit_or_up(sum[m.position_index[c]])) << "corner " << c;
+  }
+}
