@@ -149,9 +149,11 @@ enum class BuildQuality { low, medium, high };
 
 class Scene {
  public:
-  // positions: vertex_count xyz triples; indices: triangle_count index triples.
+  // positions: vertex_count xyz triples; indices: triangle_count index triples. Copied, unless
+  // share_buffers: Embree then reads both in place, so they must outlive the Scene and stay
+  // unchanged, and 4 bytes past the last vertex must be readable (Embree loads 16 bytes at a time).
   Scene(const float* positions, std::size_t vertex_count, const std::uint32_t* indices, std::size_t triangle_count,
-        BuildQuality quality = BuildQuality::medium, int threads = 0 /* 0 = all cores */);
+        BuildQuality quality = BuildQuality::medium, int threads = 0 /* 0 = all cores */, bool share_buffers = false);
   ~Scene();
   Scene(const Scene&) = delete;
   Scene& operator=(const Scene&) = delete;

@@ -169,9 +169,8 @@ TEST(Adaptive, TheCommandTakesSamplesAutoAndReportsTheHistogram) {
 
 TEST(Adaptive, TheCommandRefusesBadSamplingOptions) {
   const std::string pair = test::sample_low() + " " + test::sample_high() + " -o m.png --size 16 ";
-  for (const std::string& bad :
-       {"--samples 4x", "--samples automatic", "--samples ''", "--max-error 2", "--samples 4 --max-error 2",
-        "--samples auto --max-error 0", "--samples auto --max-error 95", "--samples auto --max-error nan"}) {
+  for (const char* bad : {"--samples 4x", "--samples automatic", "--samples ''", "--max-error 2", "--samples 4 --max-error 2",
+                          "--samples auto --max-error 0", "--samples auto --max-error 95", "--samples auto --max-error nan"}) {
     const test::CliRun run = test::run_nmbake(pair + bad);
     EXPECT_EQ(run.code, 1) << bad << ": " << run.err;
     EXPECT_TRUE(test::contains(run.err, "--samples") || test::contains(run.err, "--max-error")) << bad << ": " << run.err;

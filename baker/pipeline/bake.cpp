@@ -184,7 +184,8 @@ void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const Ba
     st.high_duplicates_skipped = drop_duplicate_floods(s, high, threads, kept);
     announce_stage(opt, "building the BVH");
     stage = "building the BVH of " + std::to_string(kept.empty() ? high.triangle_count() : kept.size()) + " high-poly triangles";
-    build_high_scene(scene, s, high, kept, bvh_quality_for(opt, kept.empty() ? high.triangle_count() : kept.size()), opt.threads);
+    build_high_scene(scene, s, high, kept, bvh_quality_for(opt, kept.empty() ? high.triangle_count() : kept.size()), opt.threads,
+                     nullptr, !keep);
     if (keep) *cache = {scene.scene, &high, s.centre, s.diagonal, kept, st.high_duplicates_skipped, scene.quality, 0};
   }
   st.seconds_bvh = seconds_since(t0);
@@ -203,7 +204,7 @@ void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const Ba
     for (float d : result.vertex_search) reach_out = std::max(reach_out, double(d));
     stage = "building the BVH of the reachable high-poly triangles";
     if (narrow_reachable(s, high, ray_margin(s, mode.any_cage, st.front, std::max<double>(st.rear, reach_out)), kept))
-      build_high_scene(scene, s, high, kept, bvh_quality_for(opt, kept.size()), opt.threads);
+      build_high_scene(scene, s, high, kept, bvh_quality_for(opt, kept.size()), opt.threads, nullptr, true);
     st.seconds_bvh += seconds_since(t0);
   }
   st.bvh_quality = scene.quality;

@@ -3,7 +3,8 @@
 namespace nmbake {
 
 void build_high_scene(HighScene& h, const Prepared& s, const Mesh& high, const std::vector<std::uint32_t>& kept,
-                      raycast::BuildQuality quality, int threads, std::shared_ptr<const raycast::Scene> reuse) {
+                      raycast::BuildQuality quality, int threads, std::shared_ptr<const raycast::Scene> reuse, bool share) {
+  h.scene.reset();  // before the arrays a shared BVH reads change
   h.positions = s.high_pos.data();
   h.index = high.position_index.data();
   h.normals = s.high_corner_normals.data();
@@ -38,10 +39,12 @@ void build_high_scene(HighScene& h, const Prepared& s, const Mesh& high, const s
   }
   h.triangles = kept.empty() ? high.triangle_count() : kept.size();
   h.quality = quality;
-  h.scene.reset();
-  h.scene =
-      reuse ? std::move(reuse)
-            : std::make_shared<const raycast::Scene>(&s.high_pos[0].x, s.high_pos.size(), h.index, h.triangles, quality, threads);
+  // Embree may read the positions in place where Prepared keeps room for its 16-byte loads past the
+  // last vertex (prepare.cpp reserves it).
+  share = share && s.high_pos.capacity() > s.high_pos.size();
+  h.scene = reuse ? std::move(reuse)
+                  : std::make_shared<const raycast::Scene>(&s.high_pos[0].x, s.high_pos.size(), h.index, h.triangles, quality,
+                                                           threads, share);
 }
 
 RayGroups ray_groups(const Prepared& s, const HighScene& h, const BakeOptions& opt) {

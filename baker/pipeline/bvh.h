@@ -56,8 +56,11 @@ const raycast::HitRule* trace_rule(const HighScene& h, bool backfaces_skipped, c
 
 // Builds (or rebuilds) `h` over the high-poly triangles `kept` (increasing; empty: all of them).
 // With `reuse`, its BVH (built over the same triangles `kept`, on the same centre) is taken instead.
+// With `share`, Embree reads the positions and indices in place (raycast::Scene's share_buffers):
+// only for a BVH that lives no longer than `s`, `high` and `h` (not one a BvhCache keeps).
 void build_high_scene(HighScene& h, const Prepared& s, const Mesh& high, const std::vector<std::uint32_t>& kept,
-                      raycast::BuildQuality quality, int threads, std::shared_ptr<const raycast::Scene> reuse = nullptr);
+                      raycast::BuildQuality quality, int threads, std::shared_ptr<const raycast::Scene> reuse = nullptr,
+                      bool share = false);
 
 // The high-poly found inverted (BakeStats::HighFacing): fronts are taken the other way round, and
 // normals nmbake computed itself are turned outwards with them (a file's normals are kept: the map

@@ -21,8 +21,12 @@ void grow_box(glm::dvec3& lo, glm::dvec3& hi, const std::vector<glm::vec3>& pts,
   }
 }
 
-std::vector<glm::vec3> recentre(const std::vector<glm::vec3>& pts, const glm::dvec3& c) {
-  std::vector<glm::vec3> out(pts.size());
+// `spare` more elements of capacity than of size: room that Embree's 16-byte loads past the last
+// vertex may read when it takes the positions in place (build_high_scene's `share`).
+std::vector<glm::vec3> recentre(const std::vector<glm::vec3>& pts, const glm::dvec3& c, std::size_t spare = 0) {
+  std::vector<glm::vec3> out;
+  out.reserve(pts.size() + spare);
+  out.resize(pts.size());
   for (std::size_t i = 0; i < pts.size(); ++i) out[i] = glm::vec3(glm::dvec3(pts[i]) - c);
   return out;
 }
@@ -165,7 +169,7 @@ Prepared prepare(const Mesh& low, const Mesh& high, const Mesh* cage, BakeStats&
     st.coordinate_spacing = double(std::nextafter(largest, std::numeric_limits<float>::infinity()) - largest) / s.diagonal;
   }
   s.low_pos = recentre(low.positions, s.centre);
-  s.high_pos = recentre(high.positions, s.centre);
+  s.high_pos = recentre(high.positions, s.centre, 1);
   s.ray_normal = position_averaged_normals(low, s.frames);
   if (high.has_normals()) {
     s.high_corner_normals.resize(high.normal_index.size());

@@ -33,7 +33,7 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
   // Few rays: a quick BVH build pays off more than a fast one to trace. All triangles: culling
   // leaves the hits unchanged.
   HighScene scene;
-  build_high_scene(scene, s, high, {}, raycast::BuildQuality::low, opt.threads);
+  build_high_scene(scene, s, high, {}, raycast::BuildQuality::low, opt.threads, nullptr, true);
   if (st.high_facing == BakeStats::HighFacing::inverted) turn_inverted_high(s, scene, scratch.high_normals_computed);
   const RayGroups groups = ray_groups(s, scene, opt);
   raycast::HitRule rule;
@@ -80,9 +80,9 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
       work.clear();
       for (std::size_t i = i0; i < i1; ++i) {
         const int x = int(texels[i] % W), y = int(texels[i] / W);
-        const std::size_t tile = bins.tile_of(x, y);
+        const std::size_t bin = bins.tile_of(x, y);
         for (const glm::dvec2& o : offsets)
-          for (std::uint32_t bi = bins.start[tile]; bi < bins.start[tile + 1]; ++bi) {
+          for (std::uint32_t bi = bins.start[bin]; bi < bins.start[bin + 1]; ++bi) {
             const std::uint32_t t = bins.tris[bi];
             Sample sm{i, t, {0, 0, 0}};
             if (!covers(bins.texel_tris[t], sample_point(x, y, o.x, o.y), sm.b)) continue;
