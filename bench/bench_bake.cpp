@@ -18,8 +18,9 @@
 // $TMPDIR/nmbake-bench); each run's maps and reports go to a subfolder removed at the end.
 //
 // The sections live in bench_tracing.cpp (1, 2), bench_commands.cpp (3, 6), bench_scaling.cpp
-// (4, 5), bench_floods.cpp (7), bench_batch.cpp (8), bench_png.cpp (9) and bench_blender.cpp (10,
-// with blender_bake.py; Blender is $NMBAKE_BLENDER or `blender` on PATH, else nmbake's rows alone);
+// (4, 5), bench_floods.cpp (7), bench_batch.cpp (8), bench_png.cpp (9), bench_blender.cpp (10,
+// with blender_bake.py; Blender is $NMBAKE_BLENDER or `blender` on PATH, else nmbake's rows alone)
+// and bench_memory.cpp (11);
 // this file parses the arguments, prints the machine, generates the scenes (0) and prints the
 // targets. `bench_bake --measure-child CMD ARGS...` is not for people: section 10 starts each
 // command through it (bench_bake.h).
@@ -203,6 +204,7 @@ int main(int argc, char** argv) {
   if (args.runs(8)) run_batch(run, scenes);
   if (args.runs(9)) run_png_settings(run, scenes);
   if (args.runs(10)) run_blender(run, scenes);
+  if (args.runs(11)) run_memory(run, scenes);
   print_targets(run, start);
   std::error_code ec;
   fs::remove_all(run.run_dir, ec);

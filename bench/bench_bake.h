@@ -101,6 +101,18 @@ void run_blender(BenchRun& run, const Scenes& scenes);                          
 // process's stdin, stdout and stderr, waits for it, and prints "bench-measured: status S wall W maxrss_kib K" (S the raw wait
 // status, W seconds). Returns CMD's exit code, 1 when a signal ended it, 127 when it cannot start.
 inline constexpr const char* kMeasureChild = "--measure-child";
-int measure_child(char** argv);  // argv: CMD ARGS..., null-terminated
+
+// One command's wall seconds and max resident set, or why it failed.
+struct Measured {
+  bool ok = false;
+  double wall = 0.0, rss_mib = 0.0;
+  std::string why;  // "exit 1", "signal 9", "cannot start: ..."
+};
+
+// Runs `command` (program and arguments) through the measuring helper above, stdin from /dev/null
+// and its output (and the helper's figures) into `log` (bench_blender.cpp).
+Measured measure(const std::vector<std::string>& command, const std::string& log);
+void run_memory(BenchRun& run, const Scenes& scenes);  // 11 (bench_memory.cpp)
+int measure_child(char** argv);                        // argv: CMD ARGS..., null-terminated
 
 }  // namespace nmbake::bench

@@ -41,13 +41,6 @@ constexpr const char* kScript = NMBAKE_SOURCE_DIR "/bench/blender_bake.py";
 constexpr const char* kExtrusion = "0.05";  // Blender's cage extrusion, scene units (blender_bake.py's top comment)
 constexpr const char* kMeasured = "bench-measured:";
 
-// One command's wall seconds and max resident set, or why it failed.
-struct Measured {
-  bool ok = false;
-  double wall = 0.0, rss_mib = 0.0;
-  std::string why;  // "exit 1", "signal 9", "cannot start: ..."
-};
-
 // The helper is this very program, so it needs no path of its own.
 std::string self_exe() {
   std::error_code ec;
@@ -66,44 +59,6 @@ std::vector<char*> c_argv(const std::vector<std::string>& args) {
   for (const std::string& a : args) v.push_back(const_cast<char*>(a.c_str()));
   v.push_back(nullptr);
   return v;
-}
-
-// Runs `command` through the measuring helper, stdin from /dev/null and its output (and the
-// helper's figures) into `log`.
-Measured measure(const std::vector<std::string>& command, const std::string& log) {
-  Measured m;
-  std::vector<std::string> args = {self_exe(), kMeasureChild};
-  args.insert(args.end(), command.begin(), command.end());
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_APPEND, 0644);
-  posix_spawn_file_actions_adddup2(&actions, 1, 2);
-  pid_t pid = 0;
-  std::vector<char*> argv = c_argv(args);
-  const int e = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (e != 0) {
-    m.why = std::string("cannot start the measuring helper: ") + std::strerror(e);
-    return m;
-  }
-  int helper_status = 0;
-  while (waitpid(pid, &helper_status, 0) < 0 && errno == EINTR) {
-  }
-  std::ifstream in(log);
-  int status = -1;
-  long rss_kib = 0;
-  for (std::string line; std::getline(in, line);)
-    if (line.rfind(kMeasured, 0) == 0)
-      std::sscanf(line.c_str() + std::strlen(kMeasured), " status %d wall %lf maxrss_kib %ld", &status, &m.wall, &rss_kib);
-  if (status == -1) {
-    m.why = "no figures from the measuring helper (" + describe_status(helper_status) + ")";
-    return m;
-  }
-  m.rss_mib = double(rss_kib) / 1024.0;
-  m.ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
-  if (!m.ok) m.why = describe_status(status);
-  return m;
 }
 
 // Blender: $NMBAKE_BLENDER when set, else `blender` on PATH; empty (and `why`) when not found.
@@ -247,6 +202,42 @@ void judge(BenchRun& run, const Pair& p, bool m1, const std::string& no_blender)
 }
 
 }  // namespace
+
+Measured measure(const std::vector<std::string>& command, const std::string& log) {
+  Measured m;
+  std::vector<std::string> args = {self_exe(), kMeasureChild};
+  args.insert(args.end(), command.begin(), command.end());
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_APPEND, 0644);
+  posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  pid_t pid = 0;
+  std::vector<char*> argv = c_argv(args);
+  const int e = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (e != 0) {
+    m.why = std::string("cannot start the measuring helper: ") + std::strerror(e);
+    return m;
+  }
+  int helper_status = 0;
+  while (waitpid(pid, &helper_status, 0) < 0 && errno == EINTR) {
+  }
+  std::ifstream in(log);
+  int status = -1;
+  long rss_kib = 0;
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind(kMeasured, 0) == 0)
+      std::sscanf(line.c_str() + std::strlen(kMeasured), " status %d wall %lf maxrss_kib %ld", &status, &m.wall, &rss_kib);
+  if (status == -1) {
+    m.why = "no figures from the measuring helper (" + describe_status(helper_status) + ")";
+    return m;
+  }
+  m.rss_mib = double(rss_kib) / 1024.0;
+  m.ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
+  if (!m.ok) m.why = describe_status(status);
+  return m;
+}
 
 int measure_child(char** argv) {
   if (!argv[0]) return 2;
