@@ -70,7 +70,7 @@ void add_options(CLI::App& app, Args& a) {
   app.add_option("--samples", a.samples,
                  "Sample points per texel, 1-1024, or auto: 4 per texel, and 16 where those disagree (default 1)");
   app.add_option("--max-error", a.max_error,
-                 "With --samples auto: refine a texel whose 4 samples lie more than DEG degrees from their mean (default 1)");
+                 "With --samples auto: refine a texel whose 4 samples lie more than DEG degrees from their mean (default 2)");
   app.add_option("--front", a.front,
                  "One ray start distance outside the low-poly for the whole scene, scene units (default: the automatic cage, "
                  "measured per vertex)");
