@@ -1,6 +1,7 @@
 // mesh_topology's exact answers: welded ids in order of first occurrence, the earliest of duplicate
 // faces kept, and the faces turned in a non-orientable piece, which follow the order of the
 // breadth-first walk (faces linked in the order of their edges' (smaller, larger vertex) keys).
+#include <array>
 #include <cmath>
 #include <string>
 #include <utility>
@@ -54,6 +55,13 @@ Mesh make_shuffled_klein_bottle(int nu, int nv) {
   return make_mesh(std::move(positions), std::move(index));
 }
 
+// Every count of `t`: welded, isolated, duplicate faces, boundary, non-manifold, inconsistent winding.
+void expect_counts(const MeshTopology& t, const std::array<std::size_t, 6>& want) {
+  const std::array<std::size_t, 6> got = {t.welded_vertices, t.isolated_vertices,  t.duplicate_faces,
+                                          t.boundary_edges,  t.non_manifold_edges, t.inconsistent_winding_faces};
+  for (std::size_t k = 0; k < 6; ++k) EXPECT_EQ(got[k], want[k]) << "count " << k;
+}
+
 }  // namespace
 
 TEST(MeshTopology, WeldIdsFollowFirstOccurrenceAndSignedZerosMeet) {
@@ -71,13 +79,7 @@ TEST(MeshTopology, DuplicatesKeepTheEarliestFace) {
   // two would agree.
   const Mesh m = make_mesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, 0, 0}, {5, 5, 5}},
                            {1, 3, 2, /**/ 4, 2, 1, /**/ 0, 1, 2, /**/ 1, 2, 4, /**/ 0, 4, 3});
-  const MeshTopology t = inspect_topology(m);
-  EXPECT_EQ(t.welded_vertices, 4u);
-  EXPECT_EQ(t.isolated_vertices, 1u);
-  EXPECT_EQ(t.duplicate_faces, 2u);
-  EXPECT_EQ(t.boundary_edges, 4u);
-  EXPECT_EQ(t.non_manifold_edges, 0u);
-  EXPECT_EQ(t.inconsistent_winding_faces, 1u);
+  expect_counts(inspect_topology(m), {4, 1, 2, 4, 0, 1});
   // A tie: the seed (face 0) keeps its winding, +z, and so does every corner.
   std::size_t reoriented = 0;
   const std::vector<glm::vec3> n = compute_high_corner_normals(m, &reoriented);
@@ -94,12 +96,7 @@ TEST(MeshTopology, ThreeFacesOnAnEdgeMakeItNonManifoldAndLinkNone) {
   // manifold edge, but face 2 makes it non-manifold.
   const Mesh m =
       make_mesh({{0, 0, 0}, {1, 0, 0}, {0.5f, 1, 0}, {0.5f, -1, 0}, {0.5f, 0, 1}}, {0, 1, 2, /**/ 0, 1, 3, /**/ 1, 0, 4});
-  const MeshTopology t = inspect_topology(m);
-  EXPECT_EQ(t.welded_vertices, 5u);
-  EXPECT_EQ(t.duplicate_faces, 0u);
-  EXPECT_EQ(t.boundary_edges, 6u);
-  EXPECT_EQ(t.non_manifold_edges, 1u);
-  EXPECT_EQ(t.inconsistent_winding_faces, 0u);
+  expect_counts(inspect_topology(m), {5, 0, 0, 6, 1, 0});
 }
 
 TEST(MeshTopology, FacesTurnedInANonOrientablePieceFollowTheEdgeOrder) {

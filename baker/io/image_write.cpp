@@ -13,6 +13,7 @@
 #include <system_error>
 
 #include "core/errors.h"
+#include "io/text_file.h"
 
 namespace nmbake::image_write {
 namespace {
@@ -123,30 +124,8 @@ std::string temp_path_for(const std::string& path) {
 
 void write_file_bytes(const std::string& path, const std::vector<unsigned char>& bytes, const WriteOptions& options) {
   const std::string temp = options.temp_path.empty() ? temp_path_for(path) : options.temp_path;
-  auto fail = [&](int err) {
-    ::unlink(temp.c_str());
-    fail_write(path, std::strerror(err));
-  };
-  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0666);
-  if (fd < 0) fail_write(path, std::strerror(errno));
-  for (std::size_t done = 0; done < bytes.size();) {
-    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      const int err = n < 0 ? errno : EIO;
-      ::close(fd);
-      fail(err);
-    }
-    done += std::size_t(n);
-  }
-  // A full disk or a failing device may only show here (delayed allocation, NFS).
-  if (::fsync(fd) != 0) {
-    const int err = errno;
-    ::close(fd);
-    fail(err);
-  }
-  if (::close(fd) != 0) fail(errno);
-  if (!options.temp_path.empty()) return;  // the caller renames it
+  write_bytes_file(path, temp, bytes.data(), bytes.size());  // the temporary removed on an error
+  if (!options.temp_path.empty()) return;                    // the caller renames it
   if (std::rename(temp.c_str(), path.c_str()) != 0) {
     std::string reason = std::strerror(errno);
     std::error_code ec;

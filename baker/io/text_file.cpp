@@ -13,6 +13,11 @@
 namespace nmbake {
 
 void write_text_file(const std::string& path, const std::string& temp, const std::string& text) {
+  write_bytes_file(path, temp, text.data(), text.size());
+}
+
+void write_bytes_file(const std::string& path, const std::string& temp, const void* data, std::size_t size) {
+  const char* bytes = static_cast<const char*>(data);
   auto fail = [&](int err) {
     ::unlink(temp.c_str());
     throw OutputError(path + ": cannot write: " + std::strerror(err));
@@ -20,8 +25,8 @@ void write_text_file(const std::string& path, const std::string& temp, const std
   const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0666);
   if (fd < 0) throw OutputError(path + ": cannot write: " + std::strerror(errno));
   std::size_t done = 0;
-  while (done < text.size()) {
-    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+  while (done < size) {
+    const ssize_t n = ::write(fd, bytes + done, size - done);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) {
       const int err = n < 0 ? errno : EIO;

@@ -2,6 +2,7 @@
 // place only when complete, so a failed write never leaves a partial file or loses the old one.
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 namespace nmbake {
@@ -10,6 +11,9 @@ namespace nmbake {
 // it to disk (fsync); the caller renames it to `path` when every output is complete. Errors name
 // `path`: OutputError "<path>: cannot write: <reason>", the temporary removed.
 void write_text_file(const std::string& path, const std::string& temp, const std::string& text);
+
+// The same for `size` bytes at `data` (the image writers' encoded files).
+void write_bytes_file(const std::string& path, const std::string& temp, const void* data, std::size_t size);
 
 // write_text_file to a temporary file beside `path`, then renamed over it. Throws OutputError
 // "<path>: cannot write: <reason>" (the temporary removed).
