@@ -48,14 +48,15 @@ struct Args {
   bool quick = false;
   bool check = false;  // exit 1 unless every analytic scene's error falls from the first setting to the last
   std::vector<std::string> scenes;
-  std::vector<double> max_errors{kDefaultMaxErrorDeg};  // --max-errors: the --samples auto rows' thresholds
+  // --max-errors E[:F],...: the --samples auto rows' thresholds (and deep factors, BakeOptions::deep_factor)
+  std::vector<std::pair<double, double>> max_errors{{kDefaultMaxErrorDeg, kDefaultDeepFactor}};
   std::string out = "docs/accuracy", data = NMBAKE_SHARED_DATA, nmview = NMBAKE_NMVIEW;
   std::string font = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
   std::string command = "nmbake_accuracy";  // the command line as given, for accuracy.md
 };
 
 const char* kUsage =
-    "usage: nmbake_accuracy [--quick] [--scenes a,b] [--max-errors 1,2] [--out DIR] [--data DIR] [--nmview PATH|none] [--font "
+    "usage: nmbake_accuracy [--quick] [--scenes a,b] [--max-errors 1,2:4] [--out DIR] [--data DIR] [--nmview PATH|none] [--font "
     "TTF]\n"
     "Bakes every scene at sizes 512, 1024, 2048 (height_field also 4096) with 1, 4 and 16 samples, and with\n"
     "--samples auto at each --max-errors threshold (default: nmbake's), and writes\n"
@@ -92,7 +93,10 @@ Args parse_args(int argc, char** argv) {
       a.max_errors.clear();
       std::stringstream ss(value());
       for (std::string t; std::getline(ss, t, ',');)
-        if (!t.empty()) a.max_errors.push_back(std::atof(t.c_str()));
+        if (!t.empty())
+          a.max_errors.push_back({std::atof(t.c_str()), t.find(':') == std::string::npos
+                                                            ? kDefaultDeepFactor
+                                                            : std::atof(t.c_str() + t.find(':') + 1)});
     } else if (s == "--out") a.out = value();
     else if (s == "--data") a.data = value();
     else if (s == "--nmview") a.nmview = value();
@@ -183,8 +187,10 @@ void bake_setting(const Args& a, const AccuracyScene& sc, const BakeOptions& o, 
   row.samples = o.samples;
   row.adaptive = o.adaptive;
   row.max_error = o.max_error_deg;
-  const double texels = double(r.stats.texels_base + r.stats.texels_refined);
-  row.refined = texels > 0 ? double(r.stats.texels_refined) / texels : 0.0;
+  row.deep_factor = o.deep_factor;
+  const double texels = double(r.stats.texels_base + r.stats.texels_refined + r.stats.texels_deep);
+  row.refined = texels > 0 ? double(r.stats.texels_refined + r.stats.texels_deep) / texels : 0.0;
+  row.deep = texels > 0 ? double(r.stats.texels_deep) / texels : 0.0;
   row.rays = r.stats.rays;
   row.misses = r.stats.misses;
   row.prepare = r.stats.seconds_prepare;
@@ -241,11 +247,12 @@ void bake_scene(const Args& a, AccuracyScene& sc, const std::string& work, Accur
       bake_setting(a, sc, o, frames, ref, work, res);
     }
     if (size >= 4096) continue;
-    for (double e : a.max_errors) {
+    for (const auto& [e, deep] : a.max_errors) {
       BakeOptions ao = o;
       ao.adaptive = true;
       ao.samples = 16;
       ao.max_error_deg = e;
+      ao.deep_factor = deep;
       bake_setting(a, sc, ao, frames, ref, work, res);
     }
   }

@@ -65,7 +65,8 @@ std::string utc_now() {
 
 std::string AccuracyRow::sampling() const {
   if (!adaptive) return std::to_string(samples);
-  return "auto " + fmt("%g", max_error) + "deg (" + fmt("%.1f", 100.0 * refined) + "% at " + std::to_string(samples) + ")";
+  return "auto " + fmt("%g", max_error) + "deg x" + fmt("%g", deep_factor) + " (" + fmt("%.1f", 100.0 * refined) + "% at " +
+         std::to_string(samples) + "+, " + fmt("%.1f", 100.0 * deep) + "% at " + std::to_string(4 * samples) + ")";
 }
 
 namespace {

@@ -25,7 +25,7 @@ struct AccuracyRow {
   // --samples auto (samples is then the refined count): its --max-error and the share of covered
   // texels refined.
   bool adaptive = false;
-  double max_error = 0, refined = 0;
+  double max_error = 0, deep_factor = 0, refined = 0, deep = 0;  // refined: at `samples` or more; deep: at 4x
   // "16", or for adaptive "auto 1deg (12.3% at 16)".
   std::string sampling() const;
 };

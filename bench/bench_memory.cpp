@@ -36,10 +36,10 @@ void run_memory(BenchRun& run, const Scenes& scenes) {
     write_binary_ply(m16_ply, subdivide(load_mesh(scenes.m4_ply)));
     std::printf("Made %s (suz_L4_x16 subdivided once more) in %.1f s.\n\n", m16_ply.c_str(), since(t0));
   }
-  std::vector<MemoryRow> rows = {{"suz_L4 (252k)", scenes.s4 + "/high.ply", 251904.0},
-                                 {"suz_L4_x4 (1M)", scenes.m1_ply, 1007616.0},
-                                 {"suz_L4_x16 (4M)", scenes.m4_ply, 4030464.0}};
-  if (!run.args.quick) rows.push_back({"suz_L4_x64 (16M)", m16_ply, 16121856.0});
+  std::vector<MemoryRow> rows = {{"suz_L4 (252k)", scenes.s4 + "/high.ply", 251904.0, {}},
+                                 {"suz_L4_x4 (1M)", scenes.m1_ply, 1007616.0, {}},
+                                 {"suz_L4_x16 (4M)", scenes.m4_ply, 4030464.0, {}}};
+  if (!run.args.quick) rows.push_back({"suz_L4_x64 (16M)", m16_ply, 16121856.0, {}});
   BakeOptions o;
   o.width = o.height = 2048;
   const double map_mib = double(estimate_bake_bytes(o)) / 1048576.0;

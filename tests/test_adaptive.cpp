@@ -53,25 +53,32 @@ TEST(Adaptive, EveryTexelIsItsBaseMeanOrTheFixedBakes) {
   BakeOptions tight = adaptive(64, 0.05), loose = adaptive(64, 90.0);
   tight.front = tight.rear = loose.front = loose.rear = 0.1f;
   const BakeResult f = bake_normal_map(s.low, s.high, nullptr, fixed);
+  fixed.samples = 64;
+  const BakeResult f64 = bake_normal_map(s.low, s.high, nullptr, fixed);
   const BakeResult t = bake_normal_map(s.low, s.high, nullptr, tight);
   const BakeResult l = bake_normal_map(s.low, s.high, nullptr, loose);
   // The quad covers every texel fully and every ray hits: nothing refines at 90 degrees.
   EXPECT_EQ(l.stats.texels_refined, 0u);
   EXPECT_EQ(l.stats.texels_base, 64u * 64u);
   EXPECT_EQ(l.stats.rays, 4u * 64u * 64u);
-  // At 0.05 degrees nearly every texel of the curved field refines, and then holds the fixed bake's value.
-  EXPECT_GT(t.stats.texels_refined, 64u * 64u * 9 / 10);
-  EXPECT_EQ(t.stats.texels_base + t.stats.texels_refined, 64u * 64u);
-  EXPECT_EQ(t.stats.rays, 4u * 64u * 64u + 16u * t.stats.texels_refined);
-  std::size_t as_fixed = 0, as_base = 0;
+  // At 0.05 degrees nearly every texel of the curved field refines, most of them to 64 samples, and
+  // then holds the fixed bake's value with as many.
+  EXPECT_GT(t.stats.texels_refined + t.stats.texels_deep, 64u * 64u * 9 / 10);
+  EXPECT_GT(t.stats.texels_deep, 64u * 64u / 2);
+  EXPECT_EQ(t.stats.texels_base + t.stats.texels_refined + t.stats.texels_deep, 64u * 64u);
+  EXPECT_EQ(t.stats.rays, 4u * 64u * 64u + 16u * (t.stats.texels_refined + t.stats.texels_deep) + 64u * t.stats.texels_deep);
+  std::size_t as_fixed = 0, as_fixed64 = 0, as_base = 0;
   for (std::size_t i = 0; i < 64u * 64u; ++i) {
-    const bool is_fixed = same_texel(t.map, f.map, i), is_base = same_texel(t.map, l.map, i);
-    EXPECT_TRUE(is_fixed || is_base) << "texel " << i;
+    const bool is_fixed = same_texel(t.map, f.map, i), is_fixed64 = same_texel(t.map, f64.map, i),
+               is_base = same_texel(t.map, l.map, i);
+    EXPECT_TRUE(is_fixed || is_fixed64 || is_base) << "texel " << i;
     as_fixed += is_fixed && !is_base;
-    as_base += is_base && !is_fixed;
+    as_fixed64 += is_fixed64 && !is_base && !is_fixed;
+    as_base += is_base && !is_fixed && !is_fixed64;
   }
-  EXPECT_GE(as_fixed, 64u * 64u * 8 / 10);
-  EXPECT_LE(as_base, 64u * 64u - t.stats.texels_refined);
+  EXPECT_GE(as_fixed + as_fixed64, 64u * 64u * 8 / 10);
+  EXPECT_GE(as_fixed64, t.stats.texels_deep * 9 / 10);
+  EXPECT_LE(as_base, 64u * 64u - t.stats.texels_refined - t.stats.texels_deep);
   // The base pass alone (2x2 Gauss-Legendre) is not the fixed bake: the test can tell them apart.
   std::size_t base_differs = 0;
   for (std::size_t i = 0; i < 64u * 64u; ++i) base_differs += !same_texel(l.map, f.map, i);
@@ -137,7 +144,7 @@ TEST(Adaptive, TheErrorEstimateMeasuresIt) {
   ErrorEstimateOptions eo;
   eo.bits = 32;
   const ErrorEstimate e = estimate_bake_error(s.low, s.high, nullptr, o, r, eo);
-  EXPECT_GE(e.samples, 64);
+  EXPECT_EQ(e.samples, 256);  // 4x the deepest level's 64
   EXPECT_GT(e.texels, 0u);
   EXPECT_TRUE(std::isfinite(e.mean_deg));
   EXPECT_LT(e.mean_deg, 1.0);
@@ -149,15 +156,19 @@ TEST(Adaptive, TheCommandTakesSamplesAutoAndReportsTheHistogram) {
       test::run_nmbake(pair + " -o m.png --size 64 --samples auto --max-error 2 --estimate-error --report r.json");
   ASSERT_EQ(run.code, 0) << run.err;
   EXPECT_TRUE(test::contains(run.out, "samples auto (16 at ")) << run.out;
+  EXPECT_TRUE(test::contains(run.out, ", 64 at ")) << run.out;
   const nlohmann::json& r = run.report;
   EXPECT_EQ(r["options"]["samples"], "auto");
   EXPECT_EQ(r["options"]["max_error_deg"], 2.0);
-  ASSERT_EQ(r["samples_histogram"].size(), 2u);
+  ASSERT_EQ(r["samples_histogram"].size(), 3u);
   EXPECT_EQ(r["samples_histogram"][0]["samples"], 4);
   EXPECT_EQ(r["samples_histogram"][1]["samples"], 16);
-  const std::uint64_t base = r["samples_histogram"][0]["texels"], refined = r["samples_histogram"][1]["texels"];
-  EXPECT_EQ(base + refined, r["texels"]["covered"].get<std::uint64_t>());
-  EXPECT_EQ(r["rays"].get<std::uint64_t>(), 4 * base + 20 * refined);  // refined texels cast their 4 first rays too
+  EXPECT_EQ(r["samples_histogram"][2]["samples"], 64);
+  const std::uint64_t base = r["samples_histogram"][0]["texels"], refined = r["samples_histogram"][1]["texels"],
+                      deep = r["samples_histogram"][2]["texels"];
+  EXPECT_EQ(base + refined + deep, r["texels"]["covered"].get<std::uint64_t>());
+  // Refined texels cast their first 4 rays too, and the deepest their 16.
+  EXPECT_EQ(r["rays"].get<std::uint64_t>(), 4 * base + 20 * refined + 84 * deep);
   EXPECT_TRUE(r.contains("error_estimate"));
   // A fixed count: one row, every covered texel.
   const test::CliRun fixed = test::run_nmbake(pair + " -o m.png --size 64 --samples 4 --report r.json");

@@ -68,9 +68,11 @@ void add_options(CLI::App& app, Args& a) {
   app.add_option("-o,--output", a.output, "Output map: .png (8-bit), .tif (16-bit), .exr (float)")->required();
   app.add_option("--size", a.size, "Map size N or WxH in texels (default 2048)");
   app.add_option("--samples", a.samples,
-                 "Sample points per texel, 1-1024, or auto: 4 per texel, and 16 where those disagree (default 1)");
+                 "Sample points per texel, 1-1024, or auto: 4 per texel, 16 where those disagree, 64 where the 16 do "
+                 "(default 1)");
   app.add_option("--max-error", a.max_error,
-                 "With --samples auto: refine a texel whose 4 samples lie more than DEG degrees from their mean (default 2)");
+                 "With --samples auto: refine a texel whose 4 samples lie more than DEG degrees from their mean, and "
+                 "again one whose 16 lie more than 4 x DEG (default 4)");
   app.add_option("--front", a.front,
                  "One ray start distance outside the low-poly for the whole scene, scene units (default: the automatic cage, "
                  "measured per vertex)");

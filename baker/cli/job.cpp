@@ -163,13 +163,14 @@ void report_job(const JobEnv& env, OutputSet& outputs, const Args& a, const Bake
   if (env.report) *env.report = std::move(report);
 }
 
-// "4", or with --samples auto "auto (16 at 3.2% of texels)".
+// "4", or with --samples auto "auto (16 at 3.2%, 64 at 0.4% of texels, 4 elsewhere)".
 std::string samples_text(const BakeOptions& o, const BakeStats& s) {
   if (!o.adaptive) return std::to_string(o.samples);
-  const std::uint64_t texels = s.texels_base + s.texels_refined;
-  char text[80];
-  std::snprintf(text, sizeof text, "auto (%d at %.1f%% of texels, 4 elsewhere)", o.samples,
-                texels ? 100.0 * double(s.texels_refined) / double(texels) : 0.0);
+  const double texels = double(s.texels_base + s.texels_refined + s.texels_deep);
+  auto share = [texels](std::uint64_t n) { return texels > 0 ? 100.0 * double(n) / texels : 0.0; };
+  char text[120];
+  std::snprintf(text, sizeof text, "auto (%d at %.1f%%, %d at %.1f%% of texels, 4 elsewhere)", o.samples, share(s.texels_refined),
+                4 * o.samples, share(s.texels_deep));
   return text;
 }
 

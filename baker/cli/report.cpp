@@ -67,6 +67,16 @@ void add_high_details(nlohmann::json& report, const BakeStats& s, const RunInfo&
   report["high_files"] = files;
 }
 
+// Covered texels by how many samples made them: one row for a fixed count; with --samples auto, 4,
+// BakeOptions::samples and (when the bake has that level) 4x as many.
+nlohmann::json samples_histogram(const BakeOptions& o, const BakeStats& s) {
+  using nlohmann::json;
+  if (!o.adaptive) return json::array({{{"samples", o.samples}, {"texels", s.texels_covered}}});
+  json rows = json::array({{{"samples", 4}, {"texels", s.texels_base}}, {{"samples", o.samples}, {"texels", s.texels_refined}}});
+  if (4 * o.samples <= kMaxSamples) rows.push_back({{"samples", 4 * o.samples}, {"texels", s.texels_deep}});
+  return rows;
+}
+
 }  // namespace
 
 nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunInfo& r) {
@@ -127,9 +137,7 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
       {"rays_per_second", s.seconds_trace > 0 ? double(s.rays) / s.seconds_trace : 0.0},
       {"samples_covered", s.samples_covered},
       // Covered texels by how many samples made them: one row for a fixed count, two with --samples auto.
-      {"samples_histogram", o.adaptive ? json::array({{{"samples", 4}, {"texels", s.texels_base}},
-                                                      {{"samples", o.samples}, {"texels", s.texels_refined}}})
-                                       : json::array({{{"samples", o.samples}, {"texels", s.texels_covered}}})},
+      {"samples_histogram", samples_histogram(o, s)},
       {"hits", s.hits},
       {"misses", s.misses},
       {"texels", {{"total", s.texels_total}, {"covered", s.texels_covered}, {"padded", s.texels_padded}}},

@@ -68,11 +68,13 @@ struct BvhCache {
   std::size_t reused = 0;  // bakes that took it
 };
 
-// --max-error's default (BakeOptions::max_error_deg), chosen on the accuracy bench's real scenes
-// (suz_L4, torus_s3, bunny00 at 512-2048^2, thresholds 2, 4, 8; docs/accuracy.md): at 2048^2, 2
-// degrees refined 2-8% of texels and gave 1.3-3.8x the fixed 16-sample bake's mean error in 32-42%
-// of its time; 4 and 8 degrees saved little more time for more error.
-inline constexpr double kDefaultMaxErrorDeg = 2.0;
+// --max-error's default (BakeOptions::max_error_deg) and the third level's factor, chosen on the
+// accuracy bench's real scenes (suz_L4, torus_s3, bunny00 at 512-2048^2; max errors 2, 3, 4, 6
+// with factors 2, 4, 8 and without a third level; docs/accuracy.md): 4 degrees and 4x reached the
+// fixed 16-sample bake's mean error in 32-43% of its time on suz_L4 and bunny00 at 2048^2 (and
+// bunny00 at 1024^2); lower thresholds cost more time, higher ones more error.
+inline constexpr double kDefaultMaxErrorDeg = 4.0;
+inline constexpr double kDefaultDeepFactor = 4.0;  // BakeOptions::deep_factor
 
 struct BakeOptions {
   int width = 2048;   // map width in texels
@@ -80,13 +82,19 @@ struct BakeOptions {
   int samples = 1;    // sample points per texel; 1 = the texel centre only (no AA loop)
   // --samples auto: each texel first takes 4 samples at the 2x2 Gauss-Legendre points (exact for
   // a normal that varies smoothly, up to cubic terms, across the texel); a texel whose samples
-  // disagree (one lies more than max_error_deg from their mean, or some miss and some hit) is
-  // baked again with `samples` stratified samples (a square number, 16 by default), exactly as a
-  // fixed bake with that many gives it. BakeStats::texels_refined counts them.
+  // disagree (one lies more than max_error_deg from their mean, or some miss and some hit), or
+  // that an island's edge cuts, is baked again with `samples` stratified samples (a square number,
+  // 16 by default), exactly as a fixed bake with that many gives it, and one whose `samples` still
+  // disagree (deep_factor below) a third time with 4x as many. BakeStats::texels_refined and
+  // texels_deep count them.
   bool adaptive = false;
   double max_error_deg = kDefaultMaxErrorDeg;  // with adaptive: the disagreement that refines a texel, degrees
-  float front = -1.0f;                         // scene units the ray starts outside the low-poly; < 0 = auto (measured)
-  float rear = -1.0f;                          // scene units the ray reaches inside the low-poly; < 0 = auto (measured)
+  // With adaptive: a texel whose `samples` samples still lie farther than deep_factor * max_error_deg
+  // from their mean (or some miss) is baked a third time with 4 * samples (when that is at most
+  // kMaxSamples); <= 0: no third level.
+  double deep_factor = kDefaultDeepFactor;
+  float front = -1.0f;  // scene units the ray starts outside the low-poly; < 0 = auto (measured)
+  float rear = -1.0f;   // scene units the ray reaches inside the low-poly; < 0 = auto (measured)
   RayPolicy policy = RayPolicy::cage_first;
   NormalSpace space = NormalSpace::tangent;
   bool green_down = false;  // DirectX "Y-" maps: negate the bitangent component
@@ -128,9 +136,10 @@ struct BakeStats {
   double auto_probe_beyond = 0.0;                // share of probe points farther than the chosen distances
   std::uint64_t rays = 0, hits = 0, misses = 0;  // misses/hits count samples, rays count casts
   std::uint64_t samples_covered = 0;
-  // With BakeOptions::adaptive: covered texels baked with the first 4 samples only, and those baked
-  // again with BakeOptions::samples (the report's sample count histogram).
-  std::uint64_t texels_base = 0, texels_refined = 0;
+  // With BakeOptions::adaptive: covered texels baked with the first 4 samples only, those baked
+  // again with BakeOptions::samples, and those baked a third time with 4x as many (the report's
+  // sample count histogram).
+  std::uint64_t texels_base = 0, texels_refined = 0, texels_deep = 0;
   std::uint64_t overlapping_samples = 0;  // samples covered by more than one UV triangle
   std::size_t texels_total = 0, texels_covered = 0, texels_padded = 0;
   double coverage = 0.0;  // texels_covered / texels_total

@@ -40,7 +40,9 @@ ErrorEstimate estimate_bake_error(const Mesh& low, const Mesh& high, const Mesh*
   }
   const auto t0 = std::chrono::steady_clock::now();
   ErrorEstimate e;
-  e.samples = std::min(kMaxSamples, std::max(eo.samples, 4 * options.samples));
+  // 4x the most samples a texel of the bake has (with --samples auto, its deepest level's).
+  const bool deep = options.adaptive && options.deep_factor > 0.0 && 4 * options.samples <= kMaxSamples;
+  e.samples = std::min(kMaxSamples, std::max(eo.samples, 4 * (deep ? 4 * options.samples : options.samples)));
 
   // Texels: a fixed-seed uniform choice among the covered ones (partial Fisher-Yates), then sorted
   // so neighbouring texels share tiles.

@@ -30,10 +30,28 @@ std::vector<glm::dvec2> gauss_legendre_offsets() {
   return {{a, a}, {b, a}, {a, b}, {b, b}};
 }
 
+// Adaptive sampling's passes after the first: the texels whose samples so far disagree are baked
+// again with `offsets` (a square grid, so a texel then holds exactly a fixed bake's value with that
+// many). A sample farther than the level's angle from its texel's mean refines the texel.
+struct RefineLevel {
+  std::vector<glm::dvec2> offsets;
+  double cos_max = 1.0;
+  bool partial = false;  // also the texels an island's edge cuts (fewer samples than offsets)
+};
+
+std::vector<RefineLevel> refine_levels(const BakeOptions& o) {
+  if (!o.adaptive) return {};
+  const double rad = o.max_error_deg * (3.14159265358979323846 / 180.0);
+  std::vector<RefineLevel> levels{{sample_offsets(o.samples), std::cos(rad), true}};
+  if (o.deep_factor > 0.0 && 4 * o.samples <= kMaxSamples)
+    levels.push_back({sample_offsets(4 * o.samples), std::cos(std::min(o.deep_factor * rad, 1.5)), false});
+  return levels;
+}
+
 // One cache line each: the counters change per sample, and shared lines would serialize threads.
 struct alignas(64) ThreadStats {
   std::uint64_t rays = 0, hits = 0, misses = 0, covered = 0, overlaps = 0, backface_skips = 0, facing_away = 0, unmatched = 0;
-  std::uint64_t base_texels = 0, refined_texels = 0;  // adaptive sampling (BakeStats::texels_base, texels_refined)
+  std::uint64_t base_texels = 0, refined_texels = 0, deep_texels = 0;  // adaptive (BakeStats::texels_base, ...)
   double dmin = std::numeric_limits<double>::infinity(), dmax = -std::numeric_limits<double>::infinity();
   // Per object, with several (BakeStats::low_object_samples, ...).
   std::vector<std::uint64_t> low_samples, low_hits, high_hits;
@@ -50,8 +68,7 @@ struct Shared {
         opt(opt_),
         out(out_),
         offsets(opt_.adaptive ? gauss_legendre_offsets() : sample_offsets(opt_.samples)),
-        refine_offsets(opt_.adaptive ? sample_offsets(opt_.samples) : std::vector<glm::dvec2>{}),
-        cos_max_error(std::cos(opt_.max_error_deg * (3.14159265358979323846 / 180.0))),
+        levels(refine_levels(opt_)),
         rays_per_sample(setup_.closest ? 2 : 1),
         batched(opt_.space == NormalSpace::tangent && opt_.bitangent == BitangentMode::per_pixel),
         per_object(s_.low_objects > 1 || s_.high_objects > 1),
@@ -69,9 +86,8 @@ struct Shared {
   const RaySetup& setup;
   const BakeOptions& opt;
   const TraceTargets& out;
-  std::vector<glm::dvec2> offsets;         // every texel's samples (adaptive: the first 4)
-  std::vector<glm::dvec2> refine_offsets;  // adaptive: the samples of a texel baked again; else empty
-  double cos_max_error = 1.0;              // adaptive: a sample farther than this from its texel's mean refines it
+  std::vector<glm::dvec2> offsets;  // every texel's samples (adaptive: the first 4)
+  std::vector<RefineLevel> levels;  // adaptive: the passes after the first; else empty
   int rays_per_sample = 1;
   bool batched = false;     // tangent space, per-pixel bitangent: shade_batch.h shades most samples
   bool per_object = false;  // several objects: hits counted per object
@@ -100,7 +116,7 @@ class TileTracer {
         ts_(sh.stats[std::size_t(id)]),
         side_(sh.bins.side),
         tile_texels_(std::size_t(side_) * std::size_t(side_)),
-        slot_count_(tile_texels_ * std::max(sh.offsets.size(), sh.refine_offsets.size())),
+        slot_count_(tile_texels_ * std::max(sh.offsets.size(), sh.levels.empty() ? 0 : sh.levels.back().offsets.size())),
         default_rays_(!sh.setup.cage && !sh.setup.closest),
         rays_(slot_count_ * std::size_t(sh.rays_per_sample)),
         hits_(rays_.hits()),
@@ -117,7 +133,7 @@ class TileTracer {
         one_at_a_time_(slot_count_, 1),
         acc_(4 * tile_texels_),
         miss_count_(tile_texels_),
-        refine_(sh.refine_offsets.empty() ? 0 : tile_texels_) {
+        refine_(sh.levels.empty() ? 0 : tile_texels_) {
     for (int c = 0; c < 3; ++c) {
       sb_[c] = &sample_b_[std::size_t(c) * slot_count_];
       value_c_[c] = &value_[std::size_t(c) * slot_count_];
@@ -184,16 +200,19 @@ class TileTracer {
   void trace_tile(std::size_t tile) {
     const TileRect rect = rect_of(tile);
     sh_.tile_dsum[tile] = trace_pass(tile, rect, sh_.offsets, nullptr);
-    if (!sh_.refine_offsets.empty() && mark_refined()) {
-      // The texels that disagree again with every refined sample; the others keep their first sums.
+    std::size_t last_full = sh_.offsets.size();  // samples a texel of the last pass has when fully covered
+    for (std::size_t level = 0; level < sh_.levels.size(); ++level) {
+      if (!mark_refined(sh_.levels[level], level == 0, double(last_full))) break;
+      // The marked texels again with every sample of the level; the others keep their sums so far.
       first_acc_ = acc_;
       first_miss_ = miss_count_;
-      sh_.tile_dsum[tile] += trace_pass(tile, rect, sh_.refine_offsets, refine_.data());
+      sh_.tile_dsum[tile] += trace_pass(tile, rect, sh_.levels[level].offsets, refine_.data());
       for (std::size_t i = 0; i < tile_texels_; ++i) {
         if (refine_[i]) continue;
         for (int c = 0; c < 4; ++c) acc_[std::size_t(c) * tile_texels_ + i] = first_acc_[std::size_t(c) * tile_texels_ + i];
         miss_count_[i] = first_miss_[i];
       }
+      last_full = sh_.levels[level].offsets.size();
     }
     write_texels(rect);
   }
@@ -217,32 +236,41 @@ class TileTracer {
     return dsum;
   }
 
-  // Adaptive sampling: marks in refine_ the covered texels whose first samples disagree (one lies
-  // more than the maximum error from their mean, some miss and some hit) or that not all of them
-  // cover (an island's edge). Returns whether any is marked.
-  bool mark_refined() {
-    std::fill(refine_.begin(), refine_.end(), 0);
-    const double full = double(sh_.offsets.size()), cos_max = sh_.cos_max_error;
+  // Adaptive sampling: marks in refine_, among the texels the last pass baked (every covered one
+  // after the first pass, else those refine_ marks), those whose samples disagree (one lies farther
+  // than the level's angle from their mean, some miss and some hit) or, where the level says, that
+  // not all of them cover (an island's edge). Returns whether any is marked.
+  bool mark_refined(const RefineLevel& level, bool first, double full) {
+    const double cos_max = level.cos_max;
     for (std::size_t i = 0; i < tile_texels_; ++i) {
       const double n = sums_.count[i];
-      if (n == 0.0) continue;
-      ++ts_.base_texels;
-      refine_[i] = n < full || (miss_count_[i] > 0 && double(miss_count_[i]) < n);
+      const bool baked = n > 0.0 && (first || refine_[i]);
+      if (first && baked) ++ts_.base_texels;
+      refine_[i] = baked ? 2 : 0;  // 2: in the last pass, not (yet) marked
+      if (baked && ((level.partial && n < full) || (miss_count_[i] > 0 && double(miss_count_[i]) < n))) refine_[i] = 1;
     }
     for (std::size_t r = 0; r < last_sample_count_; ++r) {
       const std::size_t i = sample_texel_[r];
-      if (refine_[i]) continue;
+      if (refine_[i] != 2) continue;
       const double m[3] = {sums_.sum[0][i], sums_.sum[1][i], sums_.sum[2][i]};
       const double v[3] = {value_c_[0][r], value_c_[1][r], value_c_[2][r]};
       const double dot = m[0] * v[0] + m[1] * v[1] + m[2] * v[2];
       const double mm = m[0] * m[0] + m[1] * m[1] + m[2] * m[2], vv = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
       // cos(angle) < cos_max, without a division or a square root: dot < cos_max * |m| |v|.
-      refine_[i] = dot <= 0.0 ? mm > 0.0 || vv > 0.0 : dot * dot < cos_max * cos_max * mm * vv;
+      if (dot <= 0.0 ? mm > 0.0 || vv > 0.0 : dot * dot < cos_max * cos_max * mm * vv) refine_[i] = 1;
     }
     std::size_t marked = 0;
-    for (std::uint8_t f : refine_) marked += f;
-    ts_.base_texels -= marked;
-    ts_.refined_texels += marked;
+    for (std::uint8_t& f : refine_) {
+      f = f == 1;
+      marked += f;
+    }
+    if (first) {
+      ts_.base_texels -= marked;
+      ts_.refined_texels += marked;
+    } else {
+      ts_.refined_texels -= marked;
+      ts_.deep_texels += marked;
+    }
     return marked > 0;
   }
 
@@ -585,6 +613,7 @@ void trace_and_shade(const Prepared& s, const HighScene& scene, const TileBins& 
     total.unmatched += ts.unmatched;
     total.base_texels += ts.base_texels;
     total.refined_texels += ts.refined_texels;
+    total.deep_texels += ts.deep_texels;
     total.dmin = std::min(total.dmin, ts.dmin);
     total.dmax = std::max(total.dmax, ts.dmax);
   }
@@ -598,6 +627,7 @@ void trace_and_shade(const Prepared& s, const HighScene& scene, const TileBins& 
   st.samples_unmatched = total.unmatched;
   st.texels_base = total.base_texels;
   st.texels_refined = total.refined_texels;
+  st.texels_deep = total.deep_texels;
   count_per_object(sh, st);
   if (total.hits) {
     st.hit_distance_min = total.dmin;
