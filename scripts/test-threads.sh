@@ -56,6 +56,8 @@ run_case sample_200x120_s5 exr "$sample_low" "$sample_high" --size 200x120 --sam
 run_case sample_128_s4_closest_object exr "$sample_low" "$sample_high" --size 128 --samples 4 --policy closest --space object
 run_case sphere_256 png "$sphere_low" "$sphere_high" --size 256
 run_case sphere_96x160_s9 exr "$sphere_low" "$sphere_high" --size 96x160 --samples 9 --padding 4
+run_case sample_192_auto exr "$sample_low" "$sample_high" --size 192 --samples auto --max-error 1
+run_case sphere_256_auto png "$sphere_low" "$sphere_high" --size 256 --samples auto
 run_case sphere_512_s2_green_down png "$sphere_low" "$sphere_high" --size 512 --samples 2 --green down --bits 16
 echo "test-threads: $n cases, $failed differ"
 [ "$failed" = 0 ]
