@@ -3,13 +3,9 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <chrono>
-#include <condition_variable>
-#include <exception>
 #include <limits>
-#include <mutex>
-#include <thread>
 
+#include "pipeline/workers.h"
 #include "trace/shade_batch.h"
 #include "trace/tile_kernels.h"
 
@@ -500,65 +496,6 @@ class TileTracer {
   std::vector<std::uint32_t> first_miss_;
 };
 
-// Runs `threads` tracers; the calling thread reports progress every 100 ms. The last worker to
-// finish wakes the wait at once, so the stage does not end up to 100 ms after its work.
-// Tiles are taken from a shared counter, so the tracers that could start cover them all. The first
-// exception of a tracer (std::bad_alloc under ulimit -v) stops the others and is rethrown here; a
-// thread the system refuses (EAGAIN) leaves the work to those started, or to this one.
-void run_tracers(Shared& sh, int threads) {
-  std::mutex done_mutex;
-  std::condition_variable done_cv;
-  std::exception_ptr error;
-  int running = 0;
-  auto work = [&](int i) {
-    try {
-      TileTracer(sh, i).run();
-    } catch (...) {
-      std::lock_guard<std::mutex> lock(done_mutex);
-      if (!error) error = std::current_exception();
-      sh.cancel = true;
-    }
-    std::lock_guard<std::mutex> lock(done_mutex);
-    if (--running == 0) done_cv.notify_all();
-  };
-  std::vector<std::thread> pool;
-  try {
-    pool.reserve(std::size_t(threads));
-    for (int i = 0; i < threads; ++i) {
-      {
-        std::lock_guard<std::mutex> lock(done_mutex);
-        ++running;
-      }
-      try {
-        pool.emplace_back(work, i);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(done_mutex);
-        --running;
-        throw;
-      }
-    }
-  } catch (const std::exception&) {
-    if (pool.empty()) {  // not one thread: trace here
-      ++running;
-      work(0);
-    }
-  }
-  if (sh.opt.progress) {
-    const double tile_count = double(sh.bins.count());
-    std::unique_lock<std::mutex> lock(done_mutex);
-    while (running > 0 && !sh.cancel.load()) {
-      lock.unlock();
-      if (!sh.opt.progress(double(sh.tiles_done.load()) / tile_count)) sh.cancel = true;
-      lock.lock();
-      done_cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return running == 0; });
-    }
-  }
-  for (auto& t : pool) t.join();
-  if (error) std::rethrow_exception(error);
-  if (sh.cancel) throw Cancelled();
-  if (sh.opt.progress) sh.opt.progress(1.0);
-}
-
 // BakeStats' per-object counts: summed over the threads, or with one object each the totals.
 void count_per_object(const Shared& sh, BakeStats& st) {
   st.low_object_samples.assign(sh.s.low_objects, 0);
@@ -599,7 +536,10 @@ void trace_and_shade(const Prepared& s, const HighScene& scene, const TileBins& 
   sh.hit_rule = trace_rule(scene, st.backfaces_skipped, sh.groups, rule);
   sh.prefer = st.backfaces_skipped;
   sh.tile_dsum.assign(bins.count(), 0.0);
-  run_tracers(sh, threads);
+  // Tiles are taken from a shared counter, so the tracers that start cover them all.
+  run_workers(
+      threads, [&sh](int i) { TileTracer(sh, i).run(); }, sh.cancel, sh.opt.progress,
+      [&sh] { return double(sh.tiles_done.load()) / double(sh.bins.count()); });
 
   ThreadStats total;
   for (const ThreadStats& ts : sh.stats) {
