@@ -182,13 +182,13 @@ BakeOptions bake_options(const Args& a) {
   return o;
 }
 
-// Fails early, before a long bake, on outputs that cannot be written.
 bool needs_image_module(const Args& a) {
   for (const std::string* path : {&a.output, &a.miss_mask, &a.suspect_mask})
     if (!path->empty() && image_io_detail::lower_extension(*path) != ".png") return true;
   return false;
 }
 
+// Fails early, before a long bake, on outputs that cannot be written.
 void check_outputs(const Args& a, int bits) {
   if (!a.save_cage.empty()) {
     if (!a.cage.empty() || a.front_given || a.rear_given)

@@ -136,7 +136,6 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
       {"rays", s.rays},
       {"rays_per_second", s.seconds_trace > 0 ? double(s.rays) / s.seconds_trace : 0.0},
       {"samples_covered", s.samples_covered},
-      // Covered texels by how many samples made them: one row for a fixed count, two with --samples auto.
       {"samples_histogram", samples_histogram(o, s)},
       {"hits", s.hits},
       {"misses", s.misses},

@@ -276,7 +276,8 @@ class TileTracer {
                          const std::uint8_t* only) {
     const TileBins& bins = sh_.bins;
     const int tx0 = rect.x0, ty0 = rect.y0, tw = rect.w, th = rect.h;
-    std::fill(sample_tri_.begin(), sample_tri_.end(), -1);
+    const std::size_t slot_count = tile_texels_ * offsets.size();  // the slots this pass fills (all but adaptive's first)
+    std::fill(sample_tri_.begin(), sample_tri_.begin() + std::ptrdiff_t(slot_count), -1);
     const SampleSlots slots{sample_tri_.data(),
                             {sb_[0], sb_[1], sb_[2]},
                             {rays_.origin(0), rays_.origin(1), rays_.origin(2)},
@@ -296,7 +297,6 @@ class TileTracer {
         if (!only) ts_.overlaps += taken;  // a refining pass covers again what the first counted
       }
     }
-    const std::size_t slot_count = tile_texels_ * offsets.size();
     if (only)
       for (std::size_t i = 0; i < slot_count; ++i)
         if (!only[i % tile_texels_]) sample_tri_[i] = -1;
@@ -490,9 +490,9 @@ class TileTracer {
   std::vector<double> acc_;                  // per texel of the tile: x, y, z sums and covered samples, as arrays
   TexelSums sums_;
   std::vector<std::uint32_t> miss_count_;
-  std::vector<std::uint8_t> refine_;   // adaptive: per texel of the tile, baked again with the refining samples
+  std::vector<std::uint8_t> refine_;   // adaptive: per texel of the tile, baked again by the next level's pass
   std::size_t last_sample_count_ = 0;  // covered samples of the last cover_tile
-  std::vector<double> first_acc_;      // adaptive: the first pass's sums while the refining pass runs
+  std::vector<double> first_acc_;      // adaptive: the sums so far while a refining pass runs
   std::vector<std::uint32_t> first_miss_;
 };
 
