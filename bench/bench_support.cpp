@@ -41,10 +41,14 @@ Timing bare_loop(const raycast::Scene& scene, const std::vector<raycast::Ray>& r
   auto work = [&] {
     for (std::size_t i; (i = next.fetch_add(chunk)) < rays.size();) {
       const std::size_t n = std::min(chunk, rays.size() - i);
+      // The bake's rays are coherent (neighbouring texels in a row): the packet loops say so too,
+      // as the bake does (raycast::RayBatch::coherent).
       if (mode == Bare::arrays) {
-        scene.intersect(arrays.rays(i), arrays.hits(i), n);
+        raycast::RayBatch batch = arrays.rays(i);
+        batch.coherent = true;
+        scene.intersect(batch, arrays.hits(i), n);
       } else if (mode == Bare::packets) {
-        scene.intersect(&rays[i], &hits[i], n);
+        scene.intersect(&rays[i], &hits[i], n, true);
       } else {
         for (std::size_t k = i; k < i + n; ++k) hits[k] = scene.intersect(rays[k]);
       }

@@ -150,6 +150,8 @@ std::vector<QualityRow> run_tracing(BenchRun& run) {
       "Bare loops: one rtcIntersect1 per ray; 8-wide packets (rtcIntersect8) filled from Ray structs; 8-wide packets from\n"
       "arrays already in Embree's packet layout (filled before the clock starts; the bake writes its rays this way). The\n"
       "bake uses 8-wide packets; raycast.h has no 16-wide packets or rtcIntersect1M streams, so those are not measured.\n"
+      "The bake and both packet loops tell Embree the packets are coherent (RTC_INTERSECT_CONTEXT_FLAG_COHERENT: eight\n"
+      "neighbouring texels of a row); the single-ray loop cannot.\n"
       "\"Own s\": the fastest bake's trace less the best bare loop on its rays: the bake's own rasterizing, ray making,\n"
       "shading and writing, as wall seconds.\n"
       "Rounds: %d at 1 and 4 samples, %d at 16; each timed column is the best of them. \"Per round\": each round's trace\n"

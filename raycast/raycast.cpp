@@ -3,6 +3,7 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <stdexcept>
@@ -174,6 +175,27 @@ struct RuleContext {
   }
 };
 
+// Whether the packet's 8 directions lie in one octant as Embree sees them. Its coherent traversal
+// bounds a packet by one frustum, which assumes that, and it takes the reciprocal of a direction
+// component below 1e-18 in magnitude (a zero of either sign too) as +1e18: a packet of a bake
+// where normals turn through a plane, directions -0.0017 and -7e-19 along x, lost every hit
+// under it (Embree 3.13). So a component counts as positive below 1e-18, by its sign above 1e-16,
+// and in between (where the rounding of that threshold could decide) not at all: such a packet,
+// and one whose rays straddle an axis plane, is traced as incoherent.
+bool one_octant(const RTCRayHit8& rh) {
+  const float* d[3] = {rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z};
+  for (const float* a : d) {
+    int side[8];
+    for (int k = 0; k < 8; ++k) {
+      const float m = std::fabs(a[k]);
+      side[k] = m < 1e-18f ? 1 : !(m >= 1e-16f) ? 0 : a[k] > 0.0f ? 1 : -1;  // 0: undecided (or NaN)
+    }
+    for (int k = 0; k < 8; ++k)
+      if (side[k] == 0 || side[k] != side[0]) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 RayArrays::RayArrays(std::size_t count) : count_(count), fields_(11 * count), triangle_(count, no_hit), flags_(count, 0) {}
@@ -308,10 +330,12 @@ Hit Scene::intersect(const Ray& ray, const HitRule& rule, bool outward, std::uin
   return h;
 }
 
-void Scene::intersect(const Ray* rays, Hit* hits, std::size_t count) const {
+void Scene::intersect(const Ray* rays, Hit* hits, std::size_t count, bool coherent) const {
   // The one packet path (below), through arrays in its layout.
   RayArrays arrays(rays, count);
-  intersect(arrays.rays(), arrays.hits(), count, nullptr);
+  RayBatch batch = arrays.rays();
+  batch.coherent = coherent;
+  intersect(batch, arrays.hits(), count, nullptr);
   for (std::size_t i = 0; i < count; ++i) {
     const Hit h = arrays.hit(i);
     hits[i] = h.hit() ? h : Hit{};
@@ -362,6 +386,8 @@ void Scene::intersect(const RayBatch& rays, const HitBatch& hits, std::size_t co
         if (rays.group) rc.group[k] = rays.group[i];
       }
     }
+    rc.context.flags =
+        rays.coherent && one_octant(rh) ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
     rtcIntersect8(valid, impl_->scene, &rc.context, &rh);
     for (std::size_t k = 0; k < 8; ++k)
       rh.hit.primID[k] = rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID ? rh.hit.primID[k] : no_hit;

@@ -1,6 +1,7 @@
 // The trace loop's vector kernels (tile_kernels.h) give exactly the bits of their one-sample
-// definitions: cover_rect against covers() and the default-policy ray, write_texel_row against the
-// texel formula, including the cases each flags or special-cases.
+// definitions: cover_rect against covers(), the default-policy ray and the cage ray (cage_ray and
+// inward_ray), write_texel_row against the texel formula, including the cases each flags or
+// special-cases.
 #include <cstring>
 #include <random>
 #include <vector>
@@ -8,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "core/rasterize.h"
+#include "pipeline/rays.h"
 #include "trace/tile_kernels.h"
 
 using namespace nmbake;
@@ -17,11 +19,18 @@ namespace {
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 bool same_bits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
-// A rectangle of slots with the arrays SampleSlots points into.
+// A rectangle of slots with the arrays SampleSlots points into (with `cage`, tfar, base and
+// prefer_lo too).
 struct Slots {
-  explicit Slots(std::size_t n) : tri(n, -1), b(3 * n), ray(6 * n), fallback(n, 9) { point_view(); }
+  explicit Slots(std::size_t n, bool cage = false)
+      : tri(n, -1), b(3 * n), ray(6 * n), fallback(n, 9), tfar(cage ? n : 0), base(cage ? n : 0), prefer_lo(cage ? n : 0) {
+    point_view();
+  }
   // A copy's view points at the copy's own arrays.
-  Slots(const Slots& o) : tri(o.tri), b(o.b), ray(o.ray), fallback(o.fallback) { point_view(); }
+  Slots(const Slots& o)
+      : tri(o.tri), b(o.b), ray(o.ray), fallback(o.fallback), tfar(o.tfar), base(o.base), prefer_lo(o.prefer_lo) {
+    point_view();
+  }
   Slots& operator=(const Slots&) = delete;
   void point_view() {
     const std::size_t n = tri.size();
@@ -29,12 +38,18 @@ struct Slots {
             {&b[0], &b[n], &b[2 * n]},
             {&ray[0], &ray[n], &ray[2 * n]},
             {&ray[3 * n], &ray[4 * n], &ray[5 * n]},
-            fallback.data()};
+            fallback.data(),
+            tfar.empty() ? nullptr : tfar.data(),
+            base.empty() ? nullptr : base.data(),
+            prefer_lo.empty() ? nullptr : prefer_lo.data()};
   }
   std::vector<std::int32_t> tri;
   std::vector<double> b;
   std::vector<float> ray;
   std::vector<std::uint8_t> fallback;
+  std::vector<float> tfar;
+  std::vector<double> base;
+  std::vector<float> prefer_lo;
   SampleSlots view{};
 };
 
@@ -58,6 +73,22 @@ LowTriangle random_low_triangle(std::mt19937& rng) {
   return lt;
 }
 
+// Whether covers() moved the sample of texel (x, y) in from an edge: its barycentrics b are not
+// the ones the edges give at the sample point (the rays are made from those).
+bool moved_in(const TexelTriangle& tt, int x, int y, double ox, double oy, const double b[3]) {
+  double unmoved[3];
+  const glm::dvec2 q = sample_point(x, y, ox, oy);
+  for (int k = 0; k < 3; ++k) {
+    const int e = (k + 1) % 3;  // w[k] comes from edge k + 1
+    const double ev = tt.edge_d[e].x * (q.y - tt.edge_a[e].y) - tt.edge_d[e].y * (q.x - tt.edge_a[e].x);
+    unmoved[k] = ev * tt.edge_inv_side[e];
+  }
+  const double sum = unmoved[0] + unmoved[1] + unmoved[2];
+  bool moved = false;
+  for (int k = 0; k < 3; ++k) moved |= !same_bits(unmoved[k] * (1.0 / sum), b[k]);
+  return moved;
+}
+
 // Checks one cover_rect call over the triangle's whole box against covers() sample by sample.
 // Returns the covered samples; `moved` counts those covers() moved in from an edge.
 std::size_t check_triangle(const TexelTriangle& tt, const LowTriangle* low, float front, double ox, double oy,
@@ -66,7 +97,7 @@ std::size_t check_triangle(const TexelTriangle& tt, const LowTriangle* low, floa
   if (w <= 0 || h <= 0) return 0;
   const std::size_t stride = std::size_t(w) + 3;  // rows not packed, as in a tile
   Slots slots(stride * std::size_t(h));
-  const DefaultRays rays{low, front};
+  const KernelRays rays{low, front};
   EXPECT_EQ(cover_rect(tt, 0, tt.xmin, tt.xmax, tt.ymin, tt.ymax, ox, oy, rays, slots.view, 0, stride), 0u);
   std::size_t covered = 0;
   for (int y = tt.ymin; y <= tt.ymax; ++y)
@@ -80,17 +111,7 @@ std::size_t check_triangle(const TexelTriangle& tt, const LowTriangle* low, floa
       for (int k = 0; k < 3; ++k) EXPECT_TRUE(same_bits(slots.b[std::size_t(k) * slots.tri.size() + i], b[k])) << x << "," << y;
       if (!low) continue;
       // The ray is made from the unmoved barycentrics: a moved sample must be flagged.
-      double unmoved[3];
-      const glm::dvec2 q = sample_point(x, y, ox, oy);
-      bool was_moved = false;
-      for (int k = 0; k < 3; ++k) {
-        const int e = (k + 1) % 3;  // w[k] comes from edge k + 1
-        const double ev = tt.edge_d[e].x * (q.y - tt.edge_a[e].y) - tt.edge_d[e].y * (q.x - tt.edge_a[e].x);
-        unmoved[k] = ev * tt.edge_inv_side[e];
-      }
-      const double sum = unmoved[0] + unmoved[1] + unmoved[2];
-      for (double& u : unmoved) u = u * (1.0 / sum);
-      for (int k = 0; k < 3; ++k) was_moved |= !same_bits(unmoved[k], b[k]);
+      const bool was_moved = moved_in(tt, x, y, ox, oy, b);
       *moved += was_moved;
       if (was_moved) {
         EXPECT_EQ(slots.fallback[i], 1) << x << "," << y;
@@ -131,13 +152,13 @@ TEST(TileKernels, CoverRectIsCoversBitForBit) {
 TEST(TileKernels, CoverRectKeepsTheFirstTriangleAndCountsTheRest) {
   const TexelTriangle tt = setup_texel_triangle({0.0f, 0.0f}, {1.0f, 0.0f}, {0.0f, 1.0f}, 8, 8);
   Slots slots(64);
-  const std::size_t first = cover_rect(tt, 3, 0, 7, 0, 7, 0.5, 0.5, DefaultRays{}, slots.view, 0, 8);
+  const std::size_t first = cover_rect(tt, 3, 0, 7, 0, 7, 0.5, 0.5, KernelRays{}, slots.view, 0, 8);
   EXPECT_EQ(first, 0u);
   const std::vector<std::int32_t> after_first = slots.tri;
   std::size_t covered = 0;
   for (std::int32_t t : after_first) covered += t == 3;
   EXPECT_EQ(covered, 36u);  // texel centres strictly below the diagonal plus the tie-broken ones on it
-  EXPECT_EQ(cover_rect(tt, 5, 0, 7, 0, 7, 0.5, 0.5, DefaultRays{}, slots.view, 0, 8), covered);
+  EXPECT_EQ(cover_rect(tt, 5, 0, 7, 0, 7, 0.5, 0.5, KernelRays{}, slots.view, 0, 8), covered);
   EXPECT_EQ(slots.tri, after_first);
 }
 
@@ -146,7 +167,7 @@ TEST(TileKernels, DegenerateRayNormalsAreFlagged) {
   for (int c = 0; c < 3; ++c) lt.p[c] = glm::dvec3(c, c * c, 1.0);  // ray normals all zero
   const TexelTriangle tt = setup_texel_triangle({0.1f, 0.1f}, {0.9f, 0.2f}, {0.3f, 0.8f}, 16, 16);
   Slots slots(256);
-  cover_rect(tt, 0, tt.xmin, tt.xmax, tt.ymin, tt.ymax, 0.5, 0.5, DefaultRays{&lt, 0.1f}, slots.view,
+  cover_rect(tt, 0, tt.xmin, tt.xmax, tt.ymin, tt.ymax, 0.5, 0.5, KernelRays{&lt, 0.1f}, slots.view,
              std::size_t(tt.ymin) * 16 + std::size_t(tt.xmin), 16);
   std::size_t covered = 0;
   for (std::size_t i = 0; i < 256; ++i)
@@ -155,6 +176,65 @@ TEST(TileKernels, DegenerateRayNormalsAreFlagged) {
       EXPECT_EQ(slots.fallback[i], 1) << i;
     }
   EXPECT_GT(covered, 40u);
+}
+
+TEST(TileKernels, CageRaysAreCageRayBitForBit) {
+  // With a cage, each covered sample's ray, far end, base and preferred start are inward_ray's of
+  // cage_ray's (pipeline/rays.h), or the sample is flagged: moved in from an edge, or its cage
+  // point on the low-poly (cage_ray's fallback direction).
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f), out(0.0f, 0.2f);
+  const double diagonal = 3.0;
+  std::size_t checked = 0, beyond = 0, on_low = 0;
+  for (int i = 0; i < 150; ++i) {
+    glm::vec2 uv[3];
+    for (glm::vec2& c : uv) c = {u(rng), u(rng)};
+    if (i % 4 == 0)
+      for (glm::vec2& c : uv) c = (glm::floor(c * 32.0f) + 0.5f) / 32.0f;
+    const TexelTriangle tt = setup_texel_triangle(uv[0], uv[1], uv[2], 32, 32);
+    const LowTriangle lt = random_low_triangle(rng);
+    CageTriangle ct;
+    for (int c = 0; c < 3; ++c) {
+      // Every tenth cage lies on the low-poly (no direction); a third search no farther than the cage.
+      ct.corner[c] = i % 10 == 5 ? lt.p[c] : lt.p[c] + double(out(rng)) * lt.ray_n[c];
+      ct.rear[c] = double(out(rng));
+      ct.search[c] = i % 3 == 0 ? 0.0 : 2.0 * double(out(rng));
+    }
+    const double ox = i % 3 ? 0.5 : 0.125, oy = i % 5 ? 0.5 : 0.875;
+    const int w = tt.xmax - tt.xmin + 1, h = tt.ymax - tt.ymin + 1;
+    if (w <= 0 || h <= 0) continue;
+    const std::size_t stride = std::size_t(w) + 1, n = stride * std::size_t(h);
+    Slots slots(n, true);
+    cover_rect(tt, 0, tt.xmin, tt.xmax, tt.ymin, tt.ymax, ox, oy, KernelRays{&lt, 0.0f, &ct, diagonal}, slots.view, 0, stride);
+    for (int y = tt.ymin; y <= tt.ymax; ++y)
+      for (int x = tt.xmin; x <= tt.xmax; ++x) {
+        const std::size_t s = std::size_t(y - tt.ymin) * stride + std::size_t(x - tt.xmin);
+        if (slots.tri[s] < 0) continue;
+        const double b[3] = {slots.b[s], slots.b[n + s], slots.b[2 * n + s]};
+        const CageRay c = cage_ray(lt, ct, b, diagonal);
+        if (moved_in(tt, x, y, ox, oy, b) || c.len == 0.0) {
+          EXPECT_EQ(slots.fallback[s], 1) << i << ": " << x << "," << y;
+          on_low += c.len == 0.0;
+          continue;
+        }
+        ASSERT_EQ(slots.fallback[s], 0) << i << ": " << x << "," << y;
+        double base = 0.0;
+        float prefer_lo = -1.0f;
+        const raycast::Ray r = inward_ray(c, &base, &prefer_lo);
+        for (int k = 0; k < 3; ++k) {
+          EXPECT_TRUE(same_bits(slots.ray[std::size_t(k) * n + s], r.origin[k])) << i << ": " << x << "," << y;
+          EXPECT_TRUE(same_bits(slots.ray[std::size_t(3 + k) * n + s], r.direction[k])) << i << ": " << x << "," << y;
+        }
+        EXPECT_TRUE(same_bits(slots.tfar[s], r.tfar)) << i << ": " << x << "," << y;
+        EXPECT_TRUE(same_bits(slots.base[s], base)) << i << ": " << x << "," << y;
+        EXPECT_TRUE(same_bits(slots.prefer_lo[s], prefer_lo)) << i << ": " << x << "," << y;
+        ++checked;
+        beyond += prefer_lo > 0.0f;
+      }
+  }
+  EXPECT_GT(checked, 5000u);
+  EXPECT_GT(beyond, 500u);  // rays searching beyond their cage (a preferred part that starts later)
+  EXPECT_GT(on_low, 50u);   // cage points on the low-poly were reached and flagged
 }
 
 TEST(TileKernels, WriteTexelRowIsTheTexelFormula) {
@@ -200,7 +280,8 @@ TEST(TileKernels, CompactAndAccumulateKeepSampleOrder) {
   constexpr std::size_t kTexels = 64;
   for (int samples = 1; samples <= 5; ++samples) {
     const std::size_t n = kTexels * std::size_t(samples);
-    Slots slots(n);
+    const bool cage = samples % 2 == 0;  // with a cage's per-ray arrays too
+    Slots slots(n, cage);
     for (std::size_t i = 0; i < n; ++i) {
       // Runs of covered slots, gaps, and single ones: both the four-at-a-time and the one-by-one paths.
       const bool covered = (i / 9) % 3 != 1 && i % 13 != 4;
@@ -208,18 +289,24 @@ TEST(TileKernels, CompactAndAccumulateKeepSampleOrder) {
       for (int c = 0; c < 3; ++c) slots.b[std::size_t(c) * n + i] = u(rng);
       for (int c = 0; c < 6; ++c) slots.ray[std::size_t(c) * n + i] = float(u(rng));
       slots.fallback[i] = std::uint8_t(i % 3 == 0);
+      if (cage) slots.tfar[i] = float(u(rng)), slots.base[i] = u(rng), slots.prefer_lo[i] = float(u(rng));
     }
     std::vector<std::int32_t> tri(n);
     std::vector<double> b(3 * n);
     std::vector<std::uint16_t> texel(n);
     std::vector<float> ray(6 * n);
     std::vector<std::uint8_t> fallback(n);
+    std::vector<float> tfar(n), prefer_lo(n);
+    std::vector<double> base(n);
     const CoveredSamples out{tri.data(),
                              {&b[0], &b[n], &b[2 * n]},
                              texel.data(),
                              {&ray[0], &ray[n], &ray[2 * n]},
                              {&ray[3 * n], &ray[4 * n], &ray[5 * n]},
-                             fallback.data()};
+                             fallback.data(),
+                             cage ? tfar.data() : nullptr,
+                             cage ? base.data() : nullptr,
+                             cage ? prefer_lo.data() : nullptr};
     const std::size_t count = compact_samples(slots.view, n, kTexels, true, out);
     std::size_t r = 0;
     for (std::size_t i = 0; i < n; ++i) {
@@ -230,6 +317,11 @@ TEST(TileKernels, CompactAndAccumulateKeepSampleOrder) {
       EXPECT_EQ(fallback[r], slots.fallback[i]) << i;
       for (int c = 0; c < 3; ++c) EXPECT_TRUE(same_bits(b[std::size_t(c) * n + r], slots.b[std::size_t(c) * n + i])) << i;
       for (int c = 0; c < 6; ++c) EXPECT_TRUE(same_bits(ray[std::size_t(c) * n + r], slots.ray[std::size_t(c) * n + i])) << i;
+      if (cage) {
+        EXPECT_TRUE(same_bits(tfar[r], slots.tfar[i])) << i;
+        EXPECT_TRUE(same_bits(base[r], slots.base[i])) << i;
+        EXPECT_TRUE(same_bits(prefer_lo[r], slots.prefer_lo[i])) << i;
+      }
       ++r;
     }
     EXPECT_EQ(count, r);
@@ -244,7 +336,10 @@ TEST(TileKernels, CompactAndAccumulateKeepSampleOrder) {
                                   same_texel.data(),
                                   {same.view.org[0], same.view.org[1], same.view.org[2]},
                                   {same.view.dir[0], same.view.dir[1], same.view.dir[2]},
-                                  same.view.ray_fallback};
+                                  same.view.ray_fallback,
+                                  same.view.tfar,
+                                  same.view.base,
+                                  same.view.prefer_lo};
     ASSERT_EQ(compact_samples(same.view, n, kTexels, true, in_place), count);
     for (std::size_t k = 0; k < count; ++k) {
       EXPECT_EQ(same.tri[k], tri[k]) << k;
@@ -252,6 +347,11 @@ TEST(TileKernels, CompactAndAccumulateKeepSampleOrder) {
       EXPECT_EQ(same.fallback[k], fallback[k]) << k;
       for (int c = 0; c < 3; ++c) EXPECT_TRUE(same_bits(same.b[std::size_t(c) * n + k], b[std::size_t(c) * n + k])) << k;
       for (int c = 0; c < 6; ++c) EXPECT_TRUE(same_bits(same.ray[std::size_t(c) * n + k], ray[std::size_t(c) * n + k])) << k;
+      if (cage) {
+        EXPECT_TRUE(same_bits(same.tfar[k], tfar[k])) << k;
+        EXPECT_TRUE(same_bits(same.base[k], base[k])) << k;
+        EXPECT_TRUE(same_bits(same.prefer_lo[k], prefer_lo[k])) << k;
+      }
     }
 
     std::vector<double> value(3 * n);

@@ -16,13 +16,6 @@
 
 namespace nmbake {
 
-// A low-poly triangle's cage: its corners (re-centred), and per corner the rear distance and how
-// far out rays search (LocalDistances::search; 0: to the cage only).
-struct CageTriangle {
-  glm::dvec3 corner[3];
-  double rear[3] = {0, 0, 0}, search[3] = {0, 0, 0};
-};
-
 // The scene in re-centred coordinates, flat arrays for the hot loop.
 struct Prepared {
   glm::dvec3 centre{0.0};

@@ -67,6 +67,7 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
     for (std::size_t i = 0; i < outward.size(); i += 2) outward[i] = 1;
     raycast::RayBatch ray_batch = arrays.rays();
     ray_batch.outward = outward.empty() ? nullptr : outward.data();
+    ray_batch.coherent = true;  // a texel's samples one after another
     std::vector<float> prefer_lo(arrays.size()), prefer_hi(arrays.size());
     if (st.backfaces_skipped) {
       ray_batch.prefer_lo = prefer_lo.data();

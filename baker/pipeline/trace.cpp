@@ -113,7 +113,7 @@ class TileTracer {
         side_(sh.bins.side),
         tile_texels_(std::size_t(side_) * std::size_t(side_)),
         slot_count_(tile_texels_ * std::max(sh.offsets.size(), sh.levels.empty() ? 0 : sh.levels.back().offsets.size())),
-        default_rays_(!sh.setup.cage && !sh.setup.closest),
+        kernel_rays_(!sh.setup.closest),
         rays_(slot_count_ * std::size_t(sh.rays_per_sample)),
         hits_(rays_.hits()),
         sample_tri_(slot_count_),
@@ -143,9 +143,10 @@ class TileTracer {
     }
     batch_ = rays_.rays();
     batch_.outward = outward_.empty() ? nullptr : outward_.data();
+    batch_.coherent = true;  // a tile's samples in rows of texels, sample by sample
     if (sh.setup.cage) {
       prefer_lo_.assign(rays_.size(), 0.0f);
-      prefer_hi_.assign(rays_.size(), 0.0f);
+      prefer_hi_.assign(rays_.size(), std::numeric_limits<float>::infinity());  // inward rays' (sample_rays)
       if (sh.prefer) {
         batch_.prefer_lo = prefer_lo_.data();
         batch_.prefer_hi = prefer_hi_.data();
@@ -155,8 +156,9 @@ class TileTracer {
       ray_group_.assign(rays_.size(), 0);
       batch_.group = ray_group_.data();
     }
-    // Every default-policy ray starts at 0 and reaches front + rear (sample_rays' too).
-    if (default_rays_) std::fill(rays_.tfar(), rays_.tfar() + rays_.size(), sh.setup.front + sh.setup.rear);
+    // Every default-policy ray without a cage starts at 0 and reaches front + rear (sample_rays'
+    // too); a cage's rays have each their own reach, made with them.
+    if (kernel_rays_ && !sh.setup.cage) std::fill(rays_.tfar(), rays_.tfar() + rays_.size(), sh.setup.front + sh.setup.rear);
   }
 
   // Appends the rays of every tile to `out`, in tile order, and casts none.
@@ -278,12 +280,17 @@ class TileTracer {
     const int tx0 = rect.x0, ty0 = rect.y0, tw = rect.w, th = rect.h;
     const std::size_t slot_count = tile_texels_ * offsets.size();  // the slots this pass fills (all but adaptive's first)
     std::fill(sample_tri_.begin(), sample_tri_.begin() + std::ptrdiff_t(slot_count), -1);
+    const bool cage = kernel_rays_ && sh_.setup.cage;
     const SampleSlots slots{sample_tri_.data(),
                             {sb_[0], sb_[1], sb_[2]},
                             {rays_.origin(0), rays_.origin(1), rays_.origin(2)},
                             {rays_.direction(0), rays_.direction(1), rays_.direction(2)},
-                            sample_fallback_.data()};
-    const DefaultRays default_ray_setup{default_rays_ ? sh_.s.low_tris.data() : nullptr, sh_.setup.front};
+                            sample_fallback_.data(),
+                            cage ? rays_.tfar() : nullptr,
+                            cage ? signed_base_.data() : nullptr,
+                            cage ? prefer_lo_.data() : nullptr};
+    const KernelRays kernel_rays{kernel_rays_ ? sh_.s.low_tris.data() : nullptr, sh_.setup.front,
+                                 cage ? sh_.s.cage_tris.data() : nullptr, sh_.setup.diagonal};
     for (std::uint32_t bi = bins.start[tile]; bi < bins.start[tile + 1]; ++bi) {
       const std::uint32_t t = bins.tris[bi];
       const TexelTriangle& tt = bins.texel_tris[t];
@@ -292,7 +299,7 @@ class TileTracer {
       if (x1 < x0 || y1 < y0) continue;
       for (std::size_t k = 0; k < offsets.size(); ++k) {
         const std::size_t taken = cover_rect(
-            tt, std::int32_t(t), x0, x1, y0, y1, offsets[k].x, offsets[k].y, default_ray_setup, slots,
+            tt, std::int32_t(t), x0, x1, y0, y1, offsets[k].x, offsets[k].y, kernel_rays, slots,
             (k * std::size_t(side_) + std::size_t(y0 - ty0)) * std::size_t(side_) + std::size_t(x0 - tx0), std::size_t(side_));
         if (!only) ts_.overlaps += taken;  // a refining pass covers again what the first counted
       }
@@ -305,25 +312,18 @@ class TileTracer {
                                  sample_texel_.data(),
                                  {slots.org[0], slots.org[1], slots.org[2]},
                                  {slots.dir[0], slots.dir[1], slots.dir[2]},
-                                 sample_fallback_.data()};
-    last_sample_count_ = compact_samples(slots, slot_count, tile_texels_, default_rays_, covered);
+                                 sample_fallback_.data(),
+                                 slots.tfar,
+                                 slots.base,
+                                 slots.prefer_lo};
+    last_sample_count_ = compact_samples(slots, slot_count, tile_texels_, kernel_rays_, covered);
     return last_sample_count_;
   }
 
-  // The rays the coverage did not make: cage rays straight into the arrays, and one at a time the
-  // other policies' and the default policy's special cases.
+  // The rays the coverage did not make, one at a time: the closest-hit policy's, and the cage-first
+  // policy's special cases.
   void make_rays(std::size_t sample_count) {
     const RaySetup& setup = sh_.setup;
-    if (setup.cage && !setup.closest) {
-      for (std::size_t r = 0; r < sample_count; ++r) {
-        const double b[3] = {sb_[0][r], sb_[1][r], sb_[2][r]};
-        const std::size_t tri = std::size_t(sample_tri_[r]);
-        rays_.set(r, inward_ray(cage_ray(sh_.s.low_tris[tri], sh_.s.cage_tris[tri], b, setup.diagonal), &signed_base_[r],
-                                &prefer_lo_[r]));
-        prefer_hi_[r] = std::numeric_limits<float>::infinity();
-      }
-      return;
-    }
     const std::size_t per = std::size_t(sh_.rays_per_sample);
     for (std::size_t r = 0; r < sample_count; ++r) {
       if (!sample_fallback_[r]) continue;
@@ -466,7 +466,7 @@ class TileTracer {
   ThreadStats& ts_;
   const int side_;
   const std::size_t tile_texels_, slot_count_;
-  const bool default_rays_;
+  const bool kernel_rays_;  // cover_rect makes the rays (the cage-first policy)
   raycast::RayArrays rays_;
   const raycast::HitBatch hits_;
   raycast::RayBatch batch_;

@@ -24,6 +24,13 @@ struct LowTriangle {
   glm::dvec4 t[3];
 };
 
+// A low-poly triangle's cage: its corners (re-centred), and per corner the rear distance and how
+// far out rays search (LocalDistances::search; 0: to the cage only).
+struct CageTriangle {
+  glm::dvec3 corner[3];
+  double rear[3] = {0, 0, 0}, search[3] = {0, 0, 0};
+};
+
 // The default rays, written once over the number type (double for one sample in
 // pipeline/rays.h, four lanes in trace/tile_kernels.cpp).
 // r = w0 c0 + w1 c1 + w2 c2, summed left to right (as glm's b[0] * c[0] + b[1] * c[1] + b[2] * c[2]).

@@ -25,13 +25,48 @@ namespace {
   default_ray(org, dir, p, n, front);
 }
 
+// The cage-first policy's inward ray with a cage for one triangle at barycentrics w: cage_ray and
+// inward_ray (pipeline/rays.h), term for term. Besides origin and direction: the ray's far end,
+// its base (the search distance) and where its preferred part begins. `good`: lanes whose cage
+// point lies off the low-poly (the others take cage_ray's fallback direction).
+struct CageLanes {
+  V3 org, dir;
+  V far, base, prefer_lo;
+};
+[[gnu::always_inline]] inline void weighted(V& r, const V (&w)[3], const double c[3]) {
+  r = w[0] * c[0];
+  r = r + w[1] * c[1];
+  r = r + w[2] * c[2];
+}
+[[gnu::always_inline]] inline void cage_ray_lanes(const LowTriangle& lt, const CageTriangle& ct, double diagonal, const V (&w)[3],
+                                                  CageLanes& r, unsigned& good) {
+  V3 p, pc;
+  corner_sum(p, lt.p, w);
+  corner_sum(pc, ct.corner, w);
+  V rear, search;
+  weighted(rear, w, ct.rear);
+  weighted(search, w, ct.search);
+  const V3 d = {p.x - pc.x, p.y - pc.y, p.z - pc.z};
+  V len2, len;
+  dot(len2, d, d);
+  vsqrt(len, len2);
+  good = bits(len > 1e-9 * diagonal);
+  r.dir = {d.x / len, d.y / len, d.z / len};
+  const V s = len < search ? search : len;  // std::max(len, search)
+  r.org = {p.x - s * r.dir.x, p.y - s * r.dir.y, p.z - s * r.dir.z};
+  r.far = s + rear;
+  r.base = s;
+  const V zero = {0.0, 0.0, 0.0, 0.0};
+  r.prefer_lo = s > len ? s - len : zero;
+}
+
 }  // namespace
 
 // Two versions, chosen once at load time by the CPU: AVX2 and the SSE2 baseline. Neither uses FMA,
 // so both give the scalar code's bits.
 __attribute__((target_clones("avx2", "default"))) std::size_t cover_rect(const TexelTriangle& tt, std::int32_t t, int x0, int x1,
                                                                          int y0, int y1, double ox, double oy,
-                                                                         const DefaultRays& rays, const SampleSlots& slots,
+                                                                         const KernelRays& rays, const SampleSlots& slots,
                                                                          std::size_t first, std::size_t row_stride) {
   std::size_t taken = 0;
   const V zero = {0.0, 0.0, 0.0, 0.0};
@@ -77,11 +112,18 @@ __attribute__((target_clones("avx2", "default"))) std::size_t cover_rect(const T
       const unsigned m = bits(in);
       if (!m) continue;
       normalize_weights(b, w, sum);
-      V3 org{zero, zero, zero}, dir{zero, zero, zero};
+      CageLanes cr{{zero, zero, zero}, {zero, zero, zero}, zero, zero, zero};
+      V3& org = cr.org;
+      V3& dir = cr.dir;
       unsigned good = 0;
-      if (rays.low) default_ray_lanes(rays.low[t], double(rays.front), b, org, dir, good);
+      if (rays.cage) {
+        cage_ray_lanes(rays.low[t], rays.cage[t], rays.diagonal, b, cr, good);
+      } else if (rays.low) {
+        default_ray_lanes(rays.low[t], double(rays.front), b, org, dir, good);
+      }
       const F of[3] = {__builtin_convertvector(org.x, F), __builtin_convertvector(org.y, F), __builtin_convertvector(org.z, F)};
       const F df[3] = {__builtin_convertvector(dir.x, F), __builtin_convertvector(dir.y, F), __builtin_convertvector(dir.z, F)};
+      const F far = __builtin_convertvector(cr.far, F), lo = __builtin_convertvector(cr.prefer_lo, F);
       const std::size_t slot0 = row + std::size_t(x - x0);
       if (m == 0xfu) {
         // The common case, four lanes at once: all four samples covered, their slots free, none
@@ -97,6 +139,11 @@ __attribute__((target_clones("avx2", "default"))) std::size_t cover_rect(const T
           for (int c = 0; c < 3; ++c) {
             std::memcpy(&slots.org[c][slot0], &of[c], sizeof(F));
             std::memcpy(&slots.dir[c][slot0], &df[c], sizeof(F));
+          }
+          if (rays.cage) {
+            std::memcpy(&slots.tfar[slot0], &far, sizeof(F));
+            std::memcpy(&slots.base[slot0], &cr.base, sizeof(V));
+            std::memcpy(&slots.prefer_lo[slot0], &lo, sizeof(F));
           }
           store_flags(&slots.ray_fallback[slot0], ~good);
           continue;
@@ -120,6 +167,11 @@ __attribute__((target_clones("avx2", "default"))) std::size_t cover_rect(const T
           slots.org[c][slot] = of[c][k];
           slots.dir[c][slot] = df[c][k];
         }
+        if (rays.cage) {
+          slots.tfar[slot] = far[k];
+          slots.base[slot] = cr.base[k];
+          slots.prefer_lo[slot] = lo[k];
+        }
       }
     }
   }
@@ -130,6 +182,7 @@ __attribute__((target_clones("avx2", "default"))) std::size_t compact_samples(co
                                                                               std::size_t texels, bool rays,
                                                                               const CoveredSamples& out) {
   std::size_t n = 0;
+  const bool cage = rays && slots.tfar;
   // Entry i to entry n <= i, one value at a time (in place, n may equal i).
   const auto copy_one = [&](std::size_t i) {
     out.tri[n] = slots.tri[i];
@@ -141,6 +194,11 @@ __attribute__((target_clones("avx2", "default"))) std::size_t compact_samples(co
         out.dir[c][n] = slots.dir[c][i];
       }
       out.ray_fallback[n] = slots.ray_fallback[i];
+      if (cage) {
+        out.tfar[n] = slots.tfar[i];
+        out.base[n] = slots.base[i];
+        out.prefer_lo[n] = slots.prefer_lo[i];
+      }
     }
     ++n;
   };
@@ -170,6 +228,11 @@ __attribute__((target_clones("avx2", "default"))) std::size_t compact_samples(co
             std::memmove(&out.dir[c][n], &slots.dir[c][i], kLanes * sizeof(float));
           }
           std::memmove(&out.ray_fallback[n], &slots.ray_fallback[i], kLanes);
+          if (cage) {
+            std::memmove(&out.tfar[n], &slots.tfar[i], kLanes * sizeof(float));
+            std::memmove(&out.base[n], &slots.base[i], kLanes * sizeof(double));
+            std::memmove(&out.prefer_lo[n], &slots.prefer_lo[i], kLanes * sizeof(float));
+          }
         }
       }
       n += kLanes;

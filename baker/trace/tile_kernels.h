@@ -1,13 +1,14 @@
 // The trace loop's first steps for a tile, four samples per vector operation: which samples of a
-// rectangle of texels one triangle covers, with their barycentrics, and, for the default ray
-// policy, their rays.
+// rectangle of texels one triangle covers, with their barycentrics, and, for the cage-first
+// policy (default rays or a cage), their rays.
 //
 // Each result has exactly the bits of its one-sample definition, computed in the same order of
 // operations: covers() in rasterize.h for the coverage and barycentrics, and for the rays the
-// default-policy branch of the bake's sample_rays (from P + front N along -N over front + rear,
-// where P and N interpolate the triangle's corners and N is normalized, rounded to float).
-// tests/test_tile_kernels.cpp checks both bit for bit. A ray the definition makes by a special case
-// (a degenerate ray normal, a sample moved in from an edge) is flagged for the caller instead.
+// bake's sample_rays (pipeline/rays.h): without a cage from P + front N along -N over front + rear,
+// where P and N interpolate the triangle's corners and N is normalized, rounded to float; with one
+// cage_ray and inward_ray. tests/test_tile_kernels.cpp checks them bit for bit. A ray the
+// definition makes by a special case (a degenerate ray normal, a cage point on the low-poly, a
+// sample moved in from an edge) is flagged for the caller instead.
 #pragma once
 
 #include <cstddef>
@@ -21,18 +22,27 @@ namespace nmbake {
 // A tile's sample slots as arrays. Slot i holds the covering triangle tri[i] (-1: none yet), its
 // barycentrics b[0][i], b[1][i], b[2][i], and, when rays are made, the ray's origin and direction
 // in org[0..2][i], dir[0..2][i] (float), or ray_fallback[i] = 1 where the caller must make it.
+// With cage rays also each ray's far end tfar[i], the distance from P back to its origin base[i]
+// (sample_rays' signed_base) and where its preferred part begins, prefer_lo[i].
 struct SampleSlots {
   std::int32_t* tri;
   double* b[3];
   float* org[3];
   float* dir[3];
   std::uint8_t* ray_fallback;
+  float* tfar = nullptr;
+  double* base = nullptr;
+  float* prefer_lo = nullptr;
 };
 
-// Default-policy rays: the triangle's corners and the distances. Null `low`: no rays.
-struct DefaultRays {
+// The rays cover_rect makes. Null `low`: none. Else per triangle low[t] and, with `cage`, cage[t]
+// (the cage-first policy's inward rays, which reach a sample's own length; `diagonal` the
+// scene's, for the degenerate case), or without one the default rays from `front`.
+struct KernelRays {
   const LowTriangle* low = nullptr;
   float front = 0.0f;
+  const CageTriangle* cage = nullptr;
+  double diagonal = 1.0;
 };
 
 // For each texel (x, y), x0 <= x <= x1 and y0 <= y <= y1 (texel coordinates), the sample at
@@ -41,7 +51,7 @@ struct DefaultRays {
 // rays.low, the ray of low[t] there, unless the slot already holds a triangle. Returns how many
 // covered samples found their slot taken.
 std::size_t cover_rect(const TexelTriangle& tt, std::int32_t t, int x0, int x1, int y0, int y1, double ox, double oy,
-                       const DefaultRays& rays, const SampleSlots& slots, std::size_t first, std::size_t row_stride);
+                       const KernelRays& rays, const SampleSlots& slots, std::size_t first, std::size_t row_stride);
 
 // A tile's covered samples, in order, as arrays: triangle, barycentrics, texel of the tile and,
 // with rays, the ray's origin and direction and whether the caller must make the ray itself.
@@ -52,10 +62,14 @@ struct CoveredSamples {
   float* org[3];
   float* dir[3];
   std::uint8_t* ray_fallback;
+  float* tfar = nullptr;  // with cage rays (and SampleSlots' own)
+  double* base = nullptr;
+  float* prefer_lo = nullptr;
 };
 
 // Copies each slot i < slot_count that holds a triangle, in increasing i, to the next entry of
-// `out`: triangle, barycentrics, texel i % texels and, with `rays`, the ray and its fallback flag.
+// `out`: triangle, barycentrics, texel i % texels and, with `rays`, the ray and its fallback flag
+// (and tfar, base and prefer_lo where the slots have them).
 // Returns how many. Slot k * texels + t is sample k of texel t, so each texel's samples come in
 // sample order. texels must be at most 65536. `out` may be the slots' own arrays (except texel):
 // the compaction then works in place.
