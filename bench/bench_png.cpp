@@ -1,6 +1,7 @@
 // The PNG encoder's settings measured on a real map (the 1M-triangle sculpt's 2048^2 8-bit map of
 // section 3): zlib level, libpng's row filters and zlib's strategy against file size and encode
-// time, which is how PngSettings' defaults (baker/io/png_write.h) were chosen.
+// time, which is how PngSettings' defaults (baker/io/png_write.h) were chosen; and the default
+// settings in bands on several threads (io/png_parallel.h), as nmbake writes PNG.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -13,6 +14,7 @@
 #include "bench_bake.h"
 #include "bench_support.h"
 #include "io/image_io.h"
+#include "io/png_parallel.h"
 #include "io/png_write.h"
 
 namespace nmbake::bench {
@@ -27,6 +29,7 @@ bool fs_exists(const std::string& path) {
 struct Setting {
   const char* name;
   PngSettings s;
+  int threads = -1;  // -1: libpng's one stream (encode_png); else png_parallel's bands on this many (0: all cores)
 };
 
 }  // namespace
@@ -46,7 +49,9 @@ void run_png_settings(BenchRun& run, const Scenes& scenes) {
   std::vector<std::uint8_t> rows(image.pixels.size());
   for (std::size_t i = 0; i < rows.size(); ++i) rows[i] = std::uint8_t(std::lround(image.pixels[i] * 255.0f));
   const std::vector<Setting> settings = {
-      {"RLE strategy, paeth (the default)", PngSettings{}},
+      {"RLE strategy, paeth (the default), libpng, one thread", PngSettings{}},
+      {"the default in 8 bands, every core (what nmbake writes)", PngSettings{}, 0},
+      {"the default in 8 bands, one thread", PngSettings{}, 1},
       {"level 1, up (the settings before)", {1, 0x20, 0}},
       {"level 1, no filter", {1, 0x08, 0}},
       {"level 1, sub", {1, 0x10, 0}},
@@ -76,7 +81,9 @@ void run_png_settings(BenchRun& run, const Scenes& scenes) {
       const auto t0 = Clock::now();
       std::string error;
       const std::vector<unsigned char> bytes =
-          encode_png(rows.data(), image.width, image.height, image.channels, 8, {}, st.s, &error);
+          st.threads < 0
+              ? encode_png(rows.data(), image.width, image.height, image.channels, 8, {}, st.s, &error)
+              : encode_png_parallel(rows.data(), image.width, image.height, image.channels, 8, {}, st.s, st.threads, &error);
       best = std::min(best, since(t0));
       size = bytes.size();
     }

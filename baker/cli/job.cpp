@@ -119,6 +119,7 @@ void write_outputs(const JobEnv& env, OutputSet& outputs, const Args& a, const B
            (o.space == NormalSpace::object ? "" : (o.green_down ? "DirectX (Y-)" : "OpenGL (Y+)")) + ", baked by nmbake"}};
   wo.compression = a.compression;
   wo.dither = a.dither;
+  wo.threads = o.threads;
   const std::vector<MapFiles> files = map_files(a, r, udim);
   if (udim) check_tile_files(a, files);
   for (const MapFiles& f : files) {
@@ -131,6 +132,7 @@ void write_outputs(const JobEnv& env, OutputSet& outputs, const Args& a, const B
       check_signal();
       WriteOptions mo;
       mo.bits = default_bits_for(*path);
+      mo.threads = o.threads;
       mo.temp_path = outputs.add(*path);
       write_image(*path, *image, mo);
     }

@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "io/image_write.h"
+#include "io/png_parallel.h"
 
 namespace nmbake {
 namespace {
@@ -136,10 +137,12 @@ void write_png_image(const std::string& path, const Image& image, const WriteOpt
   std::vector<unsigned char> bytes;
   if (bits == 8) {
     const std::vector<std::uint8_t> rows = image_write::quantize8(image.pixels, options.dither);
-    bytes = encode_png(rows.data(), image.width, image.height, image.channels, 8, metadata, PngSettings{}, &error);
+    bytes = encode_png_parallel(rows.data(), image.width, image.height, image.channels, 8, metadata, PngSettings{},
+                                options.threads, &error);
   } else {
     const std::vector<std::uint16_t> rows = image_write::quantize16(image.pixels);
-    bytes = encode_png(rows.data(), image.width, image.height, image.channels, 16, metadata, PngSettings{}, &error);
+    bytes = encode_png_parallel(rows.data(), image.width, image.height, image.channels, 16, metadata, PngSettings{},
+                                options.threads, &error);
   }
   if (bytes.empty()) image_write::fail_write(path, error);
   image_write::write_file_bytes(path, bytes, options);

@@ -34,7 +34,8 @@ std::vector<unsigned char> encode_png(const void* rows, int width, int height, i
                                       const PngSettings& settings, std::string* error);
 
 // write_image (image_io.h) for a .png path: quantized as every writer does, encoded with the
-// default PngSettings, written to the temporary file and renamed as write_image documents.
+// default PngSettings on options.threads threads (png_parallel.h), written to the temporary file
+// and renamed as write_image documents.
 void write_png_image(const std::string& path, const Image& image, const WriteOptions& options);
 
 }  // namespace nmbake
