@@ -2,6 +2,8 @@
 // one without, bit for bit, while leaving the unreachable triangles out of the BVH.
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include "pipeline/bake.h"
 #include "core/cull.h"
 #include "test_support.h"
@@ -50,6 +52,36 @@ TEST(Cull, KeepsExactlyWhatTheMarginReaches) {
   EXPECT_EQ(triangles_near(regions, 100.0, pos, idx), (std::vector<std::uint32_t>{0, 1, 2}));
   const std::vector<std::uint32_t> only_far = {2};
   EXPECT_TRUE(triangles_near(regions, 0.6, pos, idx, &only_far).empty());
+}
+
+TEST(Cull, TheAnswerDoesNotDependOnTheThreads) {
+  // 300k random small triangles (several chunks of the parallel loop) against a few regions: the
+  // same triangles in the same order on 1, 2 and 3 threads, with and without candidates, and the
+  // answer is what each triangle's own test gives.
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<float> u(-4.0f, 4.0f), d(-0.05f, 0.05f);
+  std::vector<glm::vec3> pos;
+  for (int t = 0; t < 300000; ++t) {
+    const glm::vec3 c(u(rng), u(rng), u(rng));
+    for (int k = 0; k < 3; ++k) pos.push_back(c + glm::vec3(d(rng), d(rng), d(rng)));
+  }
+  const std::vector<std::uint32_t> idx = iota_indices(pos.size());
+  const std::vector<Box> regions = {{glm::dvec3(-1, -1, -1), glm::dvec3(0, 0.5, 0.2)},
+                                    {glm::dvec3(2, 2, 2), glm::dvec3(3, 3, 2.5)}};
+  const std::vector<std::uint32_t> one = triangles_near(regions, 0.1, pos, idx, nullptr, 1);
+  EXPECT_GT(one.size(), 1000u);
+  EXPECT_LT(one.size(), 100000u);
+  std::vector<std::uint32_t> odd;  // candidates: the odd triangles
+  for (std::uint32_t t = 1; t < 300000; t += 2) odd.push_back(t);
+  std::vector<std::uint32_t> one_odd;
+  for (std::uint32_t t : one)
+    if (t % 2) one_odd.push_back(t);
+  for (int threads : {2, 3}) {
+    EXPECT_EQ(triangles_near(regions, 0.1, pos, idx, nullptr, threads), one) << threads << " threads";
+    EXPECT_EQ(triangles_near(regions, 0.1, pos, idx, &odd, threads), one_odd) << threads << " threads";
+  }
+  for (std::uint32_t t : {one.front(), one.back()})
+    EXPECT_EQ(triangles_near(regions, 0.1, pos, {3 * t, 3 * t + 1, 3 * t + 2}).size(), 1u) << t;
 }
 
 TEST(Cull, ATriangleTouchingARegionIsKept) {

@@ -4,11 +4,13 @@
 #include <cmath>
 #include <limits>
 
+#include "core/parallel.h"
+
 namespace nmbake {
 
 std::vector<std::uint32_t> triangles_near(const std::vector<Box>& regions, double margin, const std::vector<glm::vec3>& positions,
-                                          const std::vector<std::uint32_t>& indices,
-                                          const std::vector<std::uint32_t>* candidates) {
+                                          const std::vector<std::uint32_t>& indices, const std::vector<std::uint32_t>* candidates,
+                                          int threads) {
   const std::size_t tris = indices.size() / 3;
   std::vector<std::uint32_t> kept;
   if (regions.empty()) return kept;
@@ -64,14 +66,22 @@ std::vector<std::uint32_t> triangles_near(const std::vector<Box>& regions, doubl
           if (marked[(std::size_t(z) * dim[1] + y) * dim[0] + x]) return true;
     return false;
   };
-  if (candidates) {
-    for (std::uint32_t t : *candidates)
-      if (near(t)) kept.push_back(t);
-  } else {
-    kept.reserve(tris);
-    for (std::size_t t = 0; t < tris; ++t)
-      if (near(t)) kept.push_back(std::uint32_t(t));
-  }
+  // In chunks on the threads, each chunk's triangles kept in order and the chunks joined in order:
+  // the answer does not depend on the threads.
+  const std::size_t count = candidates ? candidates->size() : tris;
+  constexpr std::size_t kChunk = std::size_t(1) << 16;
+  std::vector<std::vector<std::uint32_t>> parts((count + kChunk - 1) / kChunk);
+  parallel_chunks(threads, count, kChunk, [&](std::size_t begin, std::size_t end) {
+    std::vector<std::uint32_t>& part = parts[begin / kChunk];
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::uint32_t t = candidates ? (*candidates)[i] : std::uint32_t(i);
+      if (near(t)) part.push_back(t);
+    }
+  });
+  std::size_t total = 0;
+  for (const auto& part : parts) total += part.size();
+  kept.reserve(total);
+  for (const auto& part : parts) kept.insert(kept.end(), part.begin(), part.end());
   return kept;
 }
 

@@ -20,9 +20,10 @@ struct Box {
 
 // The high-poly triangles (index triples into `positions`) whose bounding box overlaps some box of
 // `regions` grown by `margin` on every side, in increasing order. `candidates`, when not null,
-// limits the answer to those triangles (themselves in increasing order).
+// limits the answer to those triangles (themselves in increasing order). `threads` share the
+// triangles (0: all cores); the answer does not depend on it.
 std::vector<std::uint32_t> triangles_near(const std::vector<Box>& regions, double margin, const std::vector<glm::vec3>& positions,
                                           const std::vector<std::uint32_t>& indices,
-                                          const std::vector<std::uint32_t>* candidates = nullptr);
+                                          const std::vector<std::uint32_t>* candidates = nullptr, int threads = 0);
 
 }  // namespace nmbake

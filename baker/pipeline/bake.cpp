@@ -180,7 +180,8 @@ void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const Ba
   } else {
     if (opt.cull_far && !keep)
       kept = select_reachable(
-          s, high, mode.probing ? mode.reach * 1.01 + 1e-6 * s.diagonal : ray_margin(s, mode.any_cage, opt.front, opt.rear));
+          s, high, mode.probing ? mode.reach * 1.01 + 1e-6 * s.diagonal : ray_margin(s, mode.any_cage, opt.front, opt.rear),
+          threads);
     st.high_duplicates_skipped = drop_duplicate_floods(s, high, threads, kept);
     announce_stage(opt, "building the BVH");
     stage = "building the BVH of " + std::to_string(kept.empty() ? high.triangle_count() : kept.size()) + " high-poly triangles";
@@ -203,7 +204,7 @@ void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const Ba
     double reach_out = 0.0;
     for (float d : result.vertex_search) reach_out = std::max(reach_out, double(d));
     stage = "building the BVH of the reachable high-poly triangles";
-    if (narrow_reachable(s, high, ray_margin(s, mode.any_cage, st.front, std::max<double>(st.rear, reach_out)), kept))
+    if (narrow_reachable(s, high, ray_margin(s, mode.any_cage, st.front, std::max<double>(st.rear, reach_out)), kept, threads))
       build_high_scene(scene, s, high, kept, bvh_quality_for(opt, kept.size()), opt.threads, nullptr, true);
     st.seconds_bvh += seconds_since(t0);
   }

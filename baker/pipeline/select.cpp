@@ -31,20 +31,20 @@ double ray_margin(const Prepared& s, bool cage, double front, double rear) {
   return 1.01 * (cage ? rear : std::max(front, rear)) + 1e-6 * s.diagonal;
 }
 
-std::vector<std::uint32_t> select_reachable(const Prepared& s, const Mesh& high, double margin) {
-  std::vector<std::uint32_t> kept = triangles_near(low_regions(s), margin, s.high_pos, high.position_index);
+std::vector<std::uint32_t> select_reachable(const Prepared& s, const Mesh& high, double margin, int threads) {
+  std::vector<std::uint32_t> kept = triangles_near(low_regions(s), margin, s.high_pos, high.position_index, nullptr, threads);
   if (kept.size() == high.triangle_count()) kept.clear();
   return kept;
 }
 
-bool narrow_reachable(const Prepared& s, const Mesh& high, double margin, std::vector<std::uint32_t>& kept) {
+bool narrow_reachable(const Prepared& s, const Mesh& high, double margin, std::vector<std::uint32_t>& kept, int threads) {
   std::vector<std::uint32_t> all;
   if (kept.empty()) {
     all.resize(high.triangle_count());
     for (std::size_t t = 0; t < all.size(); ++t) all[t] = std::uint32_t(t);
   }
   const std::vector<std::uint32_t>& current = kept.empty() ? all : kept;
-  std::vector<std::uint32_t> nearer = triangles_near(low_regions(s), margin, s.high_pos, high.position_index, &current);
+  std::vector<std::uint32_t> nearer = triangles_near(low_regions(s), margin, s.high_pos, high.position_index, &current, threads);
   if (!(double(nearer.size()) < 0.8 * double(current.size()))) return false;
   kept = std::move(nearer);
   return true;

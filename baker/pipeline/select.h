@@ -21,12 +21,12 @@ double ray_margin(const Prepared& s, bool cage, double front, double rear);
 
 // The high-poly triangles within `margin` of some region, increasing; empty when that is all of
 // them.
-std::vector<std::uint32_t> select_reachable(const Prepared& s, const Mesh& high, double margin);
+std::vector<std::uint32_t> select_reachable(const Prepared& s, const Mesh& high, double margin, int threads = 0);
 
 // Of the triangles `kept` (empty: all), those within `margin` of some region, increasing, when they
 // leave out a fifth of them or more (a rebuild then pays); else `kept` unchanged. Returns whether
 // `kept` changed.
-bool narrow_reachable(const Prepared& s, const Mesh& high, double margin, std::vector<std::uint32_t>& kept);
+bool narrow_reachable(const Prepared& s, const Mesh& high, double margin, std::vector<std::uint32_t>& kept, int threads = 0);
 
 // Groups of identical high-poly triangles (the same three corner positions, in the same winding)
 // larger than this are kept once in the BVH.
