@@ -73,7 +73,7 @@ void filter_row(int type, const unsigned char* cur, const unsigned char* prior, 
       for (std::size_t i = 0; i < first; ++i) o[i] = u8(cur[i] - prior[i] / 2);
       for (std::size_t i = first; i < n; ++i) o[i] = u8(cur[i] - (cur[i - bpp] + prior[i]) / 2);
       break;
-    default:  // 4, Paeth
+    default:                                                                 // 4, Paeth
       for (std::size_t i = 0; i < first; ++i) o[i] = u8(cur[i] - prior[i]);  // paeth(0, b, 0) = b
       for (std::size_t i = first; i < n; ++i) o[i] = u8(cur[i] - paeth(cur[i - bpp], prior[i], prior[i - bpp]));
       break;
