@@ -1,13 +1,16 @@
 // Tests of load_mesh() on PLY in every encoding and scalar type, written here value by value
 // (big-endian included), and on an OBJ sculpt rewritten as PLY.
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "io/mesh_io_detail.h"
 #include "mesh_io_test_helpers.h"
 
 namespace nmbake {
@@ -253,4 +256,133 @@ TEST(MeshIo, SculptObjAndPlyAgree) {
 }
 
 }  // namespace
+}  // namespace nmbake
+
+namespace nmbake {
+namespace {
+
+// A binary triangle mesh of n x n quads (two triangles each), large enough for several of the fast
+// path's chunks, with the properties asked for.
+std::string grid_ply(int n, const std::string& format, const std::string& coord, const std::string& count,
+                     const std::string& index, bool normals, bool uvs, bool extra) {
+  PlyElement before{"material", {{"uchar", "id", ""}}, {}};  // no rows: takes no bytes
+  PlyElement vertex{"vertex", {{coord, "x", ""}, {coord, "y", ""}, {coord, "z", ""}}, {}};
+  if (extra) vertex.properties.insert(vertex.properties.begin() + 1, {"uchar", "red", ""});
+  if (normals) vertex.properties.insert(vertex.properties.end(), {{"float", "nx", ""}, {"float", "ny", ""}, {"float", "nz", ""}});
+  if (uvs) vertex.properties.insert(vertex.properties.end(), {{"float", "s", ""}, {"float", "t", ""}});
+  for (int y = 0; y <= n; ++y)
+    for (int x = 0; x <= n; ++x) {
+      std::vector<std::vector<double>> row = {{x * 0.37 - 3.1}, {y * 0.29 + 1.7}, {std::sin(x * 0.1) * std::cos(y * 0.13)}};
+      if (extra) row.insert(row.begin() + 1, {double((x * 7 + y) % 256)});
+      if (normals) row.insert(row.end(), {{0.1}, {-0.2}, {0.97}});
+      if (uvs) row.insert(row.end(), {{x / double(n)}, {y / double(n)}});
+      vertex.rows.push_back(row);
+    }
+  PlyElement face{"face", {{index, "vertex_indices", count}}, {}};
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      const double a = y * (n + 1) + x, b = a + 1, c = a + n + 1, d = c + 1;
+      face.rows.push_back({{a, b, d}});
+      face.rows.push_back({{a, d, c}});
+    }
+  return make_ply(format, {before, vertex, face});
+}
+
+void expect_same_mesh(const mesh_io_detail::ParsedMesh& a, const mesh_io_detail::ParsedMesh& b, const std::string& what) {
+  const Mesh &m = a.mesh, &n = b.mesh;
+  EXPECT_EQ(std::memcmp(m.positions.data(), n.positions.data(), m.positions.size() * sizeof(glm::vec3)), 0) << what;
+  ASSERT_EQ(m.positions.size(), n.positions.size()) << what;
+  EXPECT_TRUE(a.exact_positions == b.exact_positions) << what;
+  EXPECT_TRUE(m.normals == n.normals) << what;
+  EXPECT_TRUE(m.uvs == n.uvs) << what;
+  EXPECT_TRUE(m.position_index == n.position_index) << what;
+  EXPECT_TRUE(m.uv_index == n.uv_index) << what;
+  EXPECT_TRUE(m.normal_index == n.normal_index) << what;
+  EXPECT_TRUE(m.source_face == n.source_face) << what;
+  EXPECT_EQ(a.corner_uvs, b.corner_uvs) << what;
+  EXPECT_EQ(a.corner_normals, b.corner_normals) << what;
+  EXPECT_EQ(a.format, b.format) << what;
+  EXPECT_EQ(a.file_faces, b.file_faces) << what;
+  EXPECT_EQ(a.faces, b.faces) << what;
+  EXPECT_EQ(a.faces_with_uvs, b.faces_with_uvs) << what;
+  EXPECT_EQ(a.faces_with_normals, b.faces_with_normals) << what;
+  EXPECT_EQ(a.first_face_without_uvs, b.first_face_without_uvs) << what;
+}
+
+}  // namespace
+
+TEST(MeshIo, PlyFastPathReadsWhatTheGeneralReaderReads) {
+  int fast = 0;
+  for (const std::string coord : {"float", "double", "short"})
+    for (const std::string count : {"uchar", "int"})
+      for (const std::string index : {"int", "uint"})
+        for (int props = 0; props < 4; ++props) {
+          const bool normals = props & 1, uvs = props & 2, extra = props == 3;
+          const std::string bytes = grid_ply(coord == "float" && index == "int" ? 190 : 20, "binary_little_endian", coord, count,
+                                             index, normals, uvs, extra);
+          const std::string what = coord + " " + count + " " + index + " props " + std::to_string(props);
+          const auto quick = mesh_io_detail::parse_ply("grid.ply", bytes, true);
+          const auto general = mesh_io_detail::parse_ply("grid.ply", bytes, false);
+          EXPECT_TRUE(quick.fast_path) << what;
+          EXPECT_FALSE(general.fast_path) << what;
+          expect_same_mesh(quick, general, what);
+          fast += quick.fast_path;
+        }
+  EXPECT_EQ(fast, 48);
+  // The shared sculpt, as every bench scene is written.
+  const std::string sculpt = shared_data_path("sculpts/suz_L4/high.ply");
+  if (std::filesystem::exists(sculpt)) {
+    const std::string bytes = test::read_file(sculpt);
+    const auto quick = mesh_io_detail::parse_ply(sculpt, bytes, true);
+    EXPECT_TRUE(quick.fast_path);
+    expect_same_mesh(quick, mesh_io_detail::parse_ply(sculpt, bytes, false), sculpt);
+  }
+}
+
+TEST(MeshIo, PlyFastPathLeavesEverythingElseToTheGeneralReader) {
+  std::string base = grid_ply(30, "binary_little_endian", "float", "uchar", "int", true, true, false);
+  const std::size_t data = base.find("end_header\n") + 11;
+  const std::size_t vertex_bytes = 31 * 31 * 32, face0 = data + vertex_bytes;
+  auto message = [](const std::string& bytes, bool fast) {
+    try {
+      mesh_io_detail::parse_ply("m.ply", bytes, fast);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  // Files it does not take: read as before, the same mesh.
+  std::vector<std::pair<std::string, std::string>> others = {
+      {"big-endian", grid_ply(30, "binary_big_endian", "float", "uchar", "int", true, true, false)},
+      {"ascii", grid_ply(5, "ascii", "float", "uchar", "int", false, false, false)},
+      {"short indices", grid_ply(30, "binary_little_endian", "float", "uchar", "short", false, true, false)}};
+  std::string quad = base;
+  quad[face0] = 4;  // the first face claims 4 corners: the next face's count becomes its 4th index...
+  others.push_back({"a face that is not a triangle", quad});
+  for (const auto& [what, bytes] : others) {
+    const std::string general = message(bytes, false);
+    ASSERT_EQ(message(bytes, true), general) << what;
+    if (general != "no error") continue;
+    const auto quick = mesh_io_detail::parse_ply("m.ply", bytes, true);
+    EXPECT_FALSE(quick.fast_path) << what;
+    expect_same_mesh(quick, mesh_io_detail::parse_ply("m.ply", bytes, false), what);
+  }
+  // Files it refuses: the general reader's message, naming the element.
+  std::string negative = base, far = base, nan = base;
+  const std::int32_t minus_one = -1, too_far = 31 * 31;
+  std::memcpy(&negative[face0 + 13 * 600 + 1], &minus_one, 4);
+  std::memcpy(&far[face0 + 1 + 4], &too_far, 4);
+  const float not_a_number = std::nanf("");
+  std::memcpy(&nan[data + 32 * 700 + 4], &not_a_number, 4);
+  for (const auto& [what, bytes] :
+       std::vector<std::pair<std::string, std::string>>{{"negative index", negative},
+                                                        {"index out of range", far},
+                                                        {"NaN", nan},
+                                                        {"truncated", base.substr(0, base.size() - 5)}}) {
+    const std::string general = message(bytes, false);
+    EXPECT_NE(general, "no error") << what;
+    EXPECT_EQ(message(bytes, true), general) << what;
+  }
+}
+
 }  // namespace nmbake

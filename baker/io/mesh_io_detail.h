@@ -33,7 +33,8 @@ struct ParsedMesh {
   std::vector<glm::dvec3> exact_positions;
   bool corner_uvs = true;
   bool corner_normals = true;
-  std::string format;  // see MeshLoadInfo::format
+  std::string format;      // see MeshLoadInfo::format
+  bool fast_path = false;  // the PLY reader's fast path read it (mesh_io_ply_types.h)
   std::size_t file_faces = 0;
   std::size_t faces = 0;  // faces that became triangles
   std::size_t polygons_triangulated = 0;
@@ -74,7 +75,9 @@ inline void start_object(ParsedMesh& out, const std::string& name) {
 [[noreturn]] inline void fail(const std::string& path, const std::string& problem) { throw InputError(path + ": " + problem); }
 
 ParsedMesh parse_obj(const std::string& path, std::string_view text);
-ParsedMesh parse_ply(const std::string& path, std::string_view bytes);
+// fast: binary triangle meshes take the PLY reader's fast path (mesh_io_ply_types.h) where they
+// can; false only to compare the two.
+ParsedMesh parse_ply(const std::string& path, std::string_view bytes, bool fast = true);
 ParsedMesh parse_off(const std::string& path, std::string_view text);
 ParsedMesh parse_stl(const std::string& path, std::string_view bytes);
 // Through Assimp (mesh_io_assimp.cpp): by `path` when `read_path` (a .gltf finds its .bin), else

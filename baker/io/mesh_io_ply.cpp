@@ -15,49 +15,12 @@
 #include <vector>
 
 #include "io/mesh_io_detail.h"
+#include "io/mesh_io_ply_types.h"
 
 namespace nmbake::mesh_io_detail {
 namespace {
 
-enum class Scalar { int8, uint8, int16, uint16, int32, uint32, float32, float64 };
-enum class Encoding { ascii, binary_little_endian, binary_big_endian };
-
-// What a property is for us; kNone is read past.
-enum Role { kNone, kX, kY, kZ, kNx, kNy, kNz, kU, kV, kIndices, kTexcoords };
-
-struct Property {
-  std::string name;
-  bool is_list = false;
-  Scalar count_type = Scalar::uint8;  // lists only
-  Scalar type = Scalar::float32;      // the scalar, or the list's items
-  Role role = kNone;
-};
-
-struct Element {
-  std::string name;
-  std::uint64_t count = 0;
-  std::vector<Property> properties;
-};
-
-struct Header {
-  Encoding encoding = Encoding::ascii;
-  std::vector<Element> elements;
-  std::size_t data_offset = 0;
-};
-
-unsigned scalar_size(Scalar t) {
-  switch (t) {
-    case Scalar::int8:
-    case Scalar::uint8: return 1;
-    case Scalar::int16:
-    case Scalar::uint16: return 2;
-    case Scalar::int32:
-    case Scalar::uint32:
-    case Scalar::float32: return 4;
-    case Scalar::float64: return 8;
-  }
-  return 0;
-}
+using namespace ply;
 
 bool is_integer_type(Scalar t) { return t != Scalar::float32 && t != Scalar::float64; }
 
@@ -196,33 +159,6 @@ Role vertex_role(const std::string& name, const Element& vertex) {
 
 // Scalar reading ------------------------------------------------------------------------------------
 
-constexpr bool kHostLittleEndian = __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__;
-
-template <typename T>
-T load(const char* p, bool swap) {
-  unsigned char raw[sizeof(T)];
-  std::memcpy(raw, p, sizeof(T));
-  if (swap)
-    for (std::size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(raw[i], raw[sizeof(T) - 1 - i]);
-  T value;
-  std::memcpy(&value, raw, sizeof(T));
-  return value;
-}
-
-double load_scalar(const char* p, Scalar t, bool swap) {
-  switch (t) {
-    case Scalar::int8: return load<std::int8_t>(p, swap);
-    case Scalar::uint8: return load<std::uint8_t>(p, swap);
-    case Scalar::int16: return load<std::int16_t>(p, swap);
-    case Scalar::uint16: return load<std::uint16_t>(p, swap);
-    case Scalar::int32: return load<std::int32_t>(p, swap);
-    case Scalar::uint32: return load<std::uint32_t>(p, swap);
-    case Scalar::float32: return static_cast<double>(load<float>(p, swap));
-    case Scalar::float64: return load<double>(p, swap);
-  }
-  return 0.0;
-}
-
 // A value for a message: integers without a fraction, anything else (NaN included) as is.
 std::string number_text(double v) {
   if (std::fabs(v) < 1e15 && v == std::floor(v)) return std::to_string(static_cast<long long>(v));
@@ -300,14 +236,6 @@ class DataReader {
 };
 
 // Data -----------------------------------------------------------------------------------------------
-
-struct Layout {
-  const Element* vertex = nullptr;
-  const Element* face = nullptr;
-  bool normals = false;
-  bool vertex_uvs = false;
-  bool face_texcoords = false;  // per-corner UVs on the faces; they win over vertex_uvs
-};
 
 Layout assign_roles(const std::string& path, Header& header) {
   Layout layout;
@@ -464,7 +392,7 @@ void reserve_triangles(ParsedMesh& out, const Header& header, const Element& fac
 
 }  // namespace
 
-ParsedMesh parse_ply(const std::string& path, std::string_view bytes) {
+ParsedMesh parse_ply(const std::string& path, std::string_view bytes, bool fast) {
   Header header = parse_header(path, bytes);
   const std::size_t data_bytes = bytes.size() - header.data_offset;
   check_counts_fit(path, header, data_bytes);
@@ -477,6 +405,11 @@ ParsedMesh parse_ply(const std::string& path, std::string_view bytes) {
   // Vertex counts were checked against the file size, so these allocations are backed by data.
   const Element& vertex = *layout.vertex;
   if (vertex.count > UINT32_MAX) fail(path, "more than 2^32-1 vertices");
+  if (fast) {
+    ParsedMesh quick;
+    quick.format = out.format;
+    if (parse_fast(header, layout, bytes.substr(header.data_offset), quick)) return quick;
+  }
   Mesh& m = out.mesh;
   m.positions.resize(vertex.count);
   out.exact_positions.resize(vertex.count);
