@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "pipeline/adaptive_levels.h"
 #include "pipeline/workers.h"
 #include "trace/shade_batch.h"
 #include "trace/tile_kernels.h"
@@ -17,32 +18,6 @@ constexpr std::size_t kTilesPerGrab = 4;  // consecutive tiles a trace thread ta
 // Tangent components this close to zero are written as exactly 0: a flat result is then
 // (128,128,255) and not a coin flip between 127 and 128 decided by float noise.
 constexpr double kSnap = 1e-6;
-
-// The 2x2 Gauss-Legendre points of a texel, (1 -+ 1/sqrt(3)) / 2 on each axis: their equal-weight
-// mean integrates a normal varying as a cubic across the texel exactly, where a stratified 4x4
-// grid leaves an error of 1/384 of the second derivative times the texel size squared.
-std::vector<glm::dvec2> gauss_legendre_offsets() {
-  const double a = 0.5 - 0.5 / std::sqrt(3.0), b = 0.5 + 0.5 / std::sqrt(3.0);
-  return {{a, a}, {b, a}, {a, b}, {b, b}};
-}
-
-// Adaptive sampling's passes after the first: the texels whose samples so far disagree are baked
-// again with `offsets` (a square grid, so a texel then holds exactly a fixed bake's value with that
-// many). A sample farther than the level's angle from its texel's mean refines the texel.
-struct RefineLevel {
-  std::vector<glm::dvec2> offsets;
-  double cos_max = 1.0;
-  bool partial = false;  // also the texels an island's edge cuts (fewer samples than offsets)
-};
-
-std::vector<RefineLevel> refine_levels(const BakeOptions& o) {
-  if (!o.adaptive) return {};
-  const double rad = o.max_error_deg * (3.14159265358979323846 / 180.0);
-  std::vector<RefineLevel> levels{{sample_offsets(o.samples), std::cos(rad), true}};
-  if (o.deep_factor > 0.0 && 4 * o.samples <= kMaxSamples)
-    levels.push_back({sample_offsets(4 * o.samples), std::cos(std::min(o.deep_factor * rad, 1.5)), false});
-  return levels;
-}
 
 // One cache line each: the counters change per sample, and shared lines would serialize threads.
 struct alignas(64) ThreadStats {
@@ -291,17 +266,30 @@ class TileTracer {
                             cage ? prefer_lo_.data() : nullptr};
     const KernelRays kernel_rays{kernel_rays_ ? sh_.s.low_tris.data() : nullptr, sh_.setup.front,
                                  cage ? sh_.s.cage_tris.data() : nullptr, sh_.setup.diagonal};
+    // A refining pass covers, row by row, only the span of the row's marked texels: a slot's result
+    // does not depend on the rectangle it is covered in, and the others are dropped below.
+    if (only) mark_spans(only, tw, th);
+    const auto cover = [&](const TexelTriangle& tt, std::uint32_t t, int x0, int x1, int y0, int y1) {
+      for (std::size_t k = 0; k < offsets.size(); ++k) {
+        const std::size_t taken = cover_rect(
+            tt, std::int32_t(t), x0, x1, y0, y1, offsets[k].x, offsets[k].y, kernel_rays, slots,
+            (k * std::size_t(side_) + std::size_t(y0 - ty0)) * std::size_t(side_) + std::size_t(x0 - tx0), std::size_t(side_));
+        if (!only) ts_.overlaps += taken;  // a refining pass covers again what the first counted
+      }
+    };
     for (std::uint32_t bi = bins.start[tile]; bi < bins.start[tile + 1]; ++bi) {
       const std::uint32_t t = bins.tris[bi];
       const TexelTriangle& tt = bins.texel_tris[t];
       const int x0 = std::max(tt.xmin, tx0), x1 = std::min(tt.xmax, tx0 + tw - 1);
       const int y0 = std::max(tt.ymin, ty0), y1 = std::min(tt.ymax, ty0 + th - 1);
       if (x1 < x0 || y1 < y0) continue;
-      for (std::size_t k = 0; k < offsets.size(); ++k) {
-        const std::size_t taken = cover_rect(
-            tt, std::int32_t(t), x0, x1, y0, y1, offsets[k].x, offsets[k].y, kernel_rays, slots,
-            (k * std::size_t(side_) + std::size_t(y0 - ty0)) * std::size_t(side_) + std::size_t(x0 - tx0), std::size_t(side_));
-        if (!only) ts_.overlaps += taken;  // a refining pass covers again what the first counted
+      if (!only) {
+        cover(tt, t, x0, x1, y0, y1);
+        continue;
+      }
+      for (int y = y0; y <= y1; ++y) {
+        const auto [lo, hi] = span_[std::size_t(y - ty0)];
+        if (std::max(x0, tx0 + lo) <= std::min(x1, tx0 + hi)) cover(tt, t, std::max(x0, tx0 + lo), std::min(x1, tx0 + hi), y, y);
       }
     }
     if (only)
@@ -318,6 +306,15 @@ class TileTracer {
                                  slots.prefer_lo};
     last_sample_count_ = compact_samples(slots, slot_count, tile_texels_, kernel_rays_, covered);
     return last_sample_count_;
+  }
+
+  // Per row of the tile, the first and last texel `only` marks (first > last: none).
+  void mark_spans(const std::uint8_t* only, int tw, int th) {
+    span_.assign(std::size_t(th), {side_, -1});
+    for (int y = 0; y < th; ++y)
+      for (int x = 0; x < tw; ++x)
+        if (only[std::size_t(y) * std::size_t(side_) + std::size_t(x)])
+          span_[std::size_t(y)] = {std::min(span_[std::size_t(y)].first, x), x};
   }
 
   // The rays the coverage did not make, one at a time: the closest-hit policy's, and the cage-first
@@ -490,9 +487,10 @@ class TileTracer {
   std::vector<double> acc_;                  // per texel of the tile: x, y, z sums and covered samples, as arrays
   TexelSums sums_;
   std::vector<std::uint32_t> miss_count_;
-  std::vector<std::uint8_t> refine_;   // adaptive: per texel of the tile, baked again by the next level's pass
-  std::size_t last_sample_count_ = 0;  // covered samples of the last cover_tile
-  std::vector<double> first_acc_;      // adaptive: the sums so far while a refining pass runs
+  std::vector<std::uint8_t> refine_;       // adaptive: per texel of the tile, baked again by the next level's pass
+  std::vector<std::pair<int, int>> span_;  // adaptive: per row of the tile, its marked texels' span (mark_spans)
+  std::size_t last_sample_count_ = 0;      // covered samples of the last cover_tile
+  std::vector<double> first_acc_;          // adaptive: the sums so far while a refining pass runs
   std::vector<std::uint32_t> first_miss_;
 };
 
