@@ -339,6 +339,22 @@ TEST(RaycastRule, MatchesBruteForceOnClosedTorus) {
   EXPECT_GT(passed, 100) << "too few rays met a back face first";
 }
 
+namespace {
+
+// The rays traced as plain packets and as coherent ones (RayBatch::coherent), under `rule` (null:
+// none).
+std::pair<raycast::RayArrays, raycast::RayArrays> trace_both(const raycast::Scene& scene, const std::vector<raycast::Ray>& rays,
+                                                             const raycast::HitRule* rule) {
+  raycast::RayArrays plain(rays.data(), rays.size()), coherent(rays.data(), rays.size());
+  scene.intersect(plain.rays(), plain.hits(), plain.size(), rule);
+  raycast::RayBatch batch = coherent.rays();
+  batch.coherent = true;
+  scene.intersect(batch, coherent.hits(), coherent.size(), rule);
+  return {std::move(plain), std::move(coherent)};
+}
+
+}  // namespace
+
 TEST(Raycast, CoherentPacketsGiveTheSameHits) {
   // Rows of parallel rays, eight neighbours per packet as a bake casts them, onto a torus: rows
   // from above it, and rows from its middle plane (those inside the tube meet a back face first).
@@ -354,11 +370,7 @@ TEST(Raycast, CoherentPacketsGiveTheSameHits) {
       rays.push_back({{-1.6f + 0.032f * float(x), -1.6f + 0.033f * float(y), y % 2 ? 2.0f : 0.0f}, 0.0f, dir, 6.0f});
   const raycast::HitRule rule;
   for (const raycast::HitRule* r : {static_cast<const raycast::HitRule*>(nullptr), &rule}) {
-    raycast::RayArrays plain(rays.data(), rays.size()), coherent(rays.data(), rays.size());
-    scene.intersect(plain.rays(), plain.hits(), plain.size(), r);
-    raycast::RayBatch batch = coherent.rays();
-    batch.coherent = true;
-    scene.intersect(batch, coherent.hits(), coherent.size(), r);
+    const auto [plain, coherent] = trace_both(scene, rays, r);
     std::size_t hits = 0, passed = 0;
     for (std::size_t i = 0; i < rays.size(); ++i) {
       const raycast::Hit a = plain.hit(i), b = coherent.hit(i);
@@ -416,11 +428,7 @@ TEST(Raycast, CoherentPacketsWithDirectionsNearAnAxisPlane) {
     }
   const raycast::HitRule rule;
   for (const raycast::HitRule* rp : {static_cast<const raycast::HitRule*>(nullptr), &rule}) {
-    raycast::RayArrays plain(rays.data(), rays.size()), coherent(rays.data(), rays.size());
-    scene.intersect(plain.rays(), plain.hits(), plain.size(), rp);
-    raycast::RayBatch batch = coherent.rays();
-    batch.coherent = true;
-    scene.intersect(batch, coherent.hits(), coherent.size(), rp);
+    const auto [plain, coherent] = trace_both(scene, rays, rp);
     std::size_t misses = 0;
     for (std::size_t i = 0; i < rays.size(); ++i) {
       const raycast::Hit a = plain.hit(i), b = coherent.hit(i);
