@@ -95,6 +95,11 @@ std::vector<std::uint16_t> quantize16(const Image::Pixels& values) { return quan
 // The EXR and TIFF writers stamp the current time into "DateTime", so two identical bakes differ
 // in a few bytes. With SOURCE_DATE_EPOCH set (seconds since 1970, the reproducible-builds
 // convention) that time is used instead and identical bakes give identical files.
+bool date_time_fields(const std::string& text, int fields[6]) {
+  int* f = fields;
+  return std::sscanf(text.c_str(), "%d:%d:%d %d:%d:%d", &f[0], &f[1], &f[2], &f[3], &f[4], &f[5]) == 6;
+}
+
 std::string reproducible_date_time() {
   const char* epoch = std::getenv("SOURCE_DATE_EPOCH");
   if (!epoch || !*epoch) return "";

@@ -24,6 +24,10 @@ std::vector<std::uint16_t> quantize16(const Image::Pixels& values);
 // "YYYY:MM:DD HH:MM:SS" (UTC) of SOURCE_DATE_EPOCH, or "" when it is unset or malformed.
 std::string reproducible_date_time();
 
+// "YYYY:MM:DD HH:MM:SS" (the DateTime metadata item) as year, month, day, hour, minute, second;
+// false when it is not that. The PNG writers store it as a tIME chunk.
+bool date_time_fields(const std::string& text, int fields[6]);
+
 // Throws OutputError "<path>: cannot write: <reason>", or ResourceError (exit 4) when the reason is
 // memory running out.
 [[noreturn]] void fail_write(const std::string& path, const std::string& reason);

@@ -4,12 +4,12 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <new>
 
 #include "core/parallel.h"
+#include "io/image_write.h"
 
 namespace nmbake {
 namespace {
@@ -153,9 +153,9 @@ bool valid_keyword(const std::string& key) {
 
 // "YYYY:MM:DD HH:MM:SS" as a tIME chunk's 7 bytes; false when it is not that.
 bool time_bytes(const std::string& text, unsigned char t[7]) {
-  int year, month, day, hour, minute, second;
-  if (std::sscanf(text.c_str(), "%d:%d:%d %d:%d:%d", &year, &month, &day, &hour, &minute, &second) != 6) return false;
-  const int v[7] = {year >> 8, year & 0xff, month, day, hour, minute, second};
+  int f[6];
+  if (!image_write::date_time_fields(text, f)) return false;
+  const int v[7] = {f[0] >> 8, f[0] & 0xff, f[1], f[2], f[3], f[4], f[5]};
   for (int k = 0; k < 7; ++k) t[k] = static_cast<unsigned char>(v[k]);
   return true;
 }

@@ -72,9 +72,9 @@ bool run_encoder(png_structp png, png_infop info, Sink* sink, const Encode& e) {
 
 // "YYYY:MM:DD HH:MM:SS" as a tIME; false when it is not that.
 bool parse_date_time(const std::string& text, png_time* t) {
-  int year, month, day, hour, minute, second;
-  if (std::sscanf(text.c_str(), "%d:%d:%d %d:%d:%d", &year, &month, &day, &hour, &minute, &second) != 6) return false;
-  *t = {png_uint_16(year), png_byte(month), png_byte(day), png_byte(hour), png_byte(minute), png_byte(second)};
+  int f[6];
+  if (!image_write::date_time_fields(text, f)) return false;
+  *t = {png_uint_16(f[0]), png_byte(f[1]), png_byte(f[2]), png_byte(f[3]), png_byte(f[4]), png_byte(f[5])};
   return true;
 }
 
