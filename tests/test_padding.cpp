@@ -1,8 +1,11 @@
+#include <algorithm>
+#include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
 
 #include "core/padding.h"
+#include "pipeline/pad.h"
 
 using namespace nmbake;
 
@@ -75,4 +78,70 @@ TEST(Padding, SameResultWithOneOrTwoThreads) {
   EXPECT_GT(n1, 0u);
   EXPECT_EQ(n1, n2);
   EXPECT_TRUE(one.pixels == two.pixels);
+}
+
+// The pad stage (pipeline/pad.h) against a plain count of what it is documented to do: the
+// background set to the flat normal, texels facing away and suspect texels counted, the mask
+// written, the region found, and all of it the same on 1, 2 and 3 threads.
+TEST(Padding, PadMapCountsMatchAPlainCountOnAnyThreads) {
+  std::mt19937 rng(23);
+  BakeOptions o;
+  o.width = 211;
+  o.height = 150;  // more bands than threads, the last one short
+  o.samples = 4;
+  o.padding = 5;
+  o.suspect_mask = true;
+  const std::size_t n = std::size_t(o.width) * o.height;
+  BakeResult in;
+  in.map = Image(o.width, o.height, 3, -7.0f);
+  in.coverage.assign(n, 0);
+  std::vector<std::uint8_t> disagree(n, 0);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  for (std::size_t i = 0; i < n; ++i) {
+    const int x = int(i % std::size_t(o.width)), y = int(i / std::size_t(o.width));
+    if ((x - 150) * (x - 150) + (y - 40) * (y - 40) > 900 && x > 20) continue;  // a disc and a strip: the rest background
+    in.coverage[i] = 1;
+    for (int c = 0; c < 3; ++c) in.map.pixels[3 * i + c] = unit(rng);
+    disagree[i] = unit(rng) < 0.05f;
+    in.stats.texels_covered++;
+  }
+  const float z_limit = float(0.5 + 0.5 * std::cos(kSuspectTiltDeg * 3.14159265358979323846 / 180.0));
+  std::size_t facing = 0, suspect = 0, cell[8][8] = {};
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!in.coverage[i]) continue;
+    const float z = in.map.pixels[3 * i + 2];
+    facing += z < 0.5f;
+    if (z < z_limit || disagree[i]) {
+      ++suspect;
+      ++cell[8 * (i / std::size_t(o.width)) / std::size_t(o.height)][8 * (i % std::size_t(o.width)) / std::size_t(o.width)];
+    }
+  }
+  ASSERT_GT(suspect, 100u);
+  std::size_t best = 0;
+  for (auto& row : cell)
+    for (std::size_t c : row) best = std::max(best, c);
+  for (int threads : {1, 2, 3}) {
+    BakeResult r = in;
+    pad_map(o, disagree, threads, r);
+    EXPECT_EQ(r.stats.texels_facing_away, facing);
+    EXPECT_EQ(r.stats.suspect_texels, suspect);
+    EXPECT_EQ(r.stats.suspect_region_share, double(best) / double(suspect));
+    std::size_t marked = 0, flat = 0;  // flat: background texels that are not (0.5, 0.5, 1)
+    for (std::size_t i = 0; i < n; ++i) {
+      marked += r.suspect_mask.pixels[i] == 1.0f;
+      EXPECT_TRUE(r.suspect_mask.pixels[i] == 0.0f || r.suspect_mask.pixels[i] == 1.0f);
+      if (!in.coverage[i]) continue;
+      for (int c = 0; c < 3; ++c) ASSERT_EQ(r.map.pixels[3 * i + c], in.map.pixels[3 * i + c]) << "a covered texel moved";
+    }
+    EXPECT_EQ(marked, suspect);
+    // Beyond the padding's reach (x > 26 and away from the disc): the flat normal.
+    for (std::size_t i = 0; i < n; ++i) {
+      const int x = int(i % std::size_t(o.width)), y = int(i / std::size_t(o.width));
+      if (x > 26 && (x - 150) * (x - 150) + (y - 40) * (y - 40) > 36 * 36) {
+        flat += !(r.map.pixels[3 * i] == 0.5f && r.map.pixels[3 * i + 1] == 0.5f && r.map.pixels[3 * i + 2] == 1.0f);
+      }
+    }
+    EXPECT_EQ(flat, 0u) << "a background texel is not (0.5, 0.5, 1)";
+    EXPECT_GT(r.stats.texels_padded, 0u);
+  }
 }

@@ -81,8 +81,10 @@ std::size_t pad_islands(Image& image, const std::vector<std::uint8_t>& covered, 
   // Pass 1, columns: squared distance to the nearest covered texel in the same column. Columns go
   // in blocks of kBlock neighbours, so the image is read and written a row segment at a time.
   constexpr int kBlock = 16;
-  std::vector<double> g(n);
-  std::vector<int> gy(n);
+  // Left unset: pass 1 writes every texel's, on every thread (the first touch of this memory, and
+  // the system's zeroing of it, is shared out too).
+  std::vector<double, DefaultInitAllocator<double>> g(n);
+  std::vector<int, DefaultInitAllocator<int>> gy(n);
   const int m = std::max(w, h);
   parallel((w + kBlock - 1) / kBlock, [&](int block) {
     const int x0 = block * kBlock, nb = std::min(kBlock, w - x0);

@@ -4,30 +4,62 @@
 #include <cmath>
 
 #include "core/padding.h"
+#include "core/parallel.h"
 
 namespace nmbake {
 
 namespace {
 
-// Suspect texels (BakeStats::suspect_texels) from the map before padding and the texels whose
-// samples disagree; their mask and the UV region most of them lie in.
-void find_suspects(const BakeOptions& opt, const std::vector<std::uint8_t>& disagree, BakeResult& result) {
-  BakeStats& st = result.stats;
+constexpr int kBandRows = 32;  // rows per part of the pass before padding
+
+// What one band of rows holds: counts summed over the bands in order, so the same whichever
+// thread took which band.
+struct BandCounts {
+  std::size_t facing_away = 0;
+  std::size_t suspect = 0;
+  std::size_t cells[8][8] = {};  // suspect texels per cell of an 8 x 8 grid, row 0 the top (v = 1)
+};
+
+// One band: the background set to the flat normal, and the suspect texels (BakeStats::
+// suspect_texels: tilted past kSuspectTiltDeg, or samples disagreeing) counted and marked.
+void scan_band(const BakeOptions& opt, const std::vector<std::uint8_t>& disagree, int band, BakeResult& result, BandCounts& out) {
   const int W = opt.width, H = opt.height;
+  const bool tangent = opt.space == NormalSpace::tangent;
+  const float flat[3] = {0.5f, 0.5f, tangent ? 1.0f : 0.5f};
   // The encoded z of a tangent-space normal tilted kSuspectTiltDeg from (0, 0, 1).
   const float z_limit = float(0.5 + 0.5 * std::cos(kSuspectTiltDeg * 3.14159265358979323846 / 180.0));
-  if (opt.suspect_mask) result.suspect_mask = Image(W, H, 1, 0.0f);
-  std::size_t cells[8][8] = {};
-  for (int y = 0; y < H; ++y)
+  float* const map = result.map.pixels.data();
+  float* const mask = opt.suspect_mask ? result.suspect_mask.pixels.data() : nullptr;
+  for (int y = band * kBandRows; y < std::min(H, (band + 1) * kBandRows); ++y) {
+    const int cell_row = std::min(7, 8 * y / H);
     for (int x = 0; x < W; ++x) {
       const std::size_t i = std::size_t(y) * W + std::size_t(x);
-      if (!result.coverage[i]) continue;
-      const bool tilted = opt.space == NormalSpace::tangent && result.map.pixels[3 * i + 2] < z_limit;
-      if (!tilted && (disagree.empty() || !disagree[i])) continue;
-      ++st.suspect_texels;
-      if (opt.suspect_mask) result.suspect_mask.pixels[i] = 1.0f;
-      ++cells[std::min(7, 8 * y / H)][std::min(7, 8 * x / W)];  // row 0 is the top: v = 1
+      float* const texel = map + 3 * i;
+      bool suspect = false;
+      if (!result.coverage[i]) {
+        texel[0] = flat[0], texel[1] = flat[1], texel[2] = flat[2];
+      } else {
+        out.facing_away += tangent && texel[2] < 0.5f;
+        suspect = (tangent && texel[2] < z_limit) || (!disagree.empty() && disagree[i]);
+        if (suspect) {
+          ++out.suspect;
+          ++out.cells[cell_row][std::min(7, 8 * x / W)];
+        }
+      }
+      if (mask) mask[i] = suspect ? 1.0f : 0.0f;
     }
+  }
+}
+
+// The sums of the bands, and the UV region most suspect texels lie in.
+void sum_bands(const std::vector<BandCounts>& bands, BakeStats& st) {
+  std::size_t cells[8][8] = {};
+  for (const BandCounts& b : bands) {
+    st.texels_facing_away += b.facing_away;
+    st.suspect_texels += b.suspect;
+    for (int r = 0; r < 8; ++r)
+      for (int c = 0; c < 8; ++c) cells[r][c] += b.cells[r][c];
+  }
   if (!st.suspect_texels) return;
   st.suspect_share = st.texels_covered ? double(st.suspect_texels) / double(st.texels_covered) : 0.0;
   int best_r = 0, best_c = 0;
@@ -45,14 +77,12 @@ void find_suspects(const BakeOptions& opt, const std::vector<std::uint8_t>& disa
 
 void pad_map(const BakeOptions& opt, const std::vector<std::uint8_t>& disagree, int threads, BakeResult& result) {
   BakeStats& st = result.stats;
-  const float flat[3] = {0.5f, 0.5f, opt.space == NormalSpace::tangent ? 1.0f : 0.5f};
-  for (std::size_t i = 0; i < result.coverage.size(); ++i)
-    if (!result.coverage[i])
-      for (int c = 0; c < 3; ++c) result.map.pixels[3 * i + c] = flat[c];
-  if (opt.space == NormalSpace::tangent)
-    for (std::size_t i = 0; i < result.coverage.size(); ++i)
-      st.texels_facing_away += result.coverage[i] && result.map.pixels[3 * i + 2] < 0.5f;
-  find_suspects(opt, disagree, result);
+  if (opt.suspect_mask) result.suspect_mask = Image(opt.width, opt.height, 1, Image::Unset{});  // scan_band writes each
+  std::vector<BandCounts> bands(std::size_t((opt.height + kBandRows - 1) / kBandRows));
+  parallel_chunks(threads, bands.size(), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t b = begin; b < end; ++b) scan_band(opt, disagree, int(b), result, bands[b]);
+  });
+  sum_bands(bands, st);
   st.texels_padded = pad_islands(result.map, result.coverage, opt.padding, threads);
 }
 
