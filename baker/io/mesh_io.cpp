@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <new>
 #include <string>
 #include <string_view>
@@ -52,39 +53,48 @@ void check_regular_file(const std::string& path) {
   if (!S_ISREG(st.st_mode)) fail(path, "is not a regular file");
 }
 
-// The whole file in one read.
-std::string read_file(const std::string& path) {
-  int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) fail(path, cannot_open(errno));
-  struct stat st {};
-  if (::fstat(fd, &st) != 0) {
-    int error = errno;
-    ::close(fd);
-    fail(path, cannot_open(error));
-  }
-  std::string bytes;
-  try {
-    bytes.resize(static_cast<std::size_t>(st.st_size));
-  } catch (const std::bad_alloc&) {
-    ::close(fd);
-    throw ResourceError(path + ": out of memory reading " + std::to_string(st.st_size) + " bytes");
-  }
-  std::size_t done = 0;
-  while (done < bytes.size()) {
-    ssize_t n = ::read(fd, bytes.data() + done, bytes.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) {
+// The whole file in one read, into memory left unset (a std::string would be zeroed first: a
+// third pass over the 25 MB of a 1M-triangle sculpt). Mapping the file instead was 0.015 s faster
+// still, but raised the bake's peak memory by 16 MiB in most runs of that sculpt: the C library
+// sizes its later allocations by the largest block freed so far, and this one was it.
+class FileBytes {
+ public:
+  explicit FileBytes(const std::string& path) {
+    int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) fail(path, cannot_open(errno));
+    struct stat st {};
+    if (::fstat(fd, &st) != 0) {
       int error = errno;
       ::close(fd);
-      fail(path, std::string("cannot read: ") + std::strerror(error));
+      fail(path, cannot_open(error));
     }
-    if (n == 0) break;  // the file shrank while we read it
-    done += static_cast<std::size_t>(n);
+    const std::size_t size = static_cast<std::size_t>(st.st_size);
+    try {
+      bytes_.reset(new char[std::max<std::size_t>(size, 1)]);
+    } catch (const std::bad_alloc&) {
+      ::close(fd);
+      throw ResourceError(path + ": out of memory reading " + std::to_string(size) + " bytes");
+    }
+    while (size_ < size) {
+      ssize_t n = ::read(fd, bytes_.get() + size_, size - size_);
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) {
+        int error = errno;
+        ::close(fd);
+        fail(path, std::string("cannot read: ") + std::strerror(error));
+      }
+      if (n == 0) break;  // the file shrank while we read it
+      size_ += static_cast<std::size_t>(n);
+    }
+    ::close(fd);
   }
-  ::close(fd);
-  bytes.resize(done);
-  return bytes;
-}
+
+  std::string_view view() const { return {bytes_.get(), size_}; }
+
+ private:
+  std::unique_ptr<char[]> bytes_;
+  std::size_t size_ = 0;
+};
 
 bool is_whitespace_only(std::string_view bytes) {
   for (char c : bytes)
@@ -302,7 +312,8 @@ Mesh load_mesh(const std::string& path, const LoadOptions& options, MeshLoadInfo
   try {
     check_regular_file(path);
     check_extension(path);
-    return parse_bytes(path, read_file(path), options, out_info, true);
+    const FileBytes bytes(path);
+    return parse_bytes(path, bytes.view(), options, out_info, true);
   } catch (const std::bad_alloc&) {
     throw ResourceError(path + ": out of memory while loading");
   } catch (const std::length_error&) {
