@@ -130,3 +130,46 @@ TEST(MeshTopology, FacesTurnedInANonOrientablePieceFollowTheEdgeOrder) {
     for (std::size_t c = 0; c < n.size(); ++c) EXPECT_EQ(n[c], unit_or_up(sum[m.position_index[c]])) << "corner " << c;
   }
 }
+
+// A grid large enough for many chunks of vertices: the counts are those of the grid, whatever the
+// threads, and with faces turned, repeated and a fin added, the counts and normals are the same on
+// 1, 2 and 3 threads.
+TEST(MeshTopology, CountsAndNormalsDoNotDependOnTheThreads) {
+  const int n = 150;  // n x n quads, (n + 1)^2 = 22801 vertices
+  std::vector<glm::vec3> positions;
+  std::vector<std::uint32_t> index;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) positions.push_back({float(i), float(j), 0.01f * float((i * 7 + j * 3) % 5)});
+  auto v = [&](int i, int j) { return std::uint32_t(j * (n + 1) + i); };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      for (std::uint32_t k : {v(i, j), v(i + 1, j), v(i + 1, j + 1)}) index.push_back(k);
+      for (std::uint32_t k : {v(i, j), v(i + 1, j + 1), v(i, j + 1)}) index.push_back(k);
+    }
+  const Mesh grid = make_mesh(positions, index);
+  for (int threads : {1, 2, 3})
+    expect_counts(inspect_topology(grid, threads), {positions.size(), 0, 0, std::size_t(4 * n), 0, 0});
+
+  // Every 37th face turned, every 101st repeated (rotated), a fin on the diagonal of the first quad.
+  std::vector<std::uint32_t> messy = index;
+  for (std::size_t t = 0; t < index.size() / 3; t += 37) std::swap(messy[3 * t + 1], messy[3 * t + 2]);
+  for (std::size_t t = 5; t < index.size() / 3; t += 101)
+    for (int k : {1, 2, 0}) messy.push_back(index[3 * t + std::size_t(k)]);
+  positions.push_back({0.5f, 0.0f, 3.0f});
+  for (std::uint32_t k : {index[0], index[2], std::uint32_t(positions.size() - 1)}) messy.push_back(k);
+  const Mesh m = make_mesh(positions, messy);
+  const MeshTopology one = inspect_topology(m, 1);
+  EXPECT_EQ(one.duplicate_faces, (index.size() / 3 - 5 + 100) / 101);
+  EXPECT_EQ(one.non_manifold_edges, 1u);
+  EXPECT_EQ(one.inconsistent_winding_faces, (index.size() / 3 + 36) / 37);
+  std::size_t reoriented_one = 0;
+  const std::vector<glm::vec3> normals_one = compute_high_corner_normals(m, &reoriented_one, 1);
+  for (int threads : {2, 3}) {
+    const MeshTopology t = inspect_topology(m, threads);
+    expect_counts(t, {one.welded_vertices, one.isolated_vertices, one.duplicate_faces, one.boundary_edges, one.non_manifold_edges,
+                      one.inconsistent_winding_faces});
+    std::size_t reoriented = 0;
+    EXPECT_TRUE(compute_high_corner_normals(m, &reoriented, threads) == normals_one);
+    EXPECT_EQ(reoriented, reoriented_one);
+  }
+}

@@ -1,8 +1,10 @@
 #include "core/mesh_topology.h"
 
 #include "core/normals.h"
+#include "core/parallel.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cstring>
 #include <utility>
 
@@ -110,12 +112,12 @@ VertexFaces list_faces_by_vertex(std::size_t ids, Analysis& a) {
 using FacePairs = std::vector<std::pair<std::uint64_t, std::uint32_t>>;
 
 // Marks the duplicates among `pairs` (in face order): each face whose pair an earlier one has.
-// Whether there were any.
-bool mark_duplicates(FacePairs& pairs, Analysis& a) {
-  const std::size_t before = a.topo.duplicate_faces;
+// How many.
+std::size_t mark_duplicates(FacePairs& pairs, Analysis& a) {
+  std::size_t marked = 0;
   auto mark = [&](std::size_t i) {
     a.skip[pairs[i].second] = 1;
-    ++a.topo.duplicate_faces;
+    ++marked;
   };
   if (pairs.size() <= 32) {  // a handful of faces: compare each with the earlier ones
     for (std::size_t i = 1; i < pairs.size(); ++i)
@@ -129,40 +131,42 @@ bool mark_duplicates(FacePairs& pairs, Analysis& a) {
     for (std::size_t i = 1; i < pairs.size(); ++i)
       if (pairs[i].first == pairs[i - 1].first) mark(i);
   }
-  return a.topo.duplicate_faces != before;
+  return marked;
 }
 
-// At vertex `b`, given `faces` (in face order) it is the smallest or the middle vertex of:
-// - duplicates: among the faces whose smallest vertex is b, a face whose (middle, largest) pair an
-//   earlier one has (the faces a global sort of (sorted triple, face) finds after the first of each
-//   run);
-// - then the edges from b to a larger vertex of the faces left, sorted by (larger vertex, face):
-//   the order of a global sort of all edges by (key, face). Runs of one key are one edge; manifold
-//   edges link two faces.
-// A half-edge is larger vertex << 32 | face << 1 | forward (the face runs from b to the larger
-// vertex); face < 2^31, as the bucket starts count 2 per face in 32 bits. Faces are distinct within
-// one edge, so sorting by value sorts by (key, face).
-void visit_vertex(std::uint32_t b, const std::uint32_t* faces, std::size_t n, Analysis& a, Adjacency& adj,
-                  std::vector<std::uint64_t>& edges, FacePairs& pairs) {
-  edges.clear();
+// At vertex `b`, given `faces` (in face order) it is the smallest or the middle vertex of: among
+// those whose smallest vertex is b, each face whose (middle, largest) pair an earlier one has is
+// marked a duplicate (the faces a global sort of (sorted triple, face) finds after the first of
+// each run). Only the faces whose smallest vertex is b are read or written, so vertices may be
+// visited in any order, on any thread. How many were marked.
+std::size_t mark_duplicates_at(std::uint32_t b, const std::uint32_t* faces, std::size_t n, Analysis& a, FacePairs& pairs) {
   pairs.clear();
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint32_t t = faces[i];
-    if (a.skip[t]) continue;  // a duplicate, marked at its smallest vertex
+    std::uint32_t v[3] = {a.corner[3 * std::size_t(t)], a.corner[3 * std::size_t(t) + 1], a.corner[3 * std::size_t(t) + 2]};
+    sort3(v);
+    if (v[0] != b) continue;
+    pairs.emplace_back(std::uint64_t(v[1]) << 32 | v[2], t);
+  }
+  return pairs.size() >= 2 ? mark_duplicates(pairs, a) : 0;
+}
+
+// At vertex `b`, once every duplicate is marked: the edges from b to a larger vertex of its faces
+// (`faces`, as above) left, sorted by (larger vertex, face): the order of a global sort of all edges
+// by (key, face). Runs of one key are one edge. A half-edge is larger vertex << 32 | face << 1 |
+// forward (the face runs from b to the larger vertex); face < 2^31, as the bucket starts count 2
+// per face in 32 bits. Faces are distinct within one edge, so sorting by value sorts by (key, face).
+void edges_at(std::uint32_t b, const std::uint32_t* faces, std::size_t n, const Analysis& a, std::vector<std::uint64_t>& edges) {
+  edges.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t t = faces[i];
+    if (a.skip[t]) continue;
     const std::uint32_t* c = &a.corner[3 * std::size_t(t)];
-    const std::size_t first = edges.size();
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t p = c[k], q = c[k == 2 ? 0 : k + 1];
       if (std::min(p, q) == b) edges.push_back((std::uint64_t(std::max(p, q)) << 32) | (std::uint64_t(t) << 1) | (p < q));
     }
-    if (edges.size() - first == 2) {  // b is the smallest vertex: the face's other two are its edges' ends
-      const std::uint64_t x = edges[first] >> 32, y = edges[first + 1] >> 32;
-      pairs.emplace_back(x < y ? (x << 32 | y) : (y << 32 | x), t);
-    }
   }
-  if (pairs.size() >= 2 && mark_duplicates(pairs, a))
-    edges.erase(std::remove_if(edges.begin(), edges.end(), [&](std::uint64_t e) { return a.skip[std::uint32_t(e) >> 1]; }),
-                edges.end());
   if (edges.size() <= 16) {  // insertion sort: a vertex has a handful of edges
     for (std::size_t i = 1; i < edges.size(); ++i) {
       const std::uint64_t e = edges[i];
@@ -173,36 +177,71 @@ void visit_vertex(std::uint32_t b, const std::uint32_t* faces, std::size_t n, An
   } else {
     std::sort(edges.begin(), edges.end());
   }
+}
+
+// fn(first, count) for each run of one edge in `edges` (sorted by edges_at).
+template <typename Fn>
+void for_each_edge(const std::vector<std::uint64_t>& edges, Fn&& fn) {
   for (std::size_t i = 0; i < edges.size();) {
     std::size_t j = i + 1;
     while (j < edges.size() && (edges[j] >> 32) == (edges[i] >> 32)) ++j;
-    if (j - i == 1) ++a.topo.boundary_edges;
-    else if (j - i > 2) ++a.topo.non_manifold_edges;
-    else {
-      const std::uint32_t f = std::uint32_t(edges[i]) >> 1, g = std::uint32_t(edges[i + 1]) >> 1;
-      const std::uint32_t same = (edges[i] & 1) == (edges[i + 1] & 1);
-      adj.link(f, g, same);
-      adj.link(g, f, same);
-    }
+    fn(i, j - i);
     i = j;
   }
 }
 
-// Vertex by vertex in increasing order: the duplicates among the faces it is the smallest vertex
-// of, then the edges from it to larger vertices (a duplicate's edges all start at its smallest or
-// middle vertex, so are seen after it is marked).
-Adjacency link_faces(std::size_t ids, Analysis& a) {
+// Whether the two half-edges run the edge the same way (one face is wound against the other).
+std::uint32_t same_way(std::uint64_t e, std::uint64_t f) { return (e & 1) == (f & 1); }
+
+// Counted on every core, vertex by vertex: first the duplicates (at each face's smallest vertex),
+// then the edges of the faces left (boundary, non-manifold, and manifold edges whose two faces run
+// it the same way). Returns the last: only when there are some does a piece need turning.
+std::size_t count_edges(const VertexFaces& vf, std::size_t ids, Analysis& a, int threads) {
+  constexpr std::size_t kVertices = 4096;  // per chunk
+  std::atomic<std::size_t> duplicates{0}, boundary{0}, non_manifold{0}, same{0};
+  parallel_chunks(threads, ids, kVertices, [&](std::size_t begin, std::size_t end) {
+    FacePairs pairs;
+    std::size_t found = 0;
+    for (std::size_t b = begin; b < end; ++b)
+      found += mark_duplicates_at(std::uint32_t(b), vf.face.data() + vf.start[b], vf.start[b + 1] - vf.start[b], a, pairs);
+    duplicates += found;
+  });
+  parallel_chunks(threads, ids, kVertices, [&](std::size_t begin, std::size_t end) {
+    std::vector<std::uint64_t> edges;
+    std::size_t counts[3] = {0, 0, 0};  // boundary, non-manifold, same way
+    for (std::size_t b = begin; b < end; ++b) {
+      edges_at(std::uint32_t(b), vf.face.data() + vf.start[b], vf.start[b + 1] - vf.start[b], a, edges);
+      for_each_edge(edges, [&](std::size_t i, std::size_t n) {
+        if (n == 1) ++counts[0];
+        else if (n > 2) ++counts[1];
+        else counts[2] += same_way(edges[i], edges[i + 1]);
+      });
+    }
+    boundary += counts[0];
+    non_manifold += counts[1];
+    same += counts[2];
+  });
+  a.topo.duplicate_faces = duplicates;
+  a.topo.boundary_edges = boundary;
+  a.topo.non_manifold_edges = non_manifold;
+  return same;
+}
+
+// Faces linked across manifold edges, vertex by vertex in increasing order (the duplicates marked).
+Adjacency link_faces(const VertexFaces& vf, std::size_t ids, const Analysis& a) {
   const std::size_t tris = a.skip.size();
-  const VertexFaces vf = list_faces_by_vertex(ids, a);
   Adjacency adj;
   adj.face.resize(3 * tris);
   adj.count.assign(tris, 0);
-  FacePairs pairs;
   std::vector<std::uint64_t> edges;
   for (std::size_t b = 0; b < ids; ++b) {
-    const std::uint32_t* faces = vf.face.data() + vf.start[b];
-    const std::size_t n = vf.start[b + 1] - vf.start[b];
-    visit_vertex(std::uint32_t(b), faces, n, a, adj, edges, pairs);
+    edges_at(std::uint32_t(b), vf.face.data() + vf.start[b], vf.start[b + 1] - vf.start[b], a, edges);
+    for_each_edge(edges, [&](std::size_t i, std::size_t n) {
+      if (n != 2) return;
+      const std::uint32_t f = std::uint32_t(edges[i]) >> 1, g = std::uint32_t(edges[i + 1]) >> 1;
+      adj.link(f, g, same_way(edges[i], edges[i + 1]));
+      adj.link(g, f, same_way(edges[i], edges[i + 1]));
+    });
   }
   return adj;
 }
@@ -243,16 +282,22 @@ void orient_pieces(const Adjacency& adj, Analysis& a) {
   }
 }
 
-Analysis analyze(const Mesh& m) {
+Analysis analyze(const Mesh& m, int threads) {
   Analysis a;
   const std::size_t tris = m.triangle_count();
   std::size_t ids = 0;
   a.weld = weld_positions(m.positions, &ids);
   a.corner.resize(3 * tris);
-  for (std::size_t c = 0; c < 3 * tris; ++c) a.corner[c] = a.weld[m.position_index[c]];
+  parallel_chunks(threads, 3 * tris, std::size_t(1) << 16, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t c = begin; c < end; ++c) a.corner[c] = a.weld[m.position_index[c]];
+  });
   count_vertices(m, ids, a);
   a.skip.assign(tris, 0);
-  orient_pieces(link_faces(ids, a), a);
+  const VertexFaces vf = list_faces_by_vertex(ids, a);
+  // With every manifold edge run opposite ways by its two faces, each piece is wound one way: no
+  // face to turn, and no need for the links (the common case, and the slower half of the work).
+  if (count_edges(vf, ids, a, threads) > 0) orient_pieces(link_faces(vf, ids, a), a);
+  else a.flip.assign(tris, 0);
   return a;
 }
 
@@ -287,10 +332,10 @@ std::vector<std::uint32_t> weld_positions(const std::vector<glm::vec3>& position
   return out;
 }
 
-MeshTopology inspect_topology(const Mesh& mesh) { return analyze(mesh).topo; }
+MeshTopology inspect_topology(const Mesh& mesh, int threads) { return analyze(mesh, threads).topo; }
 
-std::vector<glm::vec3> compute_high_corner_normals(const Mesh& m, std::size_t* reoriented) {
-  const Analysis a = analyze(m);
+std::vector<glm::vec3> compute_high_corner_normals(const Mesh& m, std::size_t* reoriented, int threads) {
+  const Analysis a = analyze(m, threads);
   if (reoriented) *reoriented = a.topo.inconsistent_winding_faces;
   // Indexed by welded id (< positions).
   const std::vector<glm::dvec3> sum = angle_weighted_sums(m, &a.corner, m.positions.size(), &a.skip, &a.flip);

@@ -26,7 +26,8 @@ struct MeshTopology {
   std::size_t inconsistent_winding_faces = 0;
 };
 
-MeshTopology inspect_topology(const Mesh& mesh);
+// threads <= 0: all cores; the answers do not depend on it.
+MeshTopology inspect_topology(const Mesh& mesh, int threads = 0);
 
 // Per position, an id shared by all positions with bit-identical coordinates (-0 equals +0).
 // `count` receives the number of distinct ids.
@@ -36,6 +37,6 @@ std::vector<std::uint32_t> weld_positions(const std::vector<glm::vec3>& position
 // vertices welded by value, duplicate faces counted once, and faces wound against their
 // neighbours turned to the majority winding of their piece first (`reoriented` receives how many).
 // Zero-area faces carry no direction; a vertex with none gets (0,0,1). Never NaN.
-std::vector<glm::vec3> compute_high_corner_normals(const Mesh& mesh, std::size_t* reoriented = nullptr);
+std::vector<glm::vec3> compute_high_corner_normals(const Mesh& mesh, std::size_t* reoriented = nullptr, int threads = 0);
 
 }  // namespace nmbake
