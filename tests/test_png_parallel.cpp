@@ -5,12 +5,15 @@
 // malformed input is an error, not a file.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "io/image_io.h"
+#include "io/image_write.h"
 #include "io/png_parallel.h"
 #include "test_support.h"
 
@@ -131,4 +134,27 @@ TEST(PngParallel, OtherSettingsGoToLibpngAndBadInputIsAnError) {
   error.clear();
   EXPECT_TRUE(nmbake::encode_png_parallel(rows.data(), 16, 16, 3, 8, {{" bad", "x"}}, {}, 2, &error).empty());
   EXPECT_NE(error.find("keyword"), std::string::npos) << error;
+}
+
+// Quantization on any number of threads: the values of a plain loop (8 and 16 bits, rounded half
+// away from zero, clamped, NaN to 0), and the dithered ones the same on 1, 2 and 3 threads.
+TEST(PngParallel, QuantizationDoesNotDependOnTheThreads) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> value(-0.2f, 1.2f);
+  nmbake::Image::Pixels values(700001);  // several chunks and a short last one
+  for (float& v : values) v = value(rng);
+  values[0] = std::numeric_limits<float>::quiet_NaN();
+  values[1] = 0.5f / 255.0f;
+  values[2] = 1.0f;
+  for (int threads : {1, 2, 3}) {
+    const auto q8 = nmbake::image_write::quantize8(values, false, threads);
+    const auto q16 = nmbake::image_write::quantize16(values, threads);
+    ASSERT_EQ(q8.size(), values.size());
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      const double v = std::isnan(values[i]) ? 0.0 : std::clamp(double(values[i]), 0.0, 1.0);
+      ASSERT_EQ(q8[i], std::uint8_t(std::floor(v * 255.0 + 0.5))) << i;
+      ASSERT_EQ(q16[i], std::uint16_t(std::floor(v * 65535.0 + 0.5))) << i;
+    }
+    EXPECT_TRUE(nmbake::image_write::quantize8(values, true, threads) == nmbake::image_write::quantize8(values, true, 1));
+  }
 }

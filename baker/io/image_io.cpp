@@ -209,15 +209,15 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
   // (OpenImageIO converts float to half for EXR 16).
   OIIO::TypeDesc stored = OIIO::TypeDesc::FLOAT;
   OIIO::TypeDesc given = OIIO::TypeDesc::FLOAT;
-  std::vector<std::uint8_t> data8;
-  std::vector<std::uint16_t> data16;
+  image_write::Samples<std::uint8_t> data8;
+  image_write::Samples<std::uint16_t> data16;
   const void* data = image.pixels.data();
   if (bits == 8) {
-    data8 = image_write::quantize8(image.pixels, options.dither);
+    data8 = image_write::quantize8(image.pixels, options.dither, options.threads);
     stored = given = OIIO::TypeDesc::UINT8;
     data = data8.data();
   } else if (bits == 16 && ext != ".exr") {
-    data16 = image_write::quantize16(image.pixels);
+    data16 = image_write::quantize16(image.pixels, options.threads);
     stored = given = OIIO::TypeDesc::UINT16;
     data = data16.data();
   } else if (bits == 16) {

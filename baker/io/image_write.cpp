@@ -13,6 +13,7 @@
 #include <system_error>
 
 #include "core/errors.h"
+#include "core/parallel.h"
 #include "io/text_file.h"
 
 namespace nmbake::image_write {
@@ -20,19 +21,23 @@ namespace {
 
 namespace fs = std::filesystem;
 
+constexpr std::size_t kQuantizeChunk = std::size_t(1) << 18;  // values per chunk
+
 // value * scale rounded half away from zero, clamped to [0, scale]; NaN becomes 0.
 // For v = value * scale >= 0, round(v) == trunc(v + 0.5) exactly: v is a float times at most
 // 65535, so v + 0.5 is exact in double wherever it can reach 1. Negative and NaN values clamp to 0
 // either way.
 template <typename T>
-std::vector<T> quantize(const Image::Pixels& values, double scale) {
-  std::vector<T> out(values.size());
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    double v = static_cast<double>(values[i]) * scale + 0.5;
-    if (!(v > 0.0)) v = 0.0;
-    if (v > scale) v = scale;
-    out[i] = static_cast<T>(v);  // truncation of a value in [0, scale]
-  }
+Samples<T> quantize(const Image::Pixels& values, double scale, int threads) {
+  Samples<T> out(values.size());  // left unset: every value is written below, on every core
+  parallel_chunks(threads, values.size(), kQuantizeChunk, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      double v = static_cast<double>(values[i]) * scale + 0.5;
+      if (!(v > 0.0)) v = 0.0;
+      if (v > scale) v = scale;
+      out[i] = static_cast<T>(v);  // truncation of a value in [0, scale]
+    }
+  });
   return out;
 }
 
@@ -49,15 +54,17 @@ double unit_hash(std::uint64_t key) {
 // 8-bit values with triangular noise of one step added before rounding (WriteOptions::dither):
 // the sum of two uniform values in [0, 1) minus 1, seeded by the value's index, so that a gradient
 // finer than a step shows no bands and the average over many texels keeps the float value.
-std::vector<std::uint8_t> quantize_dithered(const Image::Pixels& values) {
-  std::vector<std::uint8_t> out(values.size());
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    const double noise = unit_hash(2 * std::uint64_t(i)) + unit_hash(2 * std::uint64_t(i) + 1) - 1.0;
-    double v = static_cast<double>(values[i]) * 255.0 + 0.5 + noise;
-    if (!(v > 0.0)) v = 0.0;
-    if (v > 255.0) v = 255.0;
-    out[i] = static_cast<std::uint8_t>(v);
-  }
+Samples<std::uint8_t> quantize_dithered(const Image::Pixels& values, int threads) {
+  Samples<std::uint8_t> out(values.size());
+  parallel_chunks(threads, values.size(), kQuantizeChunk, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const double noise = unit_hash(2 * std::uint64_t(i)) + unit_hash(2 * std::uint64_t(i) + 1) - 1.0;
+      double v = static_cast<double>(values[i]) * 255.0 + 0.5 + noise;
+      if (!(v > 0.0)) v = 0.0;
+      if (v > 255.0) v = 255.0;
+      out[i] = static_cast<std::uint8_t>(v);
+    }
+  });
   return out;
 }
 
@@ -86,11 +93,13 @@ int check_write(const std::string& path, const Image& image, const WriteOptions&
   return bits;
 }
 
-std::vector<std::uint8_t> quantize8(const Image::Pixels& values, bool dither) {
-  return dither ? quantize_dithered(values) : quantize<std::uint8_t>(values, 255.0);
+Samples<std::uint8_t> quantize8(const Image::Pixels& values, bool dither, int threads) {
+  return dither ? quantize_dithered(values, threads) : quantize<std::uint8_t>(values, 255.0, threads);
 }
 
-std::vector<std::uint16_t> quantize16(const Image::Pixels& values) { return quantize<std::uint16_t>(values, 65535.0); }
+Samples<std::uint16_t> quantize16(const Image::Pixels& values, int threads) {
+  return quantize<std::uint16_t>(values, 65535.0, threads);
+}
 
 // The EXR and TIFF writers stamp the current time into "DateTime", so two identical bakes differ
 // in a few bytes. With SOURCE_DATE_EPOCH set (seconds since 1970, the reproducible-builds

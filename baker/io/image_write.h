@@ -17,9 +17,12 @@ namespace nmbake::image_write {
 int check_write(const std::string& path, const Image& image, const WriteOptions& options);
 
 // value * 255 (or 65535) rounded half away from zero, clamped; NaN becomes 0. quantize8 adds one
-// step of triangular noise first when `dither` is set, seeded by the value's index.
-std::vector<std::uint8_t> quantize8(const Image::Pixels& values, bool dither);
-std::vector<std::uint16_t> quantize16(const Image::Pixels& values);
+// step of triangular noise first when `dither` is set, seeded by the value's index. On `threads`
+// threads (<= 0: every core); the values do not depend on them.
+template <typename T>
+using Samples = std::vector<T, DefaultInitAllocator<T>>;
+Samples<std::uint8_t> quantize8(const Image::Pixels& values, bool dither, int threads = 1);
+Samples<std::uint16_t> quantize16(const Image::Pixels& values, int threads = 1);
 
 // "YYYY:MM:DD HH:MM:SS" (UTC) of SOURCE_DATE_EPOCH, or "" when it is unset or malformed.
 std::string reproducible_date_time();

@@ -136,11 +136,11 @@ void write_png_image(const std::string& path, const Image& image, const WriteOpt
   std::string error;
   std::vector<unsigned char> bytes;
   if (bits == 8) {
-    const std::vector<std::uint8_t> rows = image_write::quantize8(image.pixels, options.dither);
+    const auto rows = image_write::quantize8(image.pixels, options.dither, options.threads);
     bytes = encode_png_parallel(rows.data(), image.width, image.height, image.channels, 8, metadata, PngSettings{},
                                 options.threads, &error);
   } else {
-    const std::vector<std::uint16_t> rows = image_write::quantize16(image.pixels);
+    const auto rows = image_write::quantize16(image.pixels, options.threads);
     bytes = encode_png_parallel(rows.data(), image.width, image.height, image.channels, 16, metadata, PngSettings{},
                                 options.threads, &error);
   }
