@@ -51,6 +51,29 @@ TEST(Padding, MatchesBruteForceNearestTexel) {
   }
 }
 
+// Within a column (a map one texel wide), a texel halfway between two covered ones takes the upper
+// one's value (the smaller row), as the exact transform's lower envelope does.
+TEST(Padding, ATieInAColumnGoesToTheUpperTexel) {
+  std::mt19937 rng(41);
+  for (int trial = 0; trial < 50; ++trial) {
+    const int H = 30 + trial;
+    Image img(1, H, 1, -1.0f);
+    std::vector<std::uint8_t> cov(std::size_t(H), 0);
+    std::bernoulli_distribution on(0.15);
+    for (int y = 0; y < H; ++y)
+      if (on(rng)) cov[std::size_t(y)] = 1, img.pixels[std::size_t(y)] = float(y);
+    pad_islands(img, cov, H);
+    for (int y = 0; y < H; ++y) {
+      if (cov[std::size_t(y)]) continue;
+      int up = y, down = y;
+      while (up >= 0 && !cov[std::size_t(up)]) --up;
+      while (down < H && !cov[std::size_t(down)]) ++down;
+      const int want = up < 0 && down >= H ? -1 : down >= H || (up >= 0 && y - up <= down - y) ? up : down;
+      EXPECT_EQ(img.pixels[std::size_t(y)], float(want)) << "trial " << trial << " row " << y;
+    }
+  }
+}
+
 TEST(Padding, ZeroPaddingAndEmptyCoverageChangeNothing) {
   Image img(8, 8, 3, 0.25f);
   std::vector<std::uint8_t> none(64, 0);

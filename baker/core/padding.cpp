@@ -78,8 +78,11 @@ std::size_t pad_islands(Image& image, const std::vector<std::uint8_t>& covered, 
       for (int i; (i = next.fetch_add(1)) < parts;) part(i);
     });
   };
-  // Pass 1, columns: squared distance to the nearest covered texel in the same column. Columns go
-  // in blocks of kBlock neighbours, so the image is read and written a row segment at a time.
+  // Pass 1, columns: squared distance to the nearest covered texel in the same column, and its row.
+  // With every covered texel at 0 and the rest infinite, that is the nearest covered row above or
+  // below, the upper one on a tie (as distance_1d, where the parabolas' crossings are the exact
+  // midpoints between covered rows, chooses): two scans, one down and one up. Columns go in blocks
+  // of kBlock neighbours, so the image is read and written a row segment at a time.
   constexpr int kBlock = 16;
   // Left unset: pass 1 writes every texel's, on every thread (the first touch of this memory, and
   // the system's zeroing of it, is shared out too).
@@ -88,16 +91,23 @@ std::size_t pad_islands(Image& image, const std::vector<std::uint8_t>& covered, 
   const int m = std::max(w, h);
   parallel((w + kBlock - 1) / kBlock, [&](int block) {
     const int x0 = block * kBlock, nb = std::min(kBlock, w - x0);
-    std::vector<double> f(std::size_t(kBlock) * h), d(std::size_t(kBlock) * h), z(m + 1);
-    std::vector<int> arg(std::size_t(kBlock) * h), v(m);
-    for (int y = 0; y < h; ++y)
-      for (int j = 0; j < nb; ++j) f[std::size_t(j) * h + y] = covered[std::size_t(y) * w + x0 + j] ? 0.0 : kInf;
-    for (int j = 0; j < nb; ++j)
-      distance_1d(&f[std::size_t(j) * h], h, &d[std::size_t(j) * h], &arg[std::size_t(j) * h], v.data(), z.data());
-    for (int y = 0; y < h; ++y)
+    int near[kBlock];
+    std::fill(near, near + kBlock, -1);
+    for (int y = 0; y < h; ++y)  // down: the nearest covered row at or above, in gy for now
       for (int j = 0; j < nb; ++j) {
-        g[std::size_t(y) * w + x0 + j] = d[std::size_t(j) * h + y];
-        gy[std::size_t(y) * w + x0 + j] = arg[std::size_t(j) * h + y];
+        const std::size_t i = std::size_t(y) * w + x0 + j;
+        if (covered[i]) near[j] = y;
+        gy[i] = near[j];
+      }
+    std::fill(near, near + kBlock, -1);
+    for (int y = h - 1; y >= 0; --y)  // up: the nearest at or below, and the nearer of the two
+      for (int j = 0; j < nb; ++j) {
+        const std::size_t i = std::size_t(y) * w + x0 + j;
+        if (covered[i]) near[j] = y;
+        const int above = gy[i], below = near[j];
+        const int p = below < 0 || (above >= 0 && y - above <= below - y) ? above : below;
+        gy[i] = p;
+        g[i] = p < 0 ? kInf : double(y - p) * (y - p);
       }
   });
   // Pass 2, rows: combine into the exact Euclidean nearest covered texel, then copy it. A row
