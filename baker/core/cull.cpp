@@ -48,18 +48,39 @@ std::vector<std::uint32_t> triangles_near(const std::vector<Box>& regions, doubl
       for (int y = c0[1]; y <= c1[1]; ++y)
         for (int x = c0[0]; x <= c1[0]; ++x) marked[(std::size_t(z) * dim[1] + y) * dim[0] + x] = 1;
   }
-  auto near = [&](std::size_t t) {
-    glm::dvec3 lo(positions[indices[3 * t]]), hi = lo;
-    for (int c = 1; c < 3; ++c) {
-      const glm::dvec3 p(positions[indices[3 * t + c]]);
-      lo = glm::min(lo, p);
-      hi = glm::max(hi, p);
+  // Per vertex, once: its cell and which side of the union it lies beyond on each axis. A
+  // triangle's box is then its corners' cells' range (the cell of a coordinate never decreases
+  // as it grows, so the cell of the smallest is the smallest cell), and it misses the union on an
+  // axis where all three corners lie beyond one side: the answers of the box itself, bit for bit.
+  struct VertexCell {
+    std::int16_t cell[3];
+    std::uint8_t below, above;  // bit a: beyond all.lo[a], beyond all.hi[a]
+  };
+  std::vector<VertexCell> vertex_cells(positions.size());
+  parallel_chunks(threads, positions.size(), std::size_t(1) << 16, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const glm::dvec3 p(positions[i]);
+      VertexCell& v = vertex_cells[i];
+      int c0[3], c1[3];
+      cell_range(p, p, c0, c1);
+      v.below = v.above = 0;
+      for (int k = 0; k < 3; ++k) {
+        v.cell[k] = std::int16_t(c0[k]);
+        v.below = std::uint8_t(v.below | int(!(p[k] >= all.lo[k])) << k);  // NaN-free inputs are the loader's promise
+        v.above = std::uint8_t(v.above | int(!(p[k] <= all.hi[k])) << k);
+      }
     }
-    // NaN-free inputs are the loader's promise; a box outside the union cannot overlap a region.
-    for (int a = 0; a < 3; ++a)
-      if (!(hi[a] >= all.lo[a] && lo[a] <= all.hi[a])) return false;
+  });
+  auto near = [&](std::size_t t) {
+    const VertexCell& p = vertex_cells[indices[3 * t]];
+    const VertexCell& q = vertex_cells[indices[3 * t + 1]];
+    const VertexCell& r = vertex_cells[indices[3 * t + 2]];
+    if ((p.below & q.below & r.below) | (p.above & q.above & r.above)) return false;  // outside the union
     int c0[3], c1[3];
-    cell_range(lo, hi, c0, c1);
+    for (int k = 0; k < 3; ++k) {
+      c0[k] = std::min({p.cell[k], q.cell[k], r.cell[k]});
+      c1[k] = std::max({p.cell[k], q.cell[k], r.cell[k]});
+    }
     for (int z = c0[2]; z <= c1[2]; ++z)
       for (int y = c0[1]; y <= c1[1]; ++y)
         for (int x = c0[0]; x <= c1[0]; ++x)
