@@ -1,5 +1,7 @@
 #include "pipeline/bvh.h"
 
+#include "core/parallel.h"
+
 namespace nmbake {
 
 void build_high_scene(HighScene& h, const Prepared& s, const Mesh& high, const std::vector<std::uint32_t>& kept,
@@ -16,15 +18,17 @@ void build_high_scene(HighScene& h, const Prepared& s, const Mesh& high, const s
   h.object = high.triangle_object.empty() ? nullptr : high.triangle_object.data();
   if (!kept.empty()) {
     std::vector<std::uint32_t> index(3 * kept.size());
-    std::vector<glm::vec3> normals(3 * kept.size());
+    CornerNormals normals(3 * kept.size());
     std::vector<std::int8_t> facing(kept.size());
-    for (std::size_t i = 0; i < kept.size(); ++i) {
-      for (int c = 0; c < 3; ++c) {
-        index[3 * i + c] = high.position_index[3 * std::size_t(kept[i]) + c];
-        normals[3 * i + c] = s.high_corner_normals[3 * std::size_t(kept[i]) + c];
+    parallel_chunks(threads, kept.size(), std::size_t(1) << 16, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        for (int c = 0; c < 3; ++c) {
+          index[3 * i + c] = high.position_index[3 * std::size_t(kept[i]) + c];
+          normals[3 * i + c] = s.high_corner_normals[3 * std::size_t(kept[i]) + c];
+        }
+        facing[i] = s.high_facing[kept[i]];
       }
-      facing[i] = s.high_facing[kept[i]];
-    }
+    });
     h.kept_index = std::move(index);
     h.kept_normals = std::move(normals);
     h.kept_facing = std::move(facing);

@@ -26,7 +26,7 @@ struct HighScene {
   std::size_t triangles = 0;
   raycast::BuildQuality quality = raycast::BuildQuality::medium;
   std::vector<std::uint32_t> kept_index;
-  std::vector<glm::vec3> kept_normals;
+  CornerNormals kept_normals;
   std::vector<std::int8_t> kept_facing;
   // Per BVH triangle, its high-poly object (Mesh::triangle_object), or null: one object.
   const std::uint32_t* object = nullptr;

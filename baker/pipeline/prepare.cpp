@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "core/mesh_topology.h"
 #include "core/parallel.h"
@@ -14,10 +15,21 @@ namespace {
 
 // Over the positions faces use: a vertex no face uses (a stray point far away) must not move the
 // centre or stretch the diagonal that scales every distance.
+// In chunks on every core, each chunk's box joined to the others' (smallest and largest values: the
+// same whatever the order).
 void grow_box(glm::dvec3& lo, glm::dvec3& hi, const std::vector<glm::vec3>& pts, const std::vector<std::uint32_t>& index) {
-  for (std::uint32_t i : index) {
-    lo = glm::min(lo, glm::dvec3(pts[i]));
-    hi = glm::max(hi, glm::dvec3(pts[i]));
+  constexpr std::size_t kChunk = std::size_t(1) << 16;
+  std::vector<std::pair<glm::dvec3, glm::dvec3>> boxes((index.size() + kChunk - 1) / kChunk, {lo, hi});
+  parallel_chunks(0, index.size(), kChunk, [&](std::size_t begin, std::size_t end) {
+    auto& [l, h] = boxes[begin / kChunk];
+    for (std::size_t c = begin; c < end; ++c) {
+      l = glm::min(l, glm::dvec3(pts[index[c]]));
+      h = glm::max(h, glm::dvec3(pts[index[c]]));
+    }
+  });
+  for (const auto& [l, h] : boxes) {
+    lo = glm::min(lo, l);
+    hi = glm::max(hi, h);
   }
 }
 
@@ -27,7 +39,9 @@ std::vector<glm::vec3> recentre(const std::vector<glm::vec3>& pts, const glm::dv
   std::vector<glm::vec3> out;
   out.reserve(pts.size() + spare);
   out.resize(pts.size());
-  for (std::size_t i = 0; i < pts.size(); ++i) out[i] = glm::vec3(glm::dvec3(pts[i]) - c);
+  parallel_chunks(0, pts.size(), std::size_t(1) << 16, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) out[i] = glm::vec3(glm::dvec3(pts[i]) - c);
+  });
   return out;
 }
 
@@ -73,7 +87,7 @@ std::vector<glm::vec3> position_averaged_normals(const Mesh& low, const TangentF
 // point to, + that of cross(p1 - p0, p2 - p0) (also where that cannot be told: no area, normals
 // that cancel), and how far they lean from the face.
 std::vector<std::int8_t> triangle_facing(const std::vector<glm::vec3>& pos, const std::vector<std::uint32_t>& index,
-                                         const std::vector<glm::vec3>& corner_normals) {
+                                         const CornerNormals& corner_normals) {
   std::vector<std::int8_t> out(index.size() / 3);
   parallel_chunks(0, out.size(), 65536, [&](std::size_t t0, std::size_t t1) {
     for (std::size_t t = t0; t < t1; ++t) {
@@ -173,10 +187,13 @@ Prepared prepare(const Mesh& low, const Mesh& high, const Mesh* cage, BakeStats&
   s.ray_normal = position_averaged_normals(low, s.frames);
   if (high.has_normals()) {
     s.high_corner_normals.resize(high.normal_index.size());
-    for (std::size_t c = 0; c < high.normal_index.size(); ++c) s.high_corner_normals[c] = high.normals[high.normal_index[c]];
+    parallel_chunks(0, high.normal_index.size(), std::size_t(1) << 16, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t c = begin; c < end; ++c) s.high_corner_normals[c] = high.normals[high.normal_index[c]];
+    });
   } else {
     // Welded by value, duplicate faces once, one winding per piece (mesh_topology.h).
-    s.high_corner_normals = compute_high_corner_normals(high, &st.high_faces_reoriented);
+    const std::vector<glm::vec3> computed = compute_high_corner_normals(high, &st.high_faces_reoriented);
+    s.high_corner_normals.assign(computed.begin(), computed.end());
     st.high_normals_computed = true;
   }
   s.high_facing = triangle_facing(s.high_pos, high.position_index, s.high_corner_normals);
