@@ -385,4 +385,24 @@ TEST(MeshIo, PlyFastPathLeavesEverythingElseToTheGeneralReader) {
   }
 }
 
+// A file large enough to be read in parts on every core (mesh_io.cpp, FileBytes) loads as its bytes
+// do from memory: the same mesh, and the normals' counts summed over the parallel chunks.
+TEST(MeshIo, ALargeFileReadInPartsLoadsAsFromMemory) {
+  const std::string bytes = grid_ply(450, "binary_little_endian", "float", "uchar", "int", true, true, false);
+  ASSERT_GT(bytes.size(), std::size_t(8) << 20);
+  const std::string path = test::scratch_dir() + "/grid.ply";
+  test::write_file(path, bytes);
+  MeshLoadInfo from_file, from_memory;
+  const Mesh a = load_mesh(path, {}, &from_file);
+  const Mesh b = load_mesh_from_memory(path, bytes, {}, &from_memory);
+  ASSERT_EQ(a.positions.size(), b.positions.size());
+  EXPECT_EQ(std::memcmp(a.positions.data(), b.positions.data(), a.positions.size() * sizeof(glm::vec3)), 0);
+  EXPECT_TRUE(a.normals == b.normals);
+  EXPECT_TRUE(a.uvs == b.uvs);
+  EXPECT_TRUE(a.position_index == b.position_index);
+  EXPECT_EQ(from_file.normals_renormalized, a.positions.size());  // (0.1, -0.2, 0.97) is 0.995 long
+  EXPECT_EQ(from_memory.normals_renormalized, from_file.normals_renormalized);
+  EXPECT_EQ(from_file.largest_coordinate, from_memory.largest_coordinate);
+}
+
 }  // namespace nmbake
