@@ -143,3 +143,51 @@ TEST(Cull, CageReachIsRespected) {
   EXPECT_GT(on.stats.hits, on.stats.samples_covered * 9 / 10);
   EXPECT_TRUE(on.map.pixels == off.map.pixels);
 }
+
+// Random boxes and triangles, many of them beyond the regions' union on some side or touching its
+// faces: every triangle whose box overlaps a grown region is kept, and none whose box lies wholly
+// beyond one side of the union (the two answers the grid must give exactly).
+TEST(Cull, KeepsEveryOverlapAndNothingBeyondTheUnion) {
+  std::mt19937 rng(77);
+  std::uniform_real_distribution<float> coord(-4.0f, 4.0f), size(0.0f, 0.6f);
+  for (int trial = 0; trial < 20; ++trial) {
+    std::vector<Box> regions(1 + trial * 3);
+    for (Box& b : regions) {
+      const glm::dvec3 lo(coord(rng) * 0.5f, coord(rng) * 0.5f, coord(rng) * 0.5f);
+      b = {lo, lo + glm::dvec3(size(rng), size(rng), size(rng))};
+    }
+    const double margin = 0.05 * trial;
+    std::vector<glm::vec3> positions;
+    for (int i = 0; i < 3000; ++i) {
+      glm::vec3 p(coord(rng), coord(rng), coord(rng));
+      if (i % 7 == 0) p.x = float(regions[0].hi.x + margin);  // on the union's faces and the regions'
+      if (i % 11 == 0) p.y = float(regions[0].lo.y - margin);
+      positions.push_back(p);
+    }
+    std::vector<std::uint32_t> index;
+    std::uniform_int_distribution<std::uint32_t> pick(0, std::uint32_t(positions.size() - 1));
+    for (int t = 0; t < 4000; ++t)
+      for (int c = 0; c < 3; ++c) index.push_back(t % 5 == 0 && c > 0 ? index.back() : pick(rng));  // every 5th: one point
+    const std::vector<std::uint32_t> kept = triangles_near(regions, margin, positions, index, nullptr, 2);
+    std::vector<std::uint8_t> in(index.size() / 3, 0);
+    for (std::uint32_t t : kept) in[t] = 1;
+    Box all{glm::dvec3(1e300), glm::dvec3(-1e300)};
+    for (const Box& b : regions) all = {glm::min(all.lo, b.lo - margin), glm::max(all.hi, b.hi + margin)};
+    for (std::size_t t = 0; t < in.size(); ++t) {
+      glm::dvec3 lo(positions[index[3 * t]]), hi = lo;
+      for (int c = 1; c < 3; ++c)
+        lo = glm::min(lo, glm::dvec3(positions[index[3 * t + c]])), hi = glm::max(hi, glm::dvec3(positions[index[3 * t + c]]));
+      bool overlaps = false;
+      for (const Box& b : regions)
+        overlaps =
+            overlaps || (glm::all(glm::lessThanEqual(lo, b.hi + margin)) && glm::all(glm::greaterThanEqual(hi, b.lo - margin)));
+      const bool beyond = glm::any(glm::lessThan(hi, all.lo)) || glm::any(glm::greaterThan(lo, all.hi));
+      if (overlaps) {
+        EXPECT_TRUE(in[t]) << "trial " << trial << " triangle " << t << " overlaps a region but was left out";
+      }
+      if (beyond) {
+        EXPECT_FALSE(in[t]) << "trial " << trial << " triangle " << t << " lies beyond the union but was kept";
+      }
+    }
+  }
+}

@@ -48,38 +48,41 @@ std::vector<std::uint32_t> triangles_near(const std::vector<Box>& regions, doubl
       for (int y = c0[1]; y <= c1[1]; ++y)
         for (int x = c0[0]; x <= c1[0]; ++x) marked[(std::size_t(z) * dim[1] + y) * dim[0] + x] = 1;
   }
-  // Per vertex, once: its cell and which side of the union it lies beyond on each axis. A
+  // Per vertex, once: its cell on each axis, or that it lies beyond one side of the union. A
   // triangle's box is then its corners' cells' range (the cell of a coordinate never decreases
   // as it grows, so the cell of the smallest is the smallest cell), and it misses the union on an
   // axis where all three corners lie beyond one side: the answers of the box itself, bit for bit.
-  struct VertexCell {
-    std::int16_t cell[3];
-    std::uint8_t below, above;  // bit a: beyond all.lo[a], beyond all.hi[a]
-  };
-  std::vector<VertexCell> vertex_cells(positions.size());
+  // 10 bits per axis: 0 beyond the low side (whose cell is 0), 1 + the cell, or dim + 1 beyond the
+  // high side (whose cell is dim - 1: the union's far side is dim cells from its near one).
+  std::vector<std::uint32_t> vertex_cells(positions.size());
   parallel_chunks(threads, positions.size(), std::size_t(1) << 16, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       const glm::dvec3 p(positions[i]);
-      VertexCell& v = vertex_cells[i];
       int c0[3], c1[3];
       cell_range(p, p, c0, c1);
-      v.below = v.above = 0;
+      std::uint32_t code = 0;
       for (int k = 0; k < 3; ++k) {
-        v.cell[k] = std::int16_t(c0[k]);
-        v.below = std::uint8_t(v.below | int(!(p[k] >= all.lo[k])) << k);  // NaN-free inputs are the loader's promise
-        v.above = std::uint8_t(v.above | int(!(p[k] <= all.hi[k])) << k);
+        // NaN-free inputs are the loader's promise.
+        const int v = !(p[k] >= all.lo[k]) ? 0 : !(p[k] <= all.hi[k]) ? dim[k] + 1 : c0[k] + 1;
+        code |= std::uint32_t(v) << (10 * k);
       }
+      vertex_cells[i] = code;
     }
   });
   auto near = [&](std::size_t t) {
-    const VertexCell& p = vertex_cells[indices[3 * t]];
-    const VertexCell& q = vertex_cells[indices[3 * t + 1]];
-    const VertexCell& r = vertex_cells[indices[3 * t + 2]];
-    if ((p.below & q.below & r.below) | (p.above & q.above & r.above)) return false;  // outside the union
+    const std::uint32_t corner[3] = {vertex_cells[indices[3 * t]], vertex_cells[indices[3 * t + 1]],
+                                     vertex_cells[indices[3 * t + 2]]};
     int c0[3], c1[3];
     for (int k = 0; k < 3; ++k) {
-      c0[k] = std::min({p.cell[k], q.cell[k], r.cell[k]});
-      c1[k] = std::max({p.cell[k], q.cell[k], r.cell[k]});
+      int lo = 1 << 10, hi = -1;
+      for (std::uint32_t c : corner) {
+        const int v = int(c >> (10 * k) & 1023u);
+        lo = std::min(lo, v);
+        hi = std::max(hi, v);
+      }
+      if (hi == 0 || lo == dim[k] + 1) return false;  // all three beyond one side: outside the union
+      c0[k] = std::clamp(lo - 1, 0, dim[k] - 1);
+      c1[k] = std::clamp(hi - 1, 0, dim[k] - 1);
     }
     for (int z = c0[2]; z <= c1[2]; ++z)
       for (int y = c0[1]; y <= c1[1]; ++y)
