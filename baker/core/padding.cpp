@@ -78,15 +78,15 @@ std::size_t pad_islands(Image& image, const std::vector<std::uint8_t>& covered, 
       for (int i; (i = next.fetch_add(1)) < parts;) part(i);
     });
   };
-  // Pass 1, columns: squared distance to the nearest covered texel in the same column, and its row.
+  // Pass 1, columns: the row of the nearest covered texel in the same column (its squared distance
+  // follows from it, and is worked out row by row in pass 2: 8 bytes per texel fewer).
   // With every covered texel at 0 and the rest infinite, that is the nearest covered row above or
   // below, the upper one on a tie (as distance_1d, where the parabolas' crossings are the exact
   // midpoints between covered rows, chooses): two scans, one down and one up. Columns go in blocks
   // of kBlock neighbours, so the image is read and written a row segment at a time.
   constexpr int kBlock = 16;
   // Left unset: pass 1 writes every texel's, on every thread (the first touch of this memory, and
-  // the system's zeroing of it, is shared out too).
-  std::vector<double, DefaultInitAllocator<double>> g(n);
+  // the system's zeroing of it, is shared out too). -1: no covered texel in the column.
   std::vector<int, DefaultInitAllocator<int>> gy(n);
   const int m = std::max(w, h);
   parallel((w + kBlock - 1) / kBlock, [&](int block) {
@@ -105,9 +105,7 @@ std::size_t pad_islands(Image& image, const std::vector<std::uint8_t>& covered, 
         const std::size_t i = std::size_t(y) * w + x0 + j;
         if (covered[i]) near[j] = y;
         const int above = gy[i], below = near[j];
-        const int p = below < 0 || (above >= 0 && y - above <= below - y) ? above : below;
-        gy[i] = p;
-        g[i] = p < 0 ? kInf : double(y - p) * (y - p);
+        gy[i] = below < 0 || (above >= 0 && y - above <= below - y) ? above : below;
       }
   });
   // Pass 2, rows: combine into the exact Euclidean nearest covered texel, then copy it. A row
@@ -116,11 +114,14 @@ std::size_t pad_islands(Image& image, const std::vector<std::uint8_t>& covered, 
   constexpr int kRows = 16;
   std::vector<std::size_t> filled((h + kRows - 1) / kRows, 0);
   parallel(int(filled.size()), [&](int part) {
-    std::vector<double> d(m), z(m + 1);
+    std::vector<double> f(w), d(m), z(m + 1);
     std::vector<int> arg(m), v(m);
     for (int y = part * kRows; y < std::min(h, (part + 1) * kRows); ++y) {
-      const double* row = &g[std::size_t(y) * w];
-      distance_1d(row, w, d.data(), arg.data(), v.data(), z.data());
+      for (int x = 0; x < w; ++x) {  // the column distances: squared, infinite where none
+        const int p = gy[std::size_t(y) * w + x];
+        f[std::size_t(x)] = p < 0 ? kInf : double(y - p) * (y - p);
+      }
+      distance_1d(f.data(), w, d.data(), arg.data(), v.data(), z.data());
       for (int x = 0; x < w; ++x) {
         if (covered[std::size_t(y) * w + x] || arg[x] < 0 || d[x] > limit) continue;
         const int sx = arg[x], sy = gy[std::size_t(y) * w + sx];

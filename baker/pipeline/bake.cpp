@@ -137,9 +137,9 @@ raycast::BuildQuality bvh_quality_for(const BakeOptions& o, std::size_t triangle
 
 std::uint64_t estimate_bake_bytes(const BakeOptions& o) {
   const std::uint64_t texels = std::uint64_t(std::max(o.width, 0)) * std::uint64_t(std::max(o.height, 0));
-  // map (3 floats) + coverage (1 byte) + padding transform (double + int) + optional miss mask.
+  // map (3 floats) + coverage (1 byte) + padding transform (one int) + optional miss mask.
   std::uint64_t per_texel =
-      12 + 1 + (o.padding > 0 ? 12 : 0) + (o.miss_mask ? 4 : 0) + (o.suspect_mask ? 4 : 0) + (o.samples > 1 ? 1 : 0);
+      12 + 1 + (o.padding > 0 ? 4 : 0) + (o.miss_mask ? 4 : 0) + (o.suspect_mask ? 4 : 0) + (o.samples > 1 ? 1 : 0);
   return texels * per_texel;
 }
 
