@@ -22,6 +22,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/bounds.h"
 #include "core/errors.h"
 #include "core/parallel.h"
 #include "io/mesh_io_detail.h"
@@ -254,20 +255,7 @@ void place(ParsedMesh& parsed, const std::string& path, const LoadOptions& optio
   std::vector<glm::dvec3>& exact = parsed.exact_positions;
   if (exact.size() != m.positions.size()) exact.assign(m.positions.begin(), m.positions.end());  // STL: float
   glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
-  // In chunks on every core, joined after (smallest and largest values: the same in any order).
-  constexpr std::size_t kChunk = std::size_t(1) << 16;
-  std::vector<std::pair<glm::dvec3, glm::dvec3>> boxes((m.position_index.size() + kChunk - 1) / kChunk, {lo, hi});
-  parallel_chunks(0, m.position_index.size(), kChunk, [&](std::size_t begin, std::size_t end) {
-    auto& [l, h] = boxes[begin / kChunk];
-    for (std::size_t c = begin; c < end; ++c) {
-      l = glm::min(l, exact[m.position_index[c]]);
-      h = glm::max(h, exact[m.position_index[c]]);
-    }
-  });
-  for (const auto& [l, h] : boxes) {
-    lo = glm::min(lo, l);
-    hi = glm::max(hi, h);
-  }
+  grow_box(lo, hi, exact, m.position_index);
   double largest = 0.0;
   for (int k = 0; k < 3; ++k) largest = std::max({largest, std::fabs(lo[k]), std::fabs(hi[k])});
   const double diagonal = glm::length(hi - lo);

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <utility>
 
+#include "core/bounds.h"
 #include "core/mesh_topology.h"
 #include "core/parallel.h"
 #include "raycast.h"
@@ -12,26 +12,6 @@
 namespace nmbake {
 
 namespace {
-
-// Over the positions faces use: a vertex no face uses (a stray point far away) must not move the
-// centre or stretch the diagonal that scales every distance.
-// In chunks on every core, each chunk's box joined to the others' (smallest and largest values: the
-// same whatever the order).
-void grow_box(glm::dvec3& lo, glm::dvec3& hi, const std::vector<glm::vec3>& pts, const std::vector<std::uint32_t>& index) {
-  constexpr std::size_t kChunk = std::size_t(1) << 16;
-  std::vector<std::pair<glm::dvec3, glm::dvec3>> boxes((index.size() + kChunk - 1) / kChunk, {lo, hi});
-  parallel_chunks(0, index.size(), kChunk, [&](std::size_t begin, std::size_t end) {
-    auto& [l, h] = boxes[begin / kChunk];
-    for (std::size_t c = begin; c < end; ++c) {
-      l = glm::min(l, glm::dvec3(pts[index[c]]));
-      h = glm::max(h, glm::dvec3(pts[index[c]]));
-    }
-  });
-  for (const auto& [l, h] : boxes) {
-    lo = glm::min(lo, l);
-    hi = glm::max(hi, h);
-  }
-}
 
 // `spare` more elements of capacity than of size: room that Embree's 16-byte loads past the last
 // vertex may read when it takes the positions in place (build_high_scene's `share`).
