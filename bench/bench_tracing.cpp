@@ -47,9 +47,12 @@ std::vector<QualityRow> sweep_quality(const std::string& scene, const Recorded& 
   return rows;
 }
 
-// Section 1's rounds on one scene and sample count: the bake, then the three bare loops.
+// Section 1's rounds on one scene and sample count: the bake, the same bake without the hit rule,
+// then the three bare loops.
 struct TraceRounds {
   Timing trace, bare1, bare8, bare_arrays;  // the best of the rounds
+  Timing no_rule;                           // the same bake with --keep-backfaces: no hit rule, no filter
+  bool same_rays = true;                    // and it cast as many rays
   double bvh = 0, pad = 0;                  // stage seconds of the fastest trace's bake
   std::string hash;                         // the map's pixel_hash (or that it varies)
   std::vector<double> paired;               // per round: trace / that round's best bare loop (wall)
@@ -64,6 +67,11 @@ TraceRounds measure_trace_rounds(const Mesh& low, const Mesh& high, const Record
       t.bvh = r.stats.seconds_bvh, t.pad = r.stats.seconds_padding;
     }
     t.trace.keep_min(r.stats.seconds_trace, r.stats.cpu_seconds_trace);
+    BakeOptions plain = rec.options;
+    plain.keep_backfaces = true;
+    const BakeResult nr = bake_normal_map(low, high, nullptr, plain);
+    t.no_rule.keep_min(nr.stats.seconds_trace, nr.stats.cpu_seconds_trace);
+    t.same_rays = t.same_rays && nr.stats.rays == r.stats.rays;
     const std::string h = hex(pixel_hash(r.map.pixels));
     t.hash = round == 0 ? h : (h == t.hash ? t.hash : t.hash + " VARIES between rounds");
     const Timing b1 = bare_loop(scene, rec.rays, threads, Bare::single);
@@ -94,13 +102,14 @@ void run_trace_row(BenchRun& run, const std::string& name, const Mesh& low, cons
   const bool judged6 = samples == 1 || samples == 16, judged2 = samples == 1 || samples == 4;
   std::printf(
       "| %s | %d | %zu%s | %s | %.3f | %.3f | %.3f (%.3f) | %.3f | %.2fM | %.2f | %.3f (%.3f) | %.3f (%.3f) | %.3f (%.3f) | "
-      "%.2fx (%.2fx) | %.2fx [%.2f .. %.2f] | %.3f | %s | %s | %s |\n",
+      "%.2fx (%.2fx) | %.2fx [%.2f .. %.2f] | %.3f | %.3f (%.3f)%s | %s | %s | %s |\n",
       name.c_str(), samples, high.triangle_count(),
       rec.culled ? (" (" + std::to_string(rec.culled) + " culled by the bake, traced by the bare loop)").c_str() : "",
       quality_name(quality), load, t.bvh, t.trace.wall, t.trace.cpu, t.pad, double(rec.rays.size()) / 1e6,
       double(rec.rays.size()) / t.trace.wall / 1e6, t.bare1.wall, t.bare1.cpu, t.bare8.wall, t.bare8.cpu, t.bare_arrays.wall,
-      t.bare_arrays.cpu, ratio, ratio_cpu, paired_median, *paired_min, *paired_max, t.trace.wall - best_wall,
-      judged2 ? verdict(ratio <= 1.3) : "-", judged6 ? verdict(ratio <= 1.15) : "-", t.hash.c_str());
+      t.bare_arrays.cpu, ratio, ratio_cpu, paired_median, *paired_min, *paired_max, t.trace.wall - best_wall, t.no_rule.wall,
+      t.no_rule.cpu, t.same_rays ? "" : " (other rays!)", judged2 ? verdict(ratio <= 1.3) : "-",
+      judged6 ? verdict(ratio <= 1.15) : "-", t.hash.c_str());
   flush();
   const std::string what = "tracing " + name + " 2048^2 " + std::to_string(samples) + " sample" + (samples > 1 ? "s" : "");
   const std::string measured =
@@ -153,16 +162,17 @@ std::vector<QualityRow> run_tracing(BenchRun& run) {
       "The bake and both packet loops tell Embree the packets are coherent (RTC_INTERSECT_CONTEXT_FLAG_COHERENT: eight\n"
       "neighbouring texels of a row); the single-ray loop cannot.\n"
       "\"Own s\": the fastest bake's trace less the best bare loop on its rays: the bake's own rasterizing, ray making,\n"
-      "shading and writing, as wall seconds.\n"
+      "shading and writing, as wall seconds. \"No rule\": the same bake with --keep-backfaces, the same rays cast\n"
+      "without the hit rule (no Embree filter; hits on back faces are taken): the rule's share of the trace.\n"
       "Rounds: %d at 1 and 4 samples, %d at 16; each timed column is the best of them. \"Per round\": each round's trace\n"
       "over that round's best bare loop, median [lowest .. highest]: how far the host's load moved the ratio in this run.\n\n",
       args.trace_rounds, args.rounds);
   std::printf(
       "| scene | samples | high tris | BVH | load s | bvh s | trace s (CPU) | pad s | rays | Mrays/s | bare 1-ray s (CPU) | "
       "bare 8-packet s (CPU) | bare 8-packet from arrays s (CPU) | trace / best bare, wall (CPU) | per round, median [range] | "
-      "own s | "
+      "own s | no rule: trace s (CPU) | "
       "issue 2 <= 1.3x | issue 6 <= 1.15x | map hash |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   flush();
   std::vector<QualityRow> quality_rows;
   const std::vector<int> ratio_samples = args.quick ? std::vector<int>{1} : std::vector<int>{1, 4, 16};
