@@ -301,7 +301,7 @@ BakeRays bake_rays(const Mesh& low, const Mesh& high, const Mesh* cage, const Ba
   std::string stage;
   prepare_trace(low, high, cage, opt, worker_threads(opt.threads), in, result, stage);
   const TileBins bins = bin_triangles(low, opt.width, opt.height, trace_tile_side(opt));
-  return {trace_rays(in.s, in.scene, bins, in.rays, opt), result.stats};
+  return {trace_rays(in.s, in.scene, bins, in.rays, opt, result.stats), result.stats};
 }
 
 }  // namespace nmbake

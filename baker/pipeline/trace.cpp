@@ -54,6 +54,11 @@ struct Shared {
   int rays_per_sample = 1;
   bool batched = false;     // tangent space, per-pixel bitangent: shade_batch.h shades most samples
   bool per_object = false;  // several objects: hits counted per object
+  // Several samples per texel, cast texel by texel (TileTracer::group_by_texel): only under a hit
+  // rule, whose hit does not depend on which rays share a packet. Without one, of two triangles at
+  // one distance Embree keeps the one its traversal meets last, and a packet's traversal order
+  // depends on all its rays (a bake with --keep-backfaces moved a texel).
+  bool by_texel = false;
   const raycast::HitRule* hit_rule = nullptr;
   bool prefer = false;  // the rule looks at the rays' preferred parts (back faces skipped)
   RayGroups groups;     // with --match: per low-poly triangle and BVH triangle
@@ -133,6 +138,7 @@ class TileTracer {
     for (std::size_t tile = 0; tile < sh_.bins.count(); ++tile) {
       if (sh_.bins.start[tile] == sh_.bins.start[tile + 1]) continue;
       const std::size_t sample_count = cover_tile(tile, rect_of(tile), sh_.offsets, nullptr);
+      if (sh_.by_texel && sh_.offsets.size() > 1 && sample_count > 1) group_by_texel(sample_count);
       make_rays(sample_count);
       for (std::size_t r = 0; r < sample_count * std::size_t(sh_.rays_per_sample); ++r) out.push_back(rays_.ray(r));
     }
@@ -186,10 +192,7 @@ class TileTracer {
   // cover, make and cast the rays, count the hits, shade into sums_. Returns the sum of hit distances.
   double trace_pass(std::size_t tile, const TileRect& rect, const std::vector<glm::dvec2>& offsets, const std::uint8_t* only) {
     const std::size_t sample_count = cover_tile(tile, rect, offsets, only);
-    // Only under a hit rule: its hit does not depend on which rays share a packet. Without one,
-    // of two triangles at one distance Embree keeps the one its traversal meets last, and a
-    // packet's traversal order depends on all its rays (a bake with --keep-backfaces moved a texel).
-    grouped_ = only != nullptr && sample_count > 1 && sh_.hit_rule != nullptr;
+    grouped_ = sh_.by_texel && offsets.size() > 1 && sample_count > 1;
     if (grouped_) group_by_texel(sample_count);
     const std::size_t ray_count = sample_count * std::size_t(sh_.rays_per_sample);
     make_rays(sample_count);
@@ -319,12 +322,10 @@ class TileTracer {
     return last_sample_count_;
   }
 
-  // A refining pass's samples, texel by texel (each texel's in sample order, as the compaction
-  // left them). The compaction orders them sample by sample, a row of texels at a time: that puts
-  // eight far-apart marked texels in one packet, where Embree took about 3x the base pass's time
-  // per ray; a texel's own samples lie within its footprint. Each texel's samples are summed in the
-  // same order as before, so its value is the same; the tile's hit distances are summed in the
-  // compaction's order (count_hits).
+  // The samples texel by texel, each texel's in sample order as the compaction left them (sample by
+  // sample, rows of texels: a packet of 8 rays spanned 8 texels, or 8 far-apart marked ones in a
+  // refining pass of --samples auto). A texel's samples lie within its footprint: Embree traces them
+  // faster. Each texel's sum is taken in the same order; so are the tile's hit distances (count_hits).
   void group_by_texel(std::size_t count) {
     texel_start_.assign(tile_texels_ + 1, 0);
     for (std::size_t r = 0; r < count; ++r) ++texel_start_[std::size_t(sample_texel_[r]) + 1];
@@ -549,9 +550,7 @@ class TileTracer {
   std::size_t last_sample_count_ = 0;      // covered samples of the last cover_tile
   std::vector<double> first_acc_;          // adaptive: the sums so far while a refining pass runs
   std::vector<std::uint32_t> first_miss_;
-  // Adaptive: a refining pass's samples grouped by texel (group_by_texel): where each went, and
-  // the hit distances to sum in the order they came in.
-  bool grouped_ = false;
+  bool grouped_ = false;  // this pass's samples grouped by texel (group_by_texel): where each went, its hit distance
   std::vector<std::uint32_t> texel_start_, dest_;
   std::vector<double> dists_, scratch_d_;
   std::vector<float> scratch_f_;
@@ -563,11 +562,13 @@ class TileTracer {
 }  // namespace
 
 std::vector<raycast::Ray> trace_rays(const Prepared& s, const HighScene& scene, const TileBins& bins, const RaySetup& rays,
-                                     const BakeOptions& opt) {
+                                     const BakeOptions& opt, const BakeStats& st) {
   Image map;
   std::vector<std::uint8_t> coverage, disagree;
   const TraceTargets out{map, coverage, map, disagree};
   Shared sh(s, scene, bins, rays, opt, out, 1);
+  raycast::HitRule rule;
+  sh.by_texel = trace_rule(scene, st.backfaces_skipped, ray_groups(s, scene, opt), rule) != nullptr;
   std::vector<raycast::Ray> all;
   TileTracer(sh, 0).collect_rays(all);
   return all;
@@ -579,6 +580,7 @@ void trace_and_shade(const Prepared& s, const HighScene& scene, const TileBins& 
   sh.groups = ray_groups(s, scene, opt);
   raycast::HitRule rule;
   sh.hit_rule = trace_rule(scene, st.backfaces_skipped, sh.groups, rule);
+  sh.by_texel = sh.hit_rule != nullptr;
   sh.prefer = st.backfaces_skipped;
   sh.tile_dsum.assign(bins.count(), 0.0);
   // Tiles are taken from a shared counter, so the tracers that start cover them all.

@@ -26,9 +26,10 @@ struct TraceTargets {
   std::vector<std::uint8_t>& disagree;
 };
 
-// The rays trace_and_shade casts, tile by tile (no map is made).
+// The rays trace_and_shade casts, tile by tile, in its order (no map is made); `st` as for
+// trace_and_shade (its backfaces_skipped).
 std::vector<raycast::Ray> trace_rays(const Prepared& s, const HighScene& scene, const TileBins& bins, const RaySetup& rays,
-                                     const BakeOptions& opt);
+                                     const BakeOptions& opt, const BakeStats& st);
 
 // Traces every tile of `bins`, applying the hit rule of `scene` unless stats.backfaces_skipped is
 // false. Fills in `st`: rays, hits, misses, samples_covered, overlapping_samples, backface_skips,
