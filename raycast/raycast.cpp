@@ -353,13 +353,19 @@ void Scene::intersect(const RayBatch& rays, const HitBatch& hits, std::size_t co
     rh.ray.id[k] = unsigned(k);
     rh.ray.flags[k] = 0;
   }
+  std::uint32_t ray[8];  // the packet's rays (a short last packet repeats its last ray)
   for (std::size_t base = 0; base < count; base += 8) {
     const std::size_t n = std::min<std::size_t>(8, count - base);
+    const bool in_place = n == 8 && !rays.order;  // rays base .. base + 7
+    for (std::size_t k = 0; k < 8; ++k) {
+      const std::size_t j = base + std::min(k, n - 1);
+      ray[k] = std::uint32_t(rays.order ? rays.order[j] : j);
+    }
     auto fill = [&](float* to, const float* from) {
-      if (n == 8) {
+      if (in_place) {
         std::memcpy(to, from + base, 8 * sizeof(float));
       } else {
-        for (std::size_t k = 0; k < 8; ++k) to[k] = from[base + std::min(k, n - 1)];  // a short last packet repeats its last ray
+        for (std::size_t k = 0; k < 8; ++k) to[k] = from[ray[k]];
       }
     };
     fill(rh.ray.org_x, rays.org_x);
@@ -379,7 +385,7 @@ void Scene::intersect(const RayBatch& rays, const HitBatch& hits, std::size_t co
     if (rule) {
       rc.reset_lanes();
       for (std::size_t k = 0; k < 8; ++k) {
-        const std::size_t i = base + std::min(k, n - 1);
+        const std::size_t i = ray[k];
         rc.outward[k] = rays.outward ? rays.outward[i] : 0;
         if (rays.prefer_lo) rc.prefer_lo[k] = rays.prefer_lo[i];
         if (rays.prefer_hi) rc.prefer_hi[k] = rays.prefer_hi[i];
@@ -394,20 +400,21 @@ void Scene::intersect(const RayBatch& rays, const HitBatch& hits, std::size_t co
     if (rule) {
       for (std::size_t k = 0; k < n; ++k) {
         const std::uint8_t f = rc.finish(int(k), rh.hit.primID[k], rh.ray.tfar[k], rh.hit.u[k], rh.hit.v[k]);
-        if (hits.flags) hits.flags[base + k] = f;
+        if (hits.flags) hits.flags[ray[k]] = f;
       }
     }
-    if (n == 8) {
+    if (in_place) {
       std::memcpy(hits.triangle + base, rh.hit.primID, 8 * sizeof(std::uint32_t));
       std::memcpy(hits.t + base, rh.ray.tfar, 8 * sizeof(float));
       std::memcpy(hits.u + base, rh.hit.u, 8 * sizeof(float));
       std::memcpy(hits.v + base, rh.hit.v, 8 * sizeof(float));
     } else {
       for (std::size_t k = 0; k < n; ++k) {
-        hits.triangle[base + k] = rh.hit.primID[k];
-        hits.t[base + k] = rh.ray.tfar[k];
-        hits.u[base + k] = rh.hit.u[k];
-        hits.v[base + k] = rh.hit.v[k];
+        const std::size_t i = ray[k];
+        hits.triangle[i] = rh.hit.primID[k];
+        hits.t[i] = rh.ray.tfar[k];
+        hits.u[i] = rh.hit.u[k];
+        hits.v[i] = rh.hit.v[k];
       }
     }
   }

@@ -56,6 +56,10 @@ struct RayBatch {
   // Embree then traces each packet of 8 together (RTC_INTERSECT_CONTEXT_FLAG_COHERENT), which
   // on the bake's rays takes about 0.6 of the time; the hits are the same.
   bool coherent = false;
+  // When not null, the order to cast the rays in (a permutation of 0 .. count - 1, Scene::intersect's
+  // count): packets are made of rays order[0..7], order[8..15], ...; each ray's hit still goes to
+  // its own index. (For making packets of near rays without moving the rays.)
+  const std::uint32_t* order = nullptr;
 };
 // Their hits, the same way: triangle[i] is no_hit for a miss (t, u, v then unspecified).
 struct HitBatch {

@@ -54,7 +54,7 @@ struct Shared {
   int rays_per_sample = 1;
   bool batched = false;     // tangent space, per-pixel bitangent: shade_batch.h shades most samples
   bool per_object = false;  // several objects: hits counted per object
-  // Several samples per texel, cast texel by texel (TileTracer::group_by_texel): only under a hit
+  // Several samples per texel, cast texel by texel (TileTracer::cast_order): only under a hit
   // rule, whose hit does not depend on which rays share a packet. Without one, of two triangles at
   // one distance Embree keeps the one its traversal meets last, and a packet's traversal order
   // depends on all its rays (a bake with --keep-backfaces moved a texel).
@@ -138,9 +138,10 @@ class TileTracer {
     for (std::size_t tile = 0; tile < sh_.bins.count(); ++tile) {
       if (sh_.bins.start[tile] == sh_.bins.start[tile + 1]) continue;
       const std::size_t sample_count = cover_tile(tile, rect_of(tile), sh_.offsets, nullptr);
-      if (sh_.by_texel && sh_.offsets.size() > 1 && sample_count > 1) group_by_texel(sample_count);
       make_rays(sample_count);
-      for (std::size_t r = 0; r < sample_count * std::size_t(sh_.rays_per_sample); ++r) out.push_back(rays_.ray(r));
+      const std::uint32_t* order = cast_order(sh_.offsets, sample_count);
+      for (std::size_t r = 0; r < sample_count * std::size_t(sh_.rays_per_sample); ++r)
+        out.push_back(rays_.ray(order ? order[r] : r));
     }
   }
 
@@ -192,10 +193,9 @@ class TileTracer {
   // cover, make and cast the rays, count the hits, shade into sums_. Returns the sum of hit distances.
   double trace_pass(std::size_t tile, const TileRect& rect, const std::vector<glm::dvec2>& offsets, const std::uint8_t* only) {
     const std::size_t sample_count = cover_tile(tile, rect, offsets, only);
-    grouped_ = sh_.by_texel && offsets.size() > 1 && sample_count > 1;
-    if (grouped_) group_by_texel(sample_count);
     const std::size_t ray_count = sample_count * std::size_t(sh_.rays_per_sample);
     make_rays(sample_count);
+    batch_.order = cast_order(offsets, sample_count);
     if (sh_.groups.active()) set_groups(sample_count);
     if (ray_count) {
       sh_.scene.scene->intersect(batch_, hits_, ray_count, sh_.hit_rule);
@@ -322,35 +322,24 @@ class TileTracer {
     return last_sample_count_;
   }
 
-  // The samples texel by texel, each texel's in sample order as the compaction left them (sample by
-  // sample, rows of texels: a packet of 8 rays spanned 8 texels, or 8 far-apart marked ones in a
-  // refining pass of --samples auto). A texel's samples lie within its footprint: Embree traces them
-  // faster. Each texel's sum is taken in the same order; so are the tile's hit distances (count_hits).
-  void group_by_texel(std::size_t count) {
+  // The order the rays are cast in (raycast::RayBatch::order), or null for their own: with several
+  // samples per texel under a hit rule (Shared::by_texel), texel by texel, each texel's in sample
+  // order. The compaction orders the samples sample by sample, rows of texels, so a packet of 8 rays
+  // spanned 8 texels (8 far-apart marked ones in a refining pass of --samples auto); a texel's
+  // samples lie within its footprint, and Embree traces such packets faster. Hits land at each
+  // ray's own index: everything after the cast reads the samples in their order, as before.
+  const std::uint32_t* cast_order(const std::vector<glm::dvec2>& offsets, std::size_t count) {
+    if (!sh_.by_texel || offsets.size() < 2 || count < 2) return nullptr;
     texel_start_.assign(tile_texels_ + 1, 0);
     for (std::size_t r = 0; r < count; ++r) ++texel_start_[std::size_t(sample_texel_[r]) + 1];
     for (std::size_t i = 1; i <= tile_texels_; ++i) texel_start_[i] += texel_start_[i - 1];
-    dest_.resize(count);
-    for (std::size_t r = 0; r < count; ++r) dest_[r] = texel_start_[sample_texel_[r]]++;
-    permute(sample_tri_.data(), count, scratch_i_);
-    for (double* b : sb_) permute(b, count, scratch_d_);
-    permute(sample_texel_.data(), count, scratch_t_);
-    permute(sample_fallback_.data(), count, scratch_u_);
-    if (!kernel_rays_) return;  // the rays are made after this, from the samples
-    for (int c = 0; c < 3; ++c) {
-      permute(rays_.origin(c), count, scratch_f_);
-      permute(rays_.direction(c), count, scratch_f_);
+    const std::uint32_t per = std::uint32_t(sh_.rays_per_sample);
+    order_.resize(count * per);
+    for (std::size_t r = 0; r < count; ++r) {
+      const std::size_t at = std::size_t(texel_start_[sample_texel_[r]]++) * per;
+      for (std::uint32_t j = 0; j < per; ++j) order_[at + j] = std::uint32_t(r) * per + j;
     }
-    permute(rays_.tnear(), count, scratch_f_);
-    permute(rays_.tfar(), count, scratch_f_);
-    permute(signed_base_.data(), count, scratch_d_);
-    if (!prefer_lo_.empty()) permute(prefer_lo_.data(), count, scratch_f_);
-  }
-  template <class T>
-  void permute(T* a, std::size_t count, std::vector<T>& scratch) {
-    scratch.resize(count);
-    for (std::size_t r = 0; r < count; ++r) scratch[dest_[r]] = a[r];
-    std::copy(scratch.begin(), scratch.end(), a);
+    return order_.data();
   }
 
   // Per row of the tile, the first and last texel `only` marks (first > last: none), in span_; the
@@ -413,7 +402,6 @@ class TileTracer {
     // In registers for the tile: the stores below could alias the thread's counters.
     double dsum = 0.0, dmin = ts_.dmin, dmax = ts_.dmax;
     const std::size_t per = std::size_t(sh_.rays_per_sample);
-    if (grouped_) dists_.assign(sample_count, 0.0);
     for (std::size_t r = 0; r < sample_count; ++r) {
       double dist = 0.0;
       const std::size_t h = chosen_hit(hits_, r * per, signed_base_.data(), sh_.setup.closest, &dist);
@@ -447,14 +435,9 @@ class TileTracer {
         dmin = std::min(dmin, dist);
         dmax = std::max(dmax, dist);
         dsum += dist;
-        if (grouped_) dists_[r] = dist;
       } else {
         ++miss_count_[sample_texel_[r]];
       }
-    }
-    if (grouped_) {  // summed in the compaction's order, as without the grouping (0 adds nothing to a sum >= +0)
-      dsum = 0.0;
-      for (std::size_t r = 0; r < sample_count; ++r) dsum += dists_[dest_[r]];
     }
     ts_.covered += sample_count;
     ts_.hits += tile_hits;
@@ -550,13 +533,7 @@ class TileTracer {
   std::size_t last_sample_count_ = 0;      // covered samples of the last cover_tile
   std::vector<double> first_acc_;          // adaptive: the sums so far while a refining pass runs
   std::vector<std::uint32_t> first_miss_;
-  bool grouped_ = false;  // this pass's samples grouped by texel (group_by_texel): where each went, its hit distance
-  std::vector<std::uint32_t> texel_start_, dest_;
-  std::vector<double> dists_, scratch_d_;
-  std::vector<float> scratch_f_;
-  std::vector<std::int32_t> scratch_i_;
-  std::vector<std::uint16_t> scratch_t_;
-  std::vector<std::uint8_t> scratch_u_;
+  std::vector<std::uint32_t> texel_start_, order_;  // cast_order
 };
 
 }  // namespace
