@@ -353,6 +353,37 @@ std::pair<raycast::RayArrays, raycast::RayArrays> trace_both(const raycast::Scen
   return {std::move(plain), std::move(coherent)};
 }
 
+// Expects the same hit (triangle, t, u, v) for every ray of `a` and `b`, and with `flags` the same
+// HitFlags. Returns how many hit, and how many passed a back face.
+std::pair<std::size_t, std::size_t> expect_same_hits(const raycast::RayArrays& a, const raycast::RayArrays& b, bool flags) {
+  std::size_t hits = 0, passed = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const raycast::Hit x = a.hit(i), y = b.hit(i);
+    EXPECT_EQ(x.triangle, y.triangle) << "ray " << i;
+    if (flags) {
+      EXPECT_EQ(a.flags(i), b.flags(i)) << "ray " << i;
+      passed += (b.flags(i) & raycast::hit_passed_backface) != 0;
+    }
+    if (!x.hit() || x.triangle != y.triangle) continue;
+    ++hits;
+    EXPECT_EQ(x.t, y.t) << "ray " << i;
+    EXPECT_EQ(x.u, y.u) << "ray " << i;
+    EXPECT_EQ(x.v, y.v) << "ray " << i;
+  }
+  return {hits, passed};
+}
+
+// Rows of parallel rays, nx by ny, `sx` and `sy` apart from (-1.6, -1.6): odd rows from above the
+// test torus (z = 2), even ones from its middle plane (inside the tube they meet a back face first).
+std::vector<raycast::Ray> rows_of_rays(int nx, int ny, float sx, float sy) {
+  std::vector<raycast::Ray> rays;
+  const glm::vec3 dir = glm::normalize(glm::vec3(0.3f, -0.2f, -1.0f));
+  for (int y = 0; y < ny; ++y)
+    for (int x = 0; x < nx; ++x)
+      rays.push_back({{-1.6f + sx * float(x), -1.6f + sy * float(y), y % 2 ? 2.0f : 0.0f}, 0.0f, dir, 6.0f});
+  return rays;
+}
+
 }  // namespace
 
 TEST(Raycast, CoherentPacketsGiveTheSameHits) {
@@ -363,28 +394,11 @@ TEST(Raycast, CoherentPacketsGiveTheSameHits) {
   const Mesh m = test::make_torus(64, 32);
   raycast::Scene scene(&m.positions[0].x, m.positions.size(), m.position_index.data(), m.triangle_count(),
                        raycast::BuildQuality::high);
-  std::vector<raycast::Ray> rays;
-  const glm::vec3 dir = glm::normalize(glm::vec3(0.3f, -0.2f, -1.0f));
-  for (int y = 0; y < 97; ++y)
-    for (int x = 0; x < 101; ++x)
-      rays.push_back({{-1.6f + 0.032f * float(x), -1.6f + 0.033f * float(y), y % 2 ? 2.0f : 0.0f}, 0.0f, dir, 6.0f});
+  const std::vector<raycast::Ray> rays = rows_of_rays(101, 97, 0.032f, 0.033f);
   const raycast::HitRule rule;
   for (const raycast::HitRule* r : {static_cast<const raycast::HitRule*>(nullptr), &rule}) {
     const auto [plain, coherent] = trace_both(scene, rays, r);
-    std::size_t hits = 0, passed = 0;
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-      const raycast::Hit a = plain.hit(i), b = coherent.hit(i);
-      ASSERT_EQ(a.triangle, b.triangle) << "ray " << i;
-      if (r) {
-        EXPECT_EQ(plain.flags(i), coherent.flags(i)) << "ray " << i;
-        passed += (coherent.flags(i) & raycast::hit_passed_backface) != 0;
-      }
-      if (!a.hit()) continue;
-      ++hits;
-      EXPECT_EQ(a.t, b.t) << "ray " << i;
-      EXPECT_EQ(a.u, b.u) << "ray " << i;
-      EXPECT_EQ(a.v, b.v) << "ray " << i;
-    }
+    const auto [hits, passed] = expect_same_hits(plain, coherent, r != nullptr);
     EXPECT_GT(hits, rays.size() / 8);
     if (r) {
       EXPECT_GT(passed, 0u) << "no ray met a back face first: the rule's case is not exercised";
@@ -410,11 +424,7 @@ TEST(RaycastRule, CastOrderLeavesEachRaysHit) {
   const Mesh m = test::make_torus(64, 32);
   raycast::Scene scene(&m.positions[0].x, m.positions.size(), m.position_index.data(), m.triangle_count(),
                        raycast::BuildQuality::high);
-  std::vector<raycast::Ray> rays;
-  const glm::vec3 dir = glm::normalize(glm::vec3(0.3f, -0.2f, -1.0f));
-  for (int y = 0; y < 61; ++y)
-    for (int x = 0; x < 67; ++x)
-      rays.push_back({{-1.6f + 0.048f * float(x), -1.6f + 0.05f * float(y), y % 2 ? 2.0f : 0.0f}, 0.0f, dir, 6.0f});
+  const std::vector<raycast::Ray> rays = rows_of_rays(67, 61, 0.048f, 0.05f);
   std::vector<std::uint32_t> order(rays.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = std::uint32_t(i);
   std::shuffle(order.begin(), order.end(), std::mt19937(12117));
@@ -426,18 +436,7 @@ TEST(RaycastRule, CastOrderLeavesEachRaysHit) {
     b.order = order.data();
     scene.intersect(a, made.hits(), made.size(), &rule);
     scene.intersect(b, shuffled.hits(), shuffled.size(), &rule);
-    std::size_t hits = 0, passed = 0;
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-      const raycast::Hit x = made.hit(i), y = shuffled.hit(i);
-      ASSERT_EQ(x.triangle, y.triangle) << "ray " << i;
-      EXPECT_EQ(made.flags(i), shuffled.flags(i)) << "ray " << i;
-      passed += (made.flags(i) & raycast::hit_passed_backface) != 0;
-      if (!x.hit()) continue;
-      ++hits;
-      EXPECT_EQ(x.t, y.t) << "ray " << i;
-      EXPECT_EQ(x.u, y.u) << "ray " << i;
-      EXPECT_EQ(x.v, y.v) << "ray " << i;
-    }
+    const auto [hits, passed] = expect_same_hits(made, shuffled, true);
     EXPECT_GT(hits, rays.size() / 8);
     EXPECT_GT(passed, 0u) << "no ray met a back face first: the rule's case is not exercised";
   }
