@@ -334,13 +334,17 @@ std::vector<std::uint32_t> weld_positions(const std::vector<glm::vec3>& position
 
 MeshTopology inspect_topology(const Mesh& mesh, int threads) { return analyze(mesh, threads).topo; }
 
-std::vector<glm::vec3> compute_high_corner_normals(const Mesh& m, std::size_t* reoriented, int threads) {
+void compute_high_corner_normals(const Mesh& m, glm::vec3* out, std::size_t* reoriented, int threads) {
   const Analysis a = analyze(m, threads);
   if (reoriented) *reoriented = a.topo.inconsistent_winding_faces;
   // Indexed by welded id (< positions).
   const std::vector<glm::dvec3> sum = angle_weighted_sums(m, &a.corner, m.positions.size(), &a.skip, &a.flip);
+  for (std::size_t c = 0; c < 3 * m.triangle_count(); ++c) out[c] = unit_or_up(sum[a.corner[c]]);
+}
+
+std::vector<glm::vec3> compute_high_corner_normals(const Mesh& m, std::size_t* reoriented, int threads) {
   std::vector<glm::vec3> out(3 * m.triangle_count());
-  for (std::size_t c = 0; c < out.size(); ++c) out[c] = unit_or_up(sum[a.corner[c]]);
+  compute_high_corner_normals(m, out.data(), reoriented, threads);
   return out;
 }
 

@@ -38,5 +38,7 @@ std::vector<std::uint32_t> weld_positions(const std::vector<glm::vec3>& position
 // neighbours turned to the majority winding of their piece first (`reoriented` receives how many).
 // Zero-area faces carry no direction; a vertex with none gets (0,0,1). Never NaN.
 std::vector<glm::vec3> compute_high_corner_normals(const Mesh& mesh, std::size_t* reoriented = nullptr, int threads = 0);
+// The same into `out` (3 per triangle), the caller's storage.
+void compute_high_corner_normals(const Mesh& mesh, glm::vec3* out, std::size_t* reoriented = nullptr, int threads = 0);
 
 }  // namespace nmbake

@@ -172,8 +172,8 @@ Prepared prepare(const Mesh& low, const Mesh& high, const Mesh* cage, BakeStats&
     });
   } else {
     // Welded by value, duplicate faces once, one winding per piece (mesh_topology.h).
-    const std::vector<glm::vec3> computed = compute_high_corner_normals(high, &st.high_faces_reoriented);
-    s.high_corner_normals.assign(computed.begin(), computed.end());
+    s.high_corner_normals.resize(3 * high.triangle_count());
+    compute_high_corner_normals(high, s.high_corner_normals.data(), &st.high_faces_reoriented);
     st.high_normals_computed = true;
   }
   s.high_facing = triangle_facing(s.high_pos, high.position_index, s.high_corner_normals);

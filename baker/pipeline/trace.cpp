@@ -54,11 +54,6 @@ struct Shared {
   int rays_per_sample = 1;
   bool batched = false;     // tangent space, per-pixel bitangent: shade_batch.h shades most samples
   bool per_object = false;  // several objects: hits counted per object
-  // Several samples per texel, cast texel by texel (TileTracer::cast_order): only under a hit
-  // rule, whose hit does not depend on which rays share a packet. Without one, of two triangles at
-  // one distance Embree keeps the one its traversal meets last, and a packet's traversal order
-  // depends on all its rays (a bake with --keep-backfaces moved a texel).
-  bool by_texel = false;
   const raycast::HitRule* hit_rule = nullptr;
   bool prefer = false;  // the rule looks at the rays' preferred parts (back faces skipped)
   RayGroups groups;     // with --match: per low-poly triangle and BVH triangle
@@ -323,13 +318,16 @@ class TileTracer {
   }
 
   // The order the rays are cast in (raycast::RayBatch::order), or null for their own: with several
-  // samples per texel under a hit rule (Shared::by_texel), texel by texel, each texel's in sample
+  // samples per texel under a hit rule, texel by texel, each texel's in sample
   // order. The compaction orders the samples sample by sample, rows of texels, so a packet of 8 rays
   // spanned 8 texels (8 far-apart marked ones in a refining pass of --samples auto); a texel's
   // samples lie within its footprint, and Embree traces such packets faster. Hits land at each
   // ray's own index: everything after the cast reads the samples in their order, as before.
   const std::uint32_t* cast_order(const std::vector<glm::dvec2>& offsets, std::size_t count) {
-    if (!sh_.by_texel || offsets.size() < 2 || count < 2) return nullptr;
+    // Only under a hit rule, whose hit does not depend on which rays share a packet. Without one, of
+    // two triangles at one distance Embree keeps the one its traversal meets last, and a packet's
+    // traversal order depends on all its rays (a bake with --keep-backfaces moved a texel).
+    if (!sh_.hit_rule || offsets.size() < 2 || count < 2) return nullptr;
     texel_start_.assign(tile_texels_ + 1, 0);
     for (std::size_t r = 0; r < count; ++r) ++texel_start_[std::size_t(sample_texel_[r]) + 1];
     for (std::size_t i = 1; i <= tile_texels_; ++i) texel_start_[i] += texel_start_[i - 1];
@@ -536,6 +534,14 @@ class TileTracer {
   std::vector<std::uint32_t> texel_start_, order_;  // cast_order
 };
 
+// The trace's hit rule (trace_rule), its match groups and whether it looks at preferred parts;
+// `rule` holds it.
+void set_rule(Shared& sh, const BakeStats& st, raycast::HitRule& rule) {
+  sh.groups = ray_groups(sh.s, sh.scene, sh.opt);
+  sh.hit_rule = trace_rule(sh.scene, st.backfaces_skipped, sh.groups, rule);
+  sh.prefer = st.backfaces_skipped;
+}
+
 }  // namespace
 
 std::vector<raycast::Ray> trace_rays(const Prepared& s, const HighScene& scene, const TileBins& bins, const RaySetup& rays,
@@ -545,7 +551,7 @@ std::vector<raycast::Ray> trace_rays(const Prepared& s, const HighScene& scene, 
   const TraceTargets out{map, coverage, map, disagree};
   Shared sh(s, scene, bins, rays, opt, out, 1);
   raycast::HitRule rule;
-  sh.by_texel = trace_rule(scene, st.backfaces_skipped, ray_groups(s, scene, opt), rule) != nullptr;
+  set_rule(sh, st, rule);  // its cast order (TileTracer::cast_order)
   std::vector<raycast::Ray> all;
   TileTracer(sh, 0).collect_rays(all);
   return all;
@@ -554,11 +560,8 @@ std::vector<raycast::Ray> trace_rays(const Prepared& s, const HighScene& scene, 
 void trace_and_shade(const Prepared& s, const HighScene& scene, const TileBins& bins, const RaySetup& rays,
                      const BakeOptions& opt, int threads, const TraceTargets& out, BakeStats& st) {
   Shared sh(s, scene, bins, rays, opt, out, threads);
-  sh.groups = ray_groups(s, scene, opt);
   raycast::HitRule rule;
-  sh.hit_rule = trace_rule(scene, st.backfaces_skipped, sh.groups, rule);
-  sh.by_texel = sh.hit_rule != nullptr;
-  sh.prefer = st.backfaces_skipped;
+  set_rule(sh, st, rule);
   sh.tile_dsum.assign(bins.count(), 0.0);
   // Tiles are taken from a shared counter, so the tracers that start cover them all.
   run_workers(
