@@ -69,6 +69,7 @@ TraceRounds measure_trace_rounds(const Mesh& low, const Mesh& high, const Record
     t.trace.keep_min(r.stats.seconds_trace, r.stats.cpu_seconds_trace);
     BakeOptions plain = rec.options;
     plain.keep_backfaces = true;
+    plain.cast_by_texel = true;  // the same packets as the bake under the rule
     const BakeResult nr = bake_normal_map(low, high, nullptr, plain);
     t.no_rule.keep_min(nr.stats.seconds_trace, nr.stats.cpu_seconds_trace);
     t.same_rays = t.same_rays && nr.stats.rays == r.stats.rays;
@@ -163,7 +164,8 @@ std::vector<QualityRow> run_tracing(BenchRun& run) {
       "neighbouring texels of a row); the single-ray loop cannot.\n"
       "\"Own s\": the fastest bake's trace less the best bare loop on its rays: the bake's own rasterizing, ray making,\n"
       "shading and writing, as wall seconds. \"No rule\": the same bake with --keep-backfaces, the same rays cast\n"
-      "without the hit rule (no Embree filter; hits on back faces are taken): the rule's share of the trace.\n"
+      "in the same packets without the hit rule (no Embree filter; hits on back faces are taken): the rule's share of\n"
+      "the trace.\n"
       "Rounds: %d at 1 and 4 samples, %d at 16; each timed column is the best of them. \"Per round\": each round's trace\n"
       "over that round's best bare loop, median [lowest .. highest]: how far the host's load moved the ratio in this run.\n\n",
       args.trace_rounds, args.rounds);

@@ -111,6 +111,11 @@ struct BakeOptions {
   // normal points to) is passed over for the next one, and a hit whose normal points away from the
   // low-poly's outside is taken only when the ray finds no other (raycast::HitRule).
   bool keep_backfaces = false;
+  // Several samples per texel are cast texel by texel under the hit rule; without it, in the order
+  // they were covered, as Embree's pick between two triangles at one distance depends on the
+  // packet's other rays. True: texel by texel either way (the bench's "no rule" timing, so that it
+  // casts the same packets as the bake under the rule; a map may then differ in such ties).
+  bool cast_by_texel = false;
   // Bytes the bake's buffers may take (estimate_bake_bytes); 0 = what the machine has
   // (memory_budget_bytes: MemAvailable, cgroup limit, ulimit -v). Larger bakes are refused.
   std::uint64_t memory_limit = 0;

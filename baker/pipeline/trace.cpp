@@ -326,8 +326,9 @@ class TileTracer {
   const std::uint32_t* cast_order(const std::vector<glm::dvec2>& offsets, std::size_t count) {
     // Only under a hit rule, whose hit does not depend on which rays share a packet. Without one, of
     // two triangles at one distance Embree keeps the one its traversal meets last, and a packet's
-    // traversal order depends on all its rays (a bake with --keep-backfaces moved a texel).
-    if (!sh_.hit_rule || offsets.size() < 2 || count < 2) return nullptr;
+    // traversal order depends on all its rays (a bake with --keep-backfaces moved a texel). The
+    // bench's timing without the rule asks for it anyway (BakeOptions::cast_by_texel).
+    if ((!sh_.hit_rule && !sh_.opt.cast_by_texel) || offsets.size() < 2 || count < 2) return nullptr;
     texel_start_.assign(tile_texels_ + 1, 0);
     for (std::size_t r = 0; r < count; ++r) ++texel_start_[std::size_t(sample_texel_[r]) + 1];
     for (std::size_t i = 1; i <= tile_texels_; ++i) texel_start_[i] += texel_start_[i - 1];
