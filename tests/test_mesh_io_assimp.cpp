@@ -104,7 +104,7 @@ TEST(AssimpFormats, UvSetPicksTheSet) {
   } catch (const InputError& e) {
     EXPECT_TRUE(test::contains(e.what(), ".obj files have one UV set")) << e.what();
   }
-  const test::CliRun r = test::run_nmbake(dae + " " + dae + " -o m.png --size 32 --uv-set 1 --report r.json");
+  const test::CliRun r = test::run_nmbake(dae + " " + dae + " -o m.png --size 32 --uv-set 1 --report r.json --allow-overlap");
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.report["options"]["uv_set"], 1);
   EXPECT_EQ(test::run_nmbake(dae + " " + dae + " -o m.png --size 32 --uv-set 8").code, 1);

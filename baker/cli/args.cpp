@@ -121,6 +121,12 @@ void add_options(CLI::App& app, Args& a) {
   app.add_flag("--keep-backfaces", a.keep_backfaces,
                "Take the first hit whatever it faces (default: hits on back faces, the insides of other parts, are passed "
                "over and counted as backface_skips in the report)");
+  app.add_flag("--allow-mismatch", a.allow_mismatch,
+               "Bake even when LOW and HIGH do not lie in one place or one is 10 or more times the other's size (by "
+               "their bounding boxes; default: refused, exit 2, naming both boxes)");
+  app.add_flag("--allow-overlap", a.allow_overlap,
+               "Bake even when over 10% of the covered texels lie under three or more UV triangles (tiled UVs; default: "
+               "refused, exit 2); stacked mirrored halves (two layers) bake without it, the lower face number winning");
   app.add_flag("--progress", a.progress,
                "Show the progress line (each stage, the time since the start, the time left once tracing has run a "
                "second) even when stderr is not a terminal (default: on a terminal only; never with --quiet)");

@@ -35,6 +35,8 @@ struct Args {
   bool no_cull = false;
   bool keep_backfaces = false;
   bool estimate_error = false;
+  bool allow_mismatch = false;                 // --allow-mismatch: bake LOW and HIGH whose boxes do not match (pair_checks.h)
+  bool allow_overlap = false;                  // --allow-overlap: bake UVs stacked three or more deep
   std::string match = "none", match_suffixes;  // --match, --match-suffixes
 };
 

@@ -6,6 +6,7 @@
 #include <tuple>
 
 #include "cli/outputs.h"
+#include "cli/pair_checks.h"
 #include "cli/report.h"
 #include "cli/udim_outputs.h"
 #include "cli/warnings.h"
@@ -234,6 +235,21 @@ RunInfo run_info(const Args& a, const std::vector<std::string>& command, int bit
   return run;
 }
 
+// A mesh file loaded in its role (LOW, HIGH, --cage): an error loading it says which it was given as
+// (a sculpt given as LOW fails for want of UVs; the line then says the order of the arguments).
+Mesh load_as(const char* role, const std::string& path, const LoadOptions& options, MeshLoadInfo* info) {
+  try {
+    return load_mesh(path, options, info);
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    const bool low = std::string(role) == "LOW";
+    throw Error(e.code(), what + (low && what.find("no UVs") != std::string::npos
+                                      ? " (given as LOW, the low-poly to bake into, which needs UVs; is it the high-poly? "
+                                        "nmbake LOW HIGH -o MAP)"
+                                      : " (given as " + std::string(role) + ")"));
+  }
+}
+
 // The high-poly files merged, from the cache when an earlier job loaded them.
 std::shared_ptr<const LoadedHigh> load_highs(const std::vector<std::string>& paths, const LoadOptions& options,
                                              MeshCache* cache) {
@@ -251,7 +267,7 @@ std::shared_ptr<const LoadedHigh> load_highs(const std::vector<std::string>& pat
   auto loaded = std::make_shared<LoadedHigh>();
   std::vector<Mesh> meshes;
   for (const std::string& path : paths) {
-    meshes.push_back(load_mesh(path, options, &loaded->infos.emplace_back()));
+    meshes.push_back(load_as("HIGH", path, options, &loaded->infos.emplace_back()));
     loaded->triangles.push_back(meshes.back().triangle_count());
   }
   loaded->mesh = merge_meshes(std::move(meshes));
@@ -277,7 +293,7 @@ void bake_job(const Args& a, const JobEnv& env) {
   LoadOptions low_opts;
   low_opts.require_uvs = true;
   low_opts.uv_set = a.uv_set;
-  Mesh low = load_mesh(a.low, low_opts, &run.low_info);
+  Mesh low = load_as("LOW", a.low, low_opts, &run.low_info);
   run.origin = {low.origin.x, low.origin.y, low.origin.z};
   LoadOptions shared;  // the high-poly and the cage share the low-poly's origin (re-centred when far)
   shared.origin = low.origin;
@@ -287,13 +303,25 @@ void bake_job(const Args& a, const JobEnv& env) {
   run.high_info = combined_info(run.high_infos);
   const Mesh& high = loaded->mesh;
   Mesh cage;
-  if (!a.cage.empty()) cage = load_mesh(a.cage, shared, &run.cage_info);
+  if (!a.cage.empty()) cage = load_as("--cage", a.cage, shared, &run.cage_info);
   const Mesh* cage_mesh = a.cage.empty() ? nullptr : &cage;
   run.seconds_load = std::chrono::duration<double>(Clock::now() - t0).count();
   run.low_objects = object_list(low);
   run.high_objects = object_list(high);
   if (a.match == "names") run.match = match_by_names(run.low_objects, run.high_objects, a.match_suffixes, o);
+  // The pair as given, before a bake that could not be right: boxes apart or of other sizes, LOW and
+  // HIGH the wrong way round, UVs stacked deep.
+  const PairBoxes boxes = compare_boxes(low, high, o.threads);
+  run.pair = pair_report(boxes);
+  if (boxes.mismatch != PairBoxes::Mismatch::none && !a.allow_mismatch)
+    throw InputError(mismatch_text(boxes, a.low, a.high, false));
+  const UvOverlap overlap = measure_map_overlap(low, o.width, o.height, has_udim(a.output), o.threads);
+  run.uv_overlap = overlap_report(overlap);
+  if (overlap_refused(overlap) && !a.allow_overlap) throw InputError(overlap_text(overlap, 0, a.low, false));
   env.progress.above([&] {
+    if (boxes.mismatch != PairBoxes::Mismatch::none) warnings.add({"warning: " + mismatch_text(boxes, a.low, a.high, true)});
+    if (const auto swapped = swap_warning(low.triangle_count(), high.triangle_count(), high.has_uvs(), a.low, a.high))
+      warnings.add({*swapped});
     warnings.add(load_warnings(run.low_info, a.low));
     for (std::size_t i = 0; i < a.highs.size(); ++i) warnings.add(load_warnings(run.high_infos[i], a.highs[i]));
     if (cage_mesh) warnings.add(load_warnings(run.cage_info, a.cage));
@@ -342,7 +370,8 @@ void bake_job(const Args& a, const JobEnv& env) {
   run.high_topology = topology.get();
   if (env.keep_progress) env.progress.hold();
   else env.progress.finish();
-  warnings.add(bake_warnings(s, run.high_topology, a.low, a.high, uv_tiles_note(low, a, o.width, o.height)));
+  warnings.add(bake_warnings(s, run.high_topology, a.low, a.high, uv_tiles_note(low, a, o.width, o.height),
+                             {boxes.mismatch != PairBoxes::Mismatch::none, &overlap}));
   warnings.check_strict();
   run.warnings = warnings.all();
   run.seconds_total = std::chrono::duration<double>(Clock::now() - env.start).count();

@@ -185,6 +185,8 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
   add_high_details(report, s, r);
   add_objects_report(report, r.low_objects, r.high_objects, r.match, s);
   report["udim"] = r.udim;
+  report["pair"] = r.pair;
+  report["uv_overlap"] = r.uv_overlap;
   report["version"] = NMBAKE_VERSION;
   report["command"] = r.command;
   report["started"] = r.started;

@@ -37,6 +37,8 @@ struct RunInfo {
   ObjectList low_objects, high_objects;  // every object of the low-poly and of the high-poly files
   MatchInfo match;                       // --match
   nlohmann::json udim;                   // -o with <UDIM>: udim_report (udim_outputs.h); else null
+  nlohmann::json pair;                   // pair_report (pair_checks.h): the meshes' boxes and how they compare
+  nlohmann::json uv_overlap;             // overlap_report (pair_checks.h): the UVs' overlap on the check's grid
 };
 
 const char* to_string(RayPolicy p);

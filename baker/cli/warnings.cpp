@@ -47,7 +47,7 @@ void WarningLog::check_strict() const {
 }
 
 std::vector<std::string> bake_warnings(const BakeStats& s, const MeshTopology& t, const std::string& low, const std::string& high,
-                                       const UvTilesNote& uv_tiles) {
+                                       const UvTilesNote& uv_tiles, const PairNote& pair) {
   std::vector<std::string> out;
   if (s.degenerate_uv_triangles)
     out.push_back(format("warning: %s: %zu triangles have zero UV area (they cover no texels and give no tangent)", low.c_str(),
@@ -75,12 +75,16 @@ std::vector<std::string> bake_warnings(const BakeStats& s, const MeshTopology& t
                "the map is baked, UVs are not wrapped%s",
                low.c_str(), s.uv_outside_triangles, s.uv_outside_entirely_triangles, tiles.c_str()));
   }
-  if (s.overlapping_samples)
-    out.push_back(format("warning: %s: UV islands overlap (%llu samples covered twice; the lower face number wins)", low.c_str(),
-                         (unsigned long long)s.overlapping_samples));
+  if (pair.overlap && pair.overlap->overlapped)
+    out.push_back("warning: " + overlap_text(*pair.overlap, s.overlapping_samples, low, true));
+  else if (s.overlapping_samples)  // too little to show on the overlap check's grid
+    out.push_back(format("warning: %s: UV islands overlap slightly (%llu samples covered twice; the lower face number wins)",
+                         low.c_str(), (unsigned long long)s.overlapping_samples));
   if (s.samples_covered && double(s.misses) > kMissShareWarn * double(s.samples_covered))
-    out.push_back(format("warning: %.1f%% of samples missed %s and were written flat; check --front/--rear (or --cage)",
-                         100.0 * double(s.misses) / double(s.samples_covered), high.c_str()));
+    out.push_back(format("warning: %.1f%% of samples missed %s and were written flat; %s",
+                         100.0 * double(s.misses) / double(s.samples_covered), high.c_str(),
+                         pair.boxes_mismatch ? "LOW and HIGH do not lie in one place or differ in size (above)"
+                                             : "check --front/--rear (or --cage)"));
   if (s.texels_covered && double(s.texels_facing_away) > kFacingAwayShareWarn * double(s.texels_covered))
     out.push_back(
         format("warning: %.1f%% of covered texels point into the low-poly: are the normals or the winding of %s inverted?",
@@ -88,10 +92,11 @@ std::vector<std::string> bake_warnings(const BakeStats& s, const MeshTopology& t
   if (s.high_facing == BakeStats::HighFacing::inverted)
     out.push_back(
         format("warning: %s: its faces look inverted (%.0f%% of the surfaces nearest the low-poly face into it): their fronts "
-               "were taken the other way round%s",
+               "were taken the other way round%s%s",
                high.c_str(), 100.0 * s.backface_probe_share,
                s.high_normals_computed ? " and the computed normals turned outwards"
-                                       : "; the file's normals are kept, so the map points into the surface"));
+                                       : "; the file's normals are kept, so the map points into the surface",
+               pair.boxes_mismatch ? " (judged from the few probes that met it: LOW and HIGH do not match, above)" : ""));
   else if (s.high_facing == BakeStats::HighFacing::mixed)
     out.push_back(
         format("warning: %s: some of its parts look inverted (%.0f%% of the surfaces nearest the low-poly face into it): "

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "cli/pair_checks.h"
 #include "cli/udim_outputs.h"
 #include "pipeline/bake.h"
 #include "core/errors.h"
@@ -17,8 +18,16 @@ namespace nmbake {
 constexpr double kMissShareWarn = 0.01;
 constexpr double kFacingAwayShareWarn = 0.2;
 
+// What the checks before the bake found (pair_checks.h): the boxes did not match (baked with
+// --allow-mismatch: misses and facing are then no fault of the distances or the winding), and the
+// UVs' overlap (null: not measured; the bake's overlapping_samples then speak alone).
+struct PairNote {
+  bool boxes_mismatch = false;
+  const UvOverlap* overlap = nullptr;
+};
+
 std::vector<std::string> bake_warnings(const BakeStats& stats, const MeshTopology& high_topology, const std::string& low_path,
-                                       const std::string& high_path, const UvTilesNote& uv_tiles = {});
+                                       const std::string& high_path, const UvTilesNote& uv_tiles = {}, const PairNote& pair = {});
 
 // What loading a mesh dropped: the file's normals (or UVs) when only some faces had them, or
 // (normals) one had length 0. `path` names the file.
