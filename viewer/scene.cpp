@@ -5,6 +5,7 @@
 #include "core/errors.h"
 #include "io/image_io.h"
 #include "io/mesh_io.h"
+#include "io/output_files.h"
 #include "core/normals.h"
 #include "core/tangent_frames.h"
 
@@ -64,7 +65,13 @@ void write_screenshot(const std::string& path, const Rgba8Image& image) {
   nmbake::Image rgb(image.width, image.height, 3);
   for (std::size_t i = 0; i < std::size_t(image.width) * std::size_t(image.height); ++i)
     for (int c = 0; c < 3; ++c) rgb.pixels[3 * i + std::size_t(c)] = float(image.pixels[4 * i + std::size_t(c)]) / 255.0f;
-  nmbake::write_image(path, rgb);
+  // Checked again here: the interactive viewer's screenshots are checked nowhere else.
+  nmbake::check_output_files({}, {{"--screenshot", path, "the screenshot"}});
+  nmbake::OutputFiles outputs;
+  nmbake::WriteOptions options;
+  options.temp_path = outputs.add(path);
+  nmbake::write_image(path, rgb, options);
+  outputs.commit();
 }
 
 }  // namespace nmview
