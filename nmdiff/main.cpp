@@ -90,7 +90,7 @@ nlohmann::json to_json(const std::string& a, const std::string& b, const DiffSta
   j["texels_compared"] = s.texels_compared;
   j["worst"] = s.worst_x >= 0 ? nlohmann::json{{"x", s.worst_x}, {"y", s.worst_y}, {"deg", s.max_deg}} : nlohmann::json(nullptr);
   j["within"] = s.within && seen.differences.empty();  // the verdict: the exit status is 0
-  j["within_tolerance"] = s.within;                      // the angles alone
+  j["within_tolerance"] = s.within;                    // the angles alone
   j["tolerances"] = {
       {"max_mean_deg", o.tolerances.max_mean_deg}, {"max_p99_deg", o.tolerances.max_p99_deg}, {"max_deg", o.tolerances.max_deg}};
   j["skipped"] = {{"mask", s.skipped_mask}, {"alpha", s.skipped_alpha}, {"invalid_a", s.invalid_a}, {"invalid_b", s.invalid_b}};
@@ -118,7 +118,7 @@ struct CommandLine {
   diff::DiffOptions options;
   std::string path_a, path_b, heatmap_path, json_path, mask_path;
   std::string green_a = "up", green_b = "up", resample = "none";
-  bool green_given = false;    // --green-a or --green-b was given: the maps' nmbake:green is not used
+  bool green_given = false;  // --green-a or --green-b was given: the maps' nmbake:green is not used
   bool same_convention = false;
   double heatmap_scale = 0.0;  // 0 = automatic
   bool ignore_alpha = false;
@@ -355,9 +355,8 @@ void report(const CommandLine& cl, const Comparison& c) {
 // Refuses outputs that are inputs or each other (exit 2) or cannot be written (exit 3) before
 // anything is read (io/output_files.h).
 void check_outputs(const CommandLine& cl) {
-  nmbake::check_output_files(
-      {{"", cl.path_a, "map A"}, {"", cl.path_b, "map B"}, {"--mask", cl.mask_path, "the mask mesh"}},
-      {{"--heatmap", cl.heatmap_path, "the heatmap"}, {"--json", cl.json_path, "the statistics"}});
+  nmbake::check_output_files({{"", cl.path_a, "map A"}, {"", cl.path_b, "map B"}, {"--mask", cl.mask_path, "the mask mesh"}},
+                             {{"--heatmap", cl.heatmap_path, "the heatmap"}, {"--json", cl.json_path, "the statistics"}});
   if (!cl.heatmap_path.empty()) nmbake::check_output_format(cl.heatmap_path, 0);
 }
 

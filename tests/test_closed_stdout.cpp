@@ -35,8 +35,8 @@ int run_in(const std::string& dir, const std::string& command) {
 }
 
 // The stream conditions, as redirections.
-const std::vector<std::string> kBrokenStreams{">&-", ">/dev/full", "2>&-", "2>/dev/full", ">&- 2>&-", "| head -c 0",
-                                              "2>&1 | head -c 0"};
+const std::vector<std::string> kBrokenStreams{">&-",         ">/dev/full",      "2>&-", "2>/dev/full", ">&- 2>&-",
+                                              "| head -c 0", "2>&1 | head -c 0"};
 
 // A tool's command line and the files it writes (compared with a run with working streams).
 struct Tool {
@@ -51,14 +51,18 @@ std::string binary(const std::string& relative) { return std::string(NMBAKE_BINA
 Tool nmbake_tool() {
   const std::string args = " '" + data_path("sample/torus_low.obj") + "' '" + data_path("sample/torus_high.ply") + "'";
   const std::string out = " -o m.png --size 64 --report r.json";
-  return {binary("baker/nmbake") + args + out, {"m.png", "r.json"}, {"m.png"},
+  return {binary("baker/nmbake") + args + out,
+          {"m.png", "r.json"},
+          {"m.png"},
           binary("baker/nmbake") + " missing.obj '" + data_path("sample/torus_high.ply") + "'" + out};
 }
 
 Tool nmdiff_tool() {
   const std::string map = " '" + data_path("golden/torus_256.png") + "'";
   const std::string out = " --json d.json --heatmap h.png";
-  return {binary("nmdiff/nmdiff") + map + map + out, {"d.json", "h.png"}, {"d.json", "h.png"},
+  return {binary("nmdiff/nmdiff") + map + map + out,
+          {"d.json", "h.png"},
+          {"d.json", "h.png"},
           binary("nmdiff/nmdiff") + " missing.png" + map + out};
 }
 

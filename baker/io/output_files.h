@@ -3,9 +3,9 @@
 // only when every one is complete.
 //
 // A failed write (a full disk, EFBIG under ulimit -f), an interruption or an error leaves every
-// old file as it was and no temporary behind. Temporaries are named ".<name>.nmbake-tmp.<pid>" (and, while the set is renamed into
-// place, the old file is kept as ".<name>.nmbake-old.<pid>"), so that those of a killed run can
-// be recognised: the next run removes its own outputs' ones whose process no longer exists.
+// old file as it was and no temporary behind. Temporaries are named ".<name>.nmbake-tmp.<pid>" (and, while the set is renamed
+// into place, the old file is kept as ".<name>.nmbake-old.<pid>"), so that those of a killed run can be recognised: the next run
+// removes its own outputs' ones whose process no longer exists.
 #pragma once
 
 #include <string>

@@ -14,13 +14,8 @@
 set -u
 tool=$1 exe=$(realpath "$2") repo=$(realpath "$3") work=$4
 high=$repo/data/sample/torus_high.ply
-rm -rf "$work" && mkdir -p "$work/scene" && cd "$work/scene" || exit 1
-log=$work  # the command's output, outside the folder compared
-fail=0
-bad() { echo "FAIL: $*"; fail=1; }
-state() { for f in $(ls -A | sort); do
-  if [ -L "$f" ]; then echo "$f -> $(readlink "$f")"; elif [ -f "$f" ]; then echo "$f $(md5sum <"$f")"; else echo "$f other"; fi
-done; }
+# shellcheck source=scene_state.sh
+. "$(dirname "$(realpath "$0")")/scene_state.sh"
 
 # The tool's command line writing OUT (and OUT2 where it has a second output), its input file in
 # the folder, and its exit status for an output that is an input.
