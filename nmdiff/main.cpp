@@ -20,6 +20,7 @@
 #include "io/mesh_io.h"
 #include "io/output_files.h"
 #include "io/text_file.h"
+#include "conventions.h"
 #include "nmdiff.h"
 
 namespace {
@@ -60,15 +61,11 @@ void print_summary(const std::string& a, const std::string& b, const DiffStats& 
             << (s.within ? "within" : "OUTSIDE") << "\n";
 }
 
-// What the maps' metadata says of their conventions (nmbake:green, nmbake:space,
-// nmbake:bitangent), "" when absent.
+// What the maps' metadata says of their conventions, and nmdiff's verdict on them (conventions.h).
 struct Conventions {
-  std::string green_a, green_b, space_a, space_b, bitangent_a, bitangent_b;
-  bool green_from_metadata = false;  // both maps said their green and no --green-a/-b was given
-  bool same_convention = false;      // --same-convention: each map decoded in its own green
-  // The conventions the maps' metadata give differently ("green", "space", "bitangent"): without
-  // --same-convention a difference (exit 1), the maps compared as they are.
-  std::vector<std::string> differences;
+  diff::MapConventions a, b;
+  diff::ConventionVerdict verdict;
+  bool same_convention = false;  // --same-convention
 };
 
 nlohmann::json or_null(const std::string& s) { return s.empty() ? nlohmann::json(nullptr) : nlohmann::json(s); }
@@ -89,8 +86,8 @@ nlohmann::json to_json(const std::string& a, const std::string& b, const DiffSta
   j["over_5deg"] = s.over_5deg;
   j["texels_compared"] = s.texels_compared;
   j["worst"] = s.worst_x >= 0 ? nlohmann::json{{"x", s.worst_x}, {"y", s.worst_y}, {"deg", s.max_deg}} : nlohmann::json(nullptr);
-  j["within"] = s.within && seen.differences.empty();  // the verdict: the exit status is 0
-  j["within_tolerance"] = s.within;                    // the angles alone
+  j["within"] = s.within && seen.verdict.differences.empty();  // the verdict: the exit status is 0
+  j["within_tolerance"] = s.within;                            // the angles alone
   j["tolerances"] = {
       {"max_mean_deg", o.tolerances.max_mean_deg}, {"max_p99_deg", o.tolerances.max_p99_deg}, {"max_deg", o.tolerances.max_deg}};
   j["skipped"] = {{"mask", s.skipped_mask}, {"alpha", s.skipped_alpha}, {"invalid_a", s.invalid_a}, {"invalid_b", s.invalid_b}};
@@ -100,12 +97,12 @@ nlohmann::json to_json(const std::string& a, const std::string& b, const DiffSta
   j["green_b"] = o.green_b == nmbake::diff::GreenAxis::up ? "up" : "down";
   j["green"] = {j["green_a"], j["green_b"]};
   j["green_flipped"] = o.green_a != o.green_b;  // B's green negated to compare in A's convention
-  j["green_from"] = seen.green_from_metadata ? "metadata" : "options";
-  j["metadata"] = {{"green", {or_null(seen.green_a), or_null(seen.green_b)}},
-                   {"space", {or_null(seen.space_a), or_null(seen.space_b)}}};
-  j["convention_differs"] = !seen.differences.empty();  // then "within" is false
-  j["conventions"] = {{"differences", seen.differences},
-                      {"bitangent", {or_null(seen.bitangent_a), or_null(seen.bitangent_b)}},
+  j["green_from"] = seen.verdict.green_from_metadata ? "metadata" : "options";
+  j["metadata"] = {{"green", {or_null(seen.a.green), or_null(seen.b.green)}},
+                   {"space", {or_null(seen.a.space), or_null(seen.b.space)}}};
+  j["convention_differs"] = !seen.verdict.differences.empty();  // then "within" is false
+  j["conventions"] = {{"differences", seen.verdict.differences},
+                      {"bitangent", {or_null(seen.a.bitangent), or_null(seen.b.bitangent)}},
                       {"same_convention", seen.same_convention}};
   j["resample"] = resample;
   j["mask"] = mask.empty() ? nlohmann::json(nullptr) : nlohmann::json(mask);
@@ -242,52 +239,31 @@ std::string metadata_value(const std::map<std::string, std::string>& metadata, c
   return it == metadata.end() ? std::string() : it->second;
 }
 
-// The maps' conventions from their metadata. Where both maps say a convention and they differ,
-// that is a difference (Conventions::differences), the maps compared as they are (B decoded in A's
-// green). With --same-convention, as before: different greens are each decoded in their own (B's
-// green flipped, said on stderr), bitangents not compared, and a tangent-space map against an
-// object-space one refused (their normals are in different frames).
+diff::MapConventions conventions_of(const std::string& path) {
+  const auto metadata = nmbake::read_image_metadata(path);
+  return {metadata_value(metadata, "nmbake:green"), metadata_value(metadata, "nmbake:space"),
+          metadata_value(metadata, "nmbake:bitangent")};
+}
+
+// The maps' conventions from their metadata (diff::compare_conventions), the greens to decode
+// with set in cl.options, each difference or flip said in one line on stderr.
 Conventions read_conventions(CommandLine& cl) {
-  const auto meta_a = nmbake::read_image_metadata(cl.path_a), meta_b = nmbake::read_image_metadata(cl.path_b);
-  Conventions seen;
-  seen.green_a = metadata_value(meta_a, "nmbake:green");
-  seen.green_b = metadata_value(meta_b, "nmbake:green");
-  seen.space_a = metadata_value(meta_a, "nmbake:space");
-  seen.space_b = metadata_value(meta_b, "nmbake:space");
-  seen.bitangent_a = metadata_value(meta_a, "nmbake:bitangent");
-  seen.bitangent_b = metadata_value(meta_b, "nmbake:bitangent");
-  seen.same_convention = cl.same_convention;
-  const auto differ = [](const std::string& a, const std::string& b) { return !a.empty() && !b.empty() && a != b; };
-  if (differ(seen.space_a, seen.space_b)) {
-    if (cl.same_convention)
-      throw nmbake::InputError(cl.path_a + " is a map in " + seen.space_a + " space, " + cl.path_b + " in " + seen.space_b +
-                               " space (nmbake:space metadata): normals in different frames cannot be compared");
-    seen.differences.push_back("space");
-  }
-  if (!cl.same_convention && differ(seen.bitangent_a, seen.bitangent_b)) seen.differences.push_back("bitangent");
-  const auto known = [](const std::string& g) { return g == "up" || g == "down"; };
-  if (!cl.green_given && known(seen.green_a) && known(seen.green_b)) {
-    seen.green_from_metadata = true;
-    cl.green_a = seen.green_a;
-    cl.green_b = cl.same_convention ? seen.green_b : seen.green_a;
-    apply_choices(cl);
-    if (seen.green_a != seen.green_b && cl.same_convention)
-      std::cerr << "nmdiff: " << cl.path_a << " is green " << seen.green_a << ", " << cl.path_b << " green " << seen.green_b
+  Conventions seen{conventions_of(cl.path_a), conventions_of(cl.path_b), {}, cl.same_convention};
+  seen.verdict = diff::compare_conventions(seen.a, seen.b, cl.green_given, cl.same_convention);
+  const diff::ConventionVerdict& v = seen.verdict;
+  if (v.spaces_clash)
+    throw nmbake::InputError(cl.path_a + " is a map in " + seen.a.space + " space, " + cl.path_b + " in " + seen.b.space +
+                             " space (nmbake:space metadata): normals in different frames cannot be compared");
+  if (v.green_from_metadata) {
+    cl.options.green_a = v.green_a;
+    cl.options.green_b = v.green_b;
+    if (v.green_a != v.green_b)
+      std::cerr << "nmdiff: " << cl.path_a << " is green " << seen.a.green << ", " << cl.path_b << " green " << seen.b.green
                 << " (nmbake:green metadata): compared in one convention, B's green flipped\n";
-    if (seen.green_a != seen.green_b && !cl.same_convention) {
-      seen.differences.insert(seen.differences.begin(), "green");
-      cl.options.detect_convention_mistakes = false;  // the line below says it
-    }
   }
-  if (!seen.differences.empty()) {
-    std::string what;
-    const auto pair = [&](const char* name, const std::string& a, const std::string& b) {
-      if (differ(a, b)) what += (what.empty() ? "" : ", ") + std::string(name) + " " + a + " against " + b;
-    };
-    if (!cl.green_given) pair("green", seen.green_a, seen.green_b);
-    pair("space", seen.space_a, seen.space_b);
-    pair("bitangent", seen.bitangent_a, seen.bitangent_b);
-    std::cerr << "nmdiff: " << cl.path_a << " and " << cl.path_b << " differ in convention (nmbake metadata): " << what
+  if (!v.differences.empty()) {
+    if (v.differences.front() == "green") cl.options.detect_convention_mistakes = false;  // the line below says it
+    std::cerr << "nmdiff: " << cl.path_a << " and " << cl.path_b << " differ in convention (nmbake metadata): " << v.described
               << "; a difference, compared as they are (--same-convention to compare them in one)\n";
   }
   return seen;
@@ -348,7 +324,7 @@ void report(const CommandLine& cl, const Comparison& c) {
   outputs.commit();
   if (!cl.heatmap_path.empty()) std::cout << "heatmap: " << cl.heatmap_path << " (0 to " << fmt("%.3g", scale) << " deg)\n";
   DiffStats verdict = c.stats;
-  verdict.within = c.stats.within && c.seen.differences.empty();
+  verdict.within = c.stats.within && c.seen.verdict.differences.empty();
   std::cout << diff::summary_line(verdict) << std::endl;
 }
 
@@ -372,7 +348,7 @@ int run(int argc, char** argv) {
     check_outputs(cl);
     const Comparison c = compare_files(cl);
     report(cl, c);
-    return c.stats.within && c.seen.differences.empty() ? kWithin : kOutside;
+    return c.stats.within && c.seen.verdict.differences.empty() ? kWithin : kOutside;
   } catch (const nmbake::Error& e) {
     std::cerr << "error: " << one_line(e.what()) << "\n";
     if (e.code() == nmbake::ExitCode::memory) return kMemory;
