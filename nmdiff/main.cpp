@@ -183,7 +183,7 @@ void add_arguments(CLI::App& app, CommandLine& cl) {
       "of nearly equal float maps by at most 0.78 deg (p99 0.45 deg).\n"
       "A warning is printed when the maps look like they differ by a green flip or a red/green swap.\n"
       "The last line of output is: mean=<deg> p99=<deg> max=<deg> texels=<n> within=<0|1>\n"
-      "Maps whose nmbake:green, nmbake:space or nmbake:bitangent metadata differ differ in convention:\n"
+      "Maps whose nmbake:green, nmbake:space or nmbake:bitangent metadata disagree are a difference:\n"
       "exit 1, said on stderr (with --same-convention green is normalised, different spaces refused).\n"
       "Outputs are checked first (an input or another output: exit 2; a folder, device, FIFO or\n"
       "dangling link: exit 3) and written to temporaries renamed into place only when all are complete.\n"
