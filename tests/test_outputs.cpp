@@ -243,5 +243,45 @@ TEST(Outputs, FileSizeLimitIsAnOutputError) {
   EXPECT_EQ(slurp(d + "/r.json"), "old");
 }
 
+// In a child process that removes temporaries on signals (nmdiff's and nmview's;
+// remove_temporaries_on_signals): `before`, then `path` written to a set not committed, then
+// SIGTERM. The child's status: 128 + SIGTERM when the signal ended it.
+template <typename Before>
+int sigterm_while_writing(const std::string& path, Before before) {
+  return in_child([&] {
+    remove_temporaries_on_signals();
+    before();
+    OutputFiles set;
+    write_text_file(path, set.add(path), "new");
+    ::raise(SIGTERM);
+    return 0;
+  });
+}
+
+// SIGTERM while an output is written removes its temporary and ends the process; the old file stays.
+TEST(Outputs, SignalRemovesTheTemporaries) {
+  const std::string d = test::scratch_dir();
+  put(d + "/m.png", "old");
+  EXPECT_EQ(sigterm_while_writing(d + "/m.png", [] {}), 128 + SIGTERM);
+  EXPECT_EQ(listing(d), std::vector<std::string>{"m.png"});
+  EXPECT_EQ(slurp(d + "/m.png"), "old");
+}
+
+// A set committed or discarded is forgotten (the handler's room is fixed): after many sets, the
+// temporary of the one being written is still removed.
+TEST(Outputs, SignalAfterManySetsStillRemovesTheTemporary) {
+  const std::string d = test::scratch_dir();
+  const int code = sigterm_while_writing(d + "/n.png", [&] {
+    for (int i = 0; i < 100; ++i) {
+      OutputFiles set;
+      write_text_file(d + "/m.png", set.add(d + "/m.png"), "new m");
+      if (i % 2 == 0) set.commit();
+    }
+  });
+  EXPECT_EQ(code, 128 + SIGTERM);
+  EXPECT_EQ(listing(d), std::vector<std::string>{"m.png"});
+  EXPECT_EQ(slurp(d + "/m.png"), "new m");
+}
+
 }  // namespace
 }  // namespace nmbake

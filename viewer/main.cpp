@@ -220,6 +220,7 @@ int main(int argc, char** argv) {
   // A closed or full stdout or stderr loses messages, never changes the screenshot or the exit
   // status; a file past ulimit -f is a failed write (exit 3).
   nmbake::protect_standard_streams();
+  nmbake::remove_temporaries_on_signals();
   nmbake::preload_image_io();  // the image library module: loads beside the parsing, or first under ulimit -v
   const int code = run_command_line(argc, argv);
   nmbake::wait_for_image_io();  // never exit while the image library's constructors run

@@ -5,7 +5,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
+#include <climits>
 #include <csignal>
 #include <cstdio>
 #include <cstring>
@@ -50,6 +52,43 @@ const char* kind_of(mode_t mode) {
   if (S_ISSOCK(mode)) return "a socket";
   return "not a regular file";
 }
+
+// The temporaries a signal handler removes (remove_temporaries_on_signals): fixed storage, as a
+// handler may only read memory and call unlink. A slot is free when its first byte is 0, which is
+// written last when a name is stored and first when it is forgotten.
+constexpr int kSignalSlots = 32;
+char g_signal_temps[kSignalSlots][PATH_MAX];
+volatile std::sig_atomic_t g_committing = 0;  // the renames have begun: the set is finished
+
+void remember_temp(const std::string& temp) {
+  if (temp.empty() || temp.size() >= PATH_MAX) return;
+  for (char* slot : g_signal_temps) {
+    if (slot[0] != 0) continue;
+    std::memcpy(slot + 1, temp.c_str() + 1, temp.size());
+    std::atomic_signal_fence(std::memory_order_release);
+    slot[0] = temp[0];
+    return;
+  }
+}
+
+void forget_temp(const std::string& temp) {
+  for (char* slot : g_signal_temps)
+    if (slot[0] != 0 && temp == slot) slot[0] = 0;
+}
+
+extern "C" void remove_temporaries_and_die(int sig) {
+  if (g_committing) return;  // the renames take microseconds: the run completes
+  for (char* slot : g_signal_temps)
+    if (slot[0] != 0) ::unlink(slot);
+  ::signal(sig, SIG_DFL);
+  ::raise(sig);
+}
+
+// Marks the renames of a commit, also when it throws.
+struct Committing {
+  Committing() { g_committing = 1; }
+  ~Committing() { g_committing = 0; }
+};
 
 // Identity of a path: device and inode where it exists, else its canonical absolute name.
 struct FileKey {
@@ -187,12 +226,14 @@ std::string OutputFiles::add(const std::string& path) {
   f.temp = sibling(f.target, kTempTag);
   remove_stale(f.target);
   files_.push_back(f);
+  remember_temp(f.temp);
   return f.temp;
 }
 
 void OutputFiles::discard() {
   if (committed_) return;
   for (const File& f : files_) {
+    forget_temp(f.temp);
     ::unlink(f.temp.c_str());
     if (!f.backup.empty()) ::unlink(f.backup.c_str());
   }
@@ -200,6 +241,7 @@ void OutputFiles::discard() {
 }
 
 void OutputFiles::commit() {
+  const Committing committing;
   // The old files stay reachable under a second name (a hard link) until every rename is done,
   // so a failed rename can put them back. The new file keeps the old one's permissions.
   for (File& f : files_) {
@@ -227,8 +269,10 @@ void OutputFiles::commit() {
     discard();
     throw OutputError(message);
   }
-  for (const File& f : files_)
+  for (const File& f : files_) {
+    forget_temp(f.temp);
     if (!f.backup.empty()) ::unlink(f.backup.c_str());
+  }
   committed_ = true;
   files_.clear();
 }
@@ -244,6 +288,18 @@ void protect_standard_streams() {
       ::dup2(null, fd);
       ::close(null);
     }
+  }
+}
+
+void remove_temporaries_on_signals() {
+  struct sigaction action {};
+  action.sa_handler = remove_temporaries_and_die;
+  sigemptyset(&action.sa_mask);
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction old {};
+    // Ignored on entry (nohup; SIGINT of a background job) stays ignored.
+    if (::sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+    ::sigaction(sig, &action, nullptr);
   }
 }
 

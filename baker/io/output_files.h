@@ -72,4 +72,10 @@ class OutputFiles {
 // is lost and changes nothing else: the exit status and the files are those of the work done.
 void protect_standard_streams();
 
+// For a command without its own handlers (nmdiff, nmview; nmbake records the signal and stops at
+// its next check): SIGINT, SIGTERM and SIGHUP remove the temporaries of every set not committed,
+// then end the process as the signal would; during a commit's renames they are ignored, the set is
+// finished. A signal ignored on entry (nohup) stays ignored.
+void remove_temporaries_on_signals();
+
 }  // namespace nmbake
