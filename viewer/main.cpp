@@ -130,7 +130,7 @@ int run(const Options& o) {
       show.difference = true;
       nmview::Framebuffer target(3 * pane_width, pane_height);
       renderer.render(target.id(), 3 * pane_width, pane_height, result.views[result.worst].view, io.light, show);
-      nmview::write_screenshot(o.screenshot, nmview::Renderer::read_framebuffer(target.id(), 3 * pane_width, pane_height));
+      nmview::write_screenshot(o.screenshot, nmview::Renderer::read_framebuffer(target.id(), 3 * pane_width, pane_height), scene);
       std::cerr << "nmview: worst view written to " << o.screenshot << "\n";
     }
     nmview::print_compare(result, std::cout);
@@ -139,7 +139,7 @@ int run(const Options& o) {
 
   nmview::Framebuffer target(io.width, io.height);
   renderer.render(target.id(), io.width, io.height, io.view, io.light, io.toggles);
-  nmview::write_screenshot(o.screenshot, nmview::Renderer::read_framebuffer(target.id(), io.width, io.height));
+  nmview::write_screenshot(o.screenshot, nmview::Renderer::read_framebuffer(target.id(), io.width, io.height), scene);
   std::cerr << "nmview: wrote " << o.screenshot << " (" << io.width << "x" << io.height << ")\n";
   return 0;
 }
