@@ -3,9 +3,10 @@
 // only when every one is complete.
 //
 // A failed write (a full disk, EFBIG under ulimit -f), an interruption or an error leaves every
-// old file as it was and no temporary behind. Temporaries are named ".<name>.nmbake-tmp.<pid>" (and, while the set is renamed
-// into place, the old file is kept as ".<name>.nmbake-old.<pid>"), so that those of a killed run can be recognised: the next run
-// removes its own outputs' ones whose process no longer exists.
+// old file as it was and no temporary behind. Temporaries are named ".<name>.nmbake-tmp.<pid>"
+// (and, while the set is renamed into place, the old file is kept as ".<name>.nmbake-old.<pid>"),
+// so that those of a killed run can be recognised: the next run removes its own outputs' ones
+// whose process no longer exists.
 #pragma once
 
 #include <string>
@@ -19,9 +20,9 @@ struct NamedFile {
   std::string option, path, what;
 };
 
-// Refuses outputs that would destroy data or could not be written, before the bake (empty paths
+// Refuses outputs that would destroy data or could not be written, before any work (empty paths
 // are skipped):
-// - UsageError (exit 1) when an output is the same file as an input or as another output, by
+// - UsageError (nmbake and nmview exit 1, nmdiff 2) when an output is the same file as an input or as another output, by
 //   identity (device and inode where the file exists, so links and "./" do not slip through; the
 //   canonical folder and name where it does not yet): "--report low.obj is the same file as
 //   low.obj; nothing written";
