@@ -18,7 +18,9 @@
 #include "core/errors.h"
 #include "io/image_io.h"
 #include "io/mesh_io.h"
+#include "io/output_files.h"
 #include "io/text_file.h"
+#include "conventions.h"
 #include "nmdiff.h"
 
 namespace {
@@ -27,7 +29,7 @@ namespace diff = nmbake::diff;
 using diff::DiffStats;
 
 // Exit status, as documented in --help.
-constexpr int kWithin = 0, kOutside = 1, kError = 2, kMemory = 4;
+constexpr int kWithin = 0, kOutside = 1, kError = 2, kOutput = 3, kMemory = 4;
 
 std::string one_line(std::string s) {
   for (char& c : s)
@@ -59,10 +61,11 @@ void print_summary(const std::string& a, const std::string& b, const DiffStats& 
             << (s.within ? "within" : "OUTSIDE") << "\n";
 }
 
-// What the maps' metadata says of their conventions (nmbake:green, nmbake:space), "" when absent.
+// What the maps' metadata says of their conventions, and nmdiff's verdict on them (conventions.h).
 struct Conventions {
-  std::string green_a, green_b, space_a, space_b;
-  bool green_from_metadata = false;  // both maps said their green and no --green-a/-b was given
+  diff::MapConventions a, b;
+  diff::ConventionVerdict verdict;
+  bool same_convention = false;  // --same-convention
 };
 
 nlohmann::json or_null(const std::string& s) { return s.empty() ? nlohmann::json(nullptr) : nlohmann::json(s); }
@@ -83,7 +86,8 @@ nlohmann::json to_json(const std::string& a, const std::string& b, const DiffSta
   j["over_5deg"] = s.over_5deg;
   j["texels_compared"] = s.texels_compared;
   j["worst"] = s.worst_x >= 0 ? nlohmann::json{{"x", s.worst_x}, {"y", s.worst_y}, {"deg", s.max_deg}} : nlohmann::json(nullptr);
-  j["within"] = s.within;
+  j["within"] = s.within && seen.verdict.differences.empty();  // the verdict: the exit status is 0
+  j["within_tolerance"] = s.within;                            // the angles alone
   j["tolerances"] = {
       {"max_mean_deg", o.tolerances.max_mean_deg}, {"max_p99_deg", o.tolerances.max_p99_deg}, {"max_deg", o.tolerances.max_deg}};
   j["skipped"] = {{"mask", s.skipped_mask}, {"alpha", s.skipped_alpha}, {"invalid_a", s.invalid_a}, {"invalid_b", s.invalid_b}};
@@ -93,9 +97,13 @@ nlohmann::json to_json(const std::string& a, const std::string& b, const DiffSta
   j["green_b"] = o.green_b == nmbake::diff::GreenAxis::up ? "up" : "down";
   j["green"] = {j["green_a"], j["green_b"]};
   j["green_flipped"] = o.green_a != o.green_b;  // B's green negated to compare in A's convention
-  j["green_from"] = seen.green_from_metadata ? "metadata" : "options";
-  j["metadata"] = {{"green", {or_null(seen.green_a), or_null(seen.green_b)}},
-                   {"space", {or_null(seen.space_a), or_null(seen.space_b)}}};
+  j["green_from"] = seen.verdict.green_from_metadata ? "metadata" : "options";
+  j["metadata"] = {{"green", {or_null(seen.a.green), or_null(seen.b.green)}},
+                   {"space", {or_null(seen.a.space), or_null(seen.b.space)}}};
+  j["convention_differs"] = !seen.verdict.differences.empty();  // then "within" is false
+  j["conventions"] = {{"differences", seen.verdict.differences},
+                      {"bitangent", {or_null(seen.a.bitangent), or_null(seen.b.bitangent)}},
+                      {"same_convention", seen.same_convention}};
   j["resample"] = resample;
   j["mask"] = mask.empty() ? nlohmann::json(nullptr) : nlohmann::json(mask);
   j["warnings"] = s.warnings;
@@ -107,7 +115,8 @@ struct CommandLine {
   diff::DiffOptions options;
   std::string path_a, path_b, heatmap_path, json_path, mask_path;
   std::string green_a = "up", green_b = "up", resample = "none";
-  bool green_given = false;    // --green-a or --green-b was given: the maps' nmbake:green is not used
+  bool green_given = false;  // --green-a or --green-b was given: the maps' nmbake:green is not used
+  bool same_convention = false;
   double heatmap_scale = 0.0;  // 0 = automatic
   bool ignore_alpha = false;
 };
@@ -146,12 +155,15 @@ void add_arguments(CLI::App& app, CommandLine& cl) {
   app.add_flag("--ignore-alpha", cl.ignore_alpha, "Do not treat a 4th channel as coverage");
   app.add_option("--green-a", cl.green_a,
                  "Green convention of A: up (OpenGL Y+) or down (DirectX Y-). Without --green-a and --green-b, "
-                 "when both maps carry nmbake:green metadata each is decoded in its own")
+                 "when both maps carry nmbake:green metadata and it differs, that is a difference (exit 1)")
       ->capture_default_str()
       ->check(CLI::IsMember({"up", "down"}));
   app.add_option("--green-b", cl.green_b, "Green convention of B: up or down")
       ->capture_default_str()
       ->check(CLI::IsMember({"up", "down"}));
+  app.add_flag("--same-convention", cl.same_convention,
+               "Maps whose nmbake:green metadata differ are compared in one convention (B's green flipped) "
+               "and their nmbake:bitangent is not compared, instead of being a difference");
   app.add_option("--resample", cl.resample,
                  "When sizes differ, bring B onto A's grid: nearest, bilinear or box (mean of the texels "
                  "inside); none = sizes must match")
@@ -171,9 +183,12 @@ void add_arguments(CLI::App& app, CommandLine& cl) {
       "of nearly equal float maps by at most 0.78 deg (p99 0.45 deg).\n"
       "A warning is printed when the maps look like they differ by a green flip or a red/green swap.\n"
       "The last line of output is: mean=<deg> p99=<deg> max=<deg> texels=<n> within=<0|1>\n"
-      "Maps whose nmbake:space metadata differ (tangent and object space) are refused.\n"
-      "Exit status: 0 within tolerance, 1 outside tolerance (or nothing compared),\n"
-      "             2 unreadable or invalid input, unwritable output, or a bad command line,\n"
+      "Maps whose nmbake:green, nmbake:space or nmbake:bitangent metadata disagree are a difference:\n"
+      "exit 1, said on stderr (with --same-convention green is normalised, different spaces refused).\n"
+      "Outputs are checked first (an input or another output: exit 2; a folder, device, FIFO or\n"
+      "dangling link: exit 3) and written to temporaries renamed into place only when all are complete.\n"
+      "Exit status: 0 within tolerance, 1 outside tolerance, nothing compared, or conventions differ,\n"
+      "             2 unreadable or invalid input, or a bad command line, 3 output not written,\n"
       "             4 out of memory, or a map whose header states more pixels than its file or memory can hold.");
 }
 
@@ -224,25 +239,33 @@ std::string metadata_value(const std::map<std::string, std::string>& metadata, c
   return it == metadata.end() ? std::string() : it->second;
 }
 
-// The maps' conventions from their metadata. A tangent-space map against an object-space one is
-// refused: their normals are in different frames. When both say their green and no option does,
-// each map is decoded in its own (B's green flipped when they differ), said on stderr.
+diff::MapConventions conventions_of(const std::string& path) {
+  const auto metadata = nmbake::read_image_metadata(path);
+  return {metadata_value(metadata, "nmbake:green"), metadata_value(metadata, "nmbake:space"),
+          metadata_value(metadata, "nmbake:bitangent")};
+}
+
+// The maps' conventions from their metadata (diff::compare_conventions), the greens to decode
+// with set in cl.options, each difference or flip said in one line on stderr.
 Conventions read_conventions(CommandLine& cl) {
-  const auto meta_a = nmbake::read_image_metadata(cl.path_a), meta_b = nmbake::read_image_metadata(cl.path_b);
-  Conventions seen{metadata_value(meta_a, "nmbake:green"), metadata_value(meta_b, "nmbake:green"),
-                   metadata_value(meta_a, "nmbake:space"), metadata_value(meta_b, "nmbake:space")};
-  if (!seen.space_a.empty() && !seen.space_b.empty() && seen.space_a != seen.space_b)
-    throw nmbake::InputError(cl.path_a + " is a map in " + seen.space_a + " space, " + cl.path_b + " in " + seen.space_b +
+  Conventions seen{conventions_of(cl.path_a), conventions_of(cl.path_b), {}, cl.same_convention};
+  seen.verdict = diff::compare_conventions(seen.a, seen.b, cl.green_given, cl.same_convention);
+  const diff::ConventionVerdict& v = seen.verdict;
+  if (v.spaces_clash)
+    throw nmbake::InputError(cl.path_a + " is a map in " + seen.a.space + " space, " + cl.path_b + " in " + seen.b.space +
                              " space (nmbake:space metadata): normals in different frames cannot be compared");
-  const auto known = [](const std::string& g) { return g == "up" || g == "down"; };
-  if (cl.green_given || !known(seen.green_a) || !known(seen.green_b)) return seen;
-  seen.green_from_metadata = true;
-  cl.green_a = seen.green_a;
-  cl.green_b = seen.green_b;
-  apply_choices(cl);
-  if (seen.green_a != seen.green_b)
-    std::cerr << "nmdiff: " << cl.path_a << " is green " << seen.green_a << ", " << cl.path_b << " green " << seen.green_b
-              << " (nmbake:green metadata): compared in one convention, B's green flipped\n";
+  if (v.green_from_metadata) {
+    cl.options.green_a = v.green_a;
+    cl.options.green_b = v.green_b;
+    if (v.green_a != v.green_b)
+      std::cerr << "nmdiff: " << cl.path_a << " is green " << seen.a.green << ", " << cl.path_b << " green " << seen.b.green
+                << " (nmbake:green metadata): compared in one convention, B's green flipped\n";
+  }
+  if (!v.differences.empty()) {
+    if (v.differences.front() == "green") cl.options.detect_convention_mistakes = false;  // the line below says it
+    std::cerr << "nmdiff: " << cl.path_a << " and " << cl.path_b << " differ in convention (nmbake metadata): " << v.described
+              << "; a difference, compared as they are (--same-convention to compare them in one)\n";
+  }
   return seen;
 }
 
@@ -271,8 +294,9 @@ Comparison compare_files(CommandLine& cl) {
   return c;
 }
 
-// The heatmap of the angles, with its scale in the metadata; prints where it went.
-void write_heatmap(const CommandLine& cl, const Comparison& c) {
+// The heatmap of the angles, with its scale in the metadata, to its temporary in `outputs`.
+// Returns the scale.
+double write_heatmap(const CommandLine& cl, const Comparison& c, nmbake::OutputFiles& outputs) {
   const double scale = cl.heatmap_scale > 0 ? cl.heatmap_scale : diff::auto_heatmap_scale(c.stats, cl.options.tolerances);
   nmbake::WriteOptions out;
   out.metadata = {{"nmdiff:scale_min_deg", "0"},
@@ -282,40 +306,53 @@ void write_heatmap(const CommandLine& cl, const Comparison& c) {
                    "dark grey texels were not compared"},
                   {"nmdiff:a", cl.path_a},
                   {"nmdiff:b", cl.path_b}};
+  out.temp_path = outputs.add(cl.heatmap_path);
   nmbake::write_image(cl.heatmap_path, diff::render_heatmap(c.field, scale), out);
-  std::cout << "heatmap: " << cl.heatmap_path << " (0 to " << fmt("%.3g", scale) << " deg)\n";
+  return scale;
 }
 
 // Everything nmdiff prints and writes after the comparison, in order: the summary, warnings, the
-// heatmap, the JSON, and the last line.
+// heatmap and the JSON (renamed into place together), and the last line.
 void report(const CommandLine& cl, const Comparison& c) {
   print_summary(cl.path_a, cl.path_b, c.stats, cl.options, c.resized, cl.resample);
   for (const std::string& w : c.stats.warnings) std::cerr << "warning: " << w << "\n";
-  if (!cl.heatmap_path.empty()) write_heatmap(cl, c);
+  nmbake::OutputFiles outputs;
+  const double scale = cl.heatmap_path.empty() ? 0.0 : write_heatmap(cl, c, outputs);
   if (!cl.json_path.empty())
-    nmbake::write_text_atomically(
-        cl.json_path, to_json(cl.path_a, cl.path_b, c.stats, cl.options, cl.mask_path, cl.resample, c.seen).dump(2) + "\n");
-  std::cout << diff::summary_line(c.stats) << std::endl;
+    nmbake::write_text_file(cl.json_path, outputs.add(cl.json_path),
+                            to_json(cl.path_a, cl.path_b, c.stats, cl.options, cl.mask_path, cl.resample, c.seen).dump(2) + "\n");
+  outputs.commit();
+  if (!cl.heatmap_path.empty()) std::cout << "heatmap: " << cl.heatmap_path << " (0 to " << fmt("%.3g", scale) << " deg)\n";
+  DiffStats verdict = c.stats;
+  verdict.within = c.stats.within && c.seen.verdict.differences.empty();
+  std::cout << diff::summary_line(verdict) << std::endl;
+}
+
+// Refuses outputs that are inputs or each other (exit 2) or cannot be written (exit 3) before
+// anything is read (io/output_files.h).
+void check_outputs(const CommandLine& cl) {
+  nmbake::check_output_files({{"", cl.path_a, "map A"}, {"", cl.path_b, "map B"}, {"--mask", cl.mask_path, "the mask mesh"}},
+                             {{"--heatmap", cl.heatmap_path, "the heatmap"}, {"--json", cl.json_path, "the statistics"}});
+  if (!cl.heatmap_path.empty()) nmbake::check_output_format(cl.heatmap_path, 0);
 }
 
 }  // namespace
 
-// The comparison's exit status, or kError; a closed stdout (nmdiff ... | head -0) is an error like
-// any other failed write, not a SIGPIPE death.
+// The comparison's exit status, or that of the error. Messages that cannot be written (a closed
+// or full stdout) change neither the status nor the files (protect_standard_streams).
 int run(int argc, char** argv) {
   CommandLine cl;
   if (const std::optional<int> status = parse_command_line(argc, argv, cl)) return *status;
 
   try {
-    if (!cl.heatmap_path.empty()) nmbake::check_output_format(cl.heatmap_path, 0);
+    check_outputs(cl);
     const Comparison c = compare_files(cl);
     report(cl, c);
-    std::cout.flush();
-    if (!std::cout) throw nmbake::OutputError(std::string("stdout: cannot write: ") + std::strerror(errno));
-    return c.stats.within ? kWithin : kOutside;
+    return c.stats.within && c.seen.verdict.differences.empty() ? kWithin : kOutside;
   } catch (const nmbake::Error& e) {
     std::cerr << "error: " << one_line(e.what()) << "\n";
     if (e.code() == nmbake::ExitCode::memory) return kMemory;
+    if (e.code() == nmbake::ExitCode::output) return kOutput;
   } catch (const std::bad_alloc&) {
     std::cerr << "error: out of memory\n";
     return kMemory;
@@ -326,7 +363,8 @@ int run(int argc, char** argv) {
 }
 
 int main(int argc, char** argv) {
-  std::signal(SIGPIPE, SIG_IGN);
+  nmbake::protect_standard_streams();
+  nmbake::remove_temporaries_on_signals();
   nmbake::preload_image_io();  // the image library module: loads beside the parsing, or first under ulimit -v
   const int code = run(argc, argv);
   nmbake::wait_for_image_io();  // never exit while the image library's constructors run

@@ -1,6 +1,8 @@
-// nmdiff_core: known answers for the angular comparison of normal maps, masks, alpha, resampling
-// and the convention-mistake warnings.
+// nmdiff_core: known answers for the angular comparison of normal maps, masks, alpha, resampling,
+// the convention-mistake warnings and the verdict on the conventions the maps' metadata state.
 #include "nmdiff.h"
+
+#include "conventions.h"
 
 #include <cmath>
 #include <functional>
@@ -348,4 +350,59 @@ TEST(Nmdiff, HeatmapShowsDifferencesOnARampWithALegend) {
   ASSERT_LT(bar_row, h.height);
   for (int x = 1; x < 64; ++x) EXPECT_GE(luma(h.at(x, bar_row)), luma(h.at(x - 1, bar_row)) - 1e-6) << x;
   EXPECT_NEAR(luma(h.at(63, bar_row)), luma(hot), 1e-6);  // 4 deg = the scale = the bar's right end
+}
+
+// Conventions stated differently by the two maps are a difference by default, the maps compared
+// as they are (B decoded in A's green); --same-convention decodes each in its own green.
+TEST(NmdiffConventions, DifferentGreensAreADifference) {
+  const diff::MapConventions up{"up", "tangent", ""}, down{"down", "tangent", ""};
+  const diff::ConventionVerdict v = diff::compare_conventions(up, down, false, false);
+  EXPECT_EQ(v.differences, std::vector<std::string>{"green"});
+  EXPECT_EQ(v.described, "green up against down");
+  EXPECT_TRUE(v.green_from_metadata);
+  EXPECT_EQ(v.green_a, diff::GreenAxis::up);
+  EXPECT_EQ(v.green_b, diff::GreenAxis::up);  // as they are
+  EXPECT_FALSE(v.spaces_clash);
+
+  const diff::ConventionVerdict same = diff::compare_conventions(up, down, false, true);
+  EXPECT_TRUE(same.differences.empty());
+  EXPECT_EQ(same.described, "");
+  EXPECT_EQ(same.green_a, diff::GreenAxis::up);
+  EXPECT_EQ(same.green_b, diff::GreenAxis::down);  // B's green flipped to compare
+}
+
+TEST(NmdiffConventions, AgreeingOrUnstatedConventionsAreNoDifference) {
+  const diff::MapConventions down{"down", "tangent", "pixel"}, none{};
+  diff::ConventionVerdict v = diff::compare_conventions(down, down, false, false);
+  EXPECT_TRUE(v.differences.empty());
+  EXPECT_TRUE(v.green_from_metadata);
+  EXPECT_EQ(v.green_a, diff::GreenAxis::down);
+  EXPECT_EQ(v.green_b, diff::GreenAxis::down);
+  v = diff::compare_conventions(down, none, false, false);  // only one map says
+  EXPECT_TRUE(v.differences.empty());
+  EXPECT_FALSE(v.green_from_metadata);
+  v = diff::compare_conventions({"sideways", "", ""}, {"up", "", ""}, false, false);  // not a green
+  EXPECT_TRUE(v.differences.empty());
+  EXPECT_FALSE(v.green_from_metadata);
+}
+
+// Greens given on the command line override the metadata's: no green difference, the other
+// conventions still compared.
+TEST(NmdiffConventions, GreensGivenOverrideTheMetadata) {
+  const diff::ConventionVerdict v =
+      diff::compare_conventions({"up", "tangent", "pixel"}, {"down", "tangent", "vertex"}, true, false);
+  EXPECT_FALSE(v.green_from_metadata);
+  EXPECT_EQ(v.differences, std::vector<std::string>{"bitangent"});
+  EXPECT_EQ(v.described, "bitangent pixel against vertex");
+}
+
+TEST(NmdiffConventions, SpacesAndBitangents) {
+  const diff::MapConventions tangent{"up", "tangent", "pixel"}, object{"down", "object", "vertex"};
+  const diff::ConventionVerdict v = diff::compare_conventions(tangent, object, false, false);
+  EXPECT_EQ(v.differences, (std::vector<std::string>{"green", "space", "bitangent"}));
+  EXPECT_EQ(v.described, "green up against down, space tangent against object, bitangent pixel against vertex");
+  EXPECT_FALSE(v.spaces_clash);
+  const diff::ConventionVerdict same = diff::compare_conventions(tangent, object, false, true);
+  EXPECT_TRUE(same.differences.empty());
+  EXPECT_TRUE(same.spaces_clash);  // normals in different frames: refused
 }

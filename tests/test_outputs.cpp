@@ -1,5 +1,10 @@
-// The nmbake command's output set (baker/cli/outputs.h): files compared by identity, outputs that
-// are refused, temporaries removed, all renamed together or none, stale temporaries cleaned.
+// The output contract of the three commands (baker/io/output_files.h; nmbake's set with its
+// interruption check, baker/cli/outputs.h): files compared by identity, outputs that are refused,
+// temporaries removed, all renamed together or none, stale temporaries cleaned; the standard
+// streams and a file size limit (ulimit -f) that cannot break it.
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/types.h>
 #include <sys/wait.h>
@@ -183,6 +188,99 @@ TEST(Outputs, StaleTemporariesRemoved) {
                                 ".n.png.nmbake-tmp." + dead,  ".m.png.nmbake-old." + dead2,       "m.png"};
   std::sort(kept.begin(), kept.end());
   EXPECT_EQ(listing(d), kept);
+}
+
+// The exit status of `body` run in a child process (0..255), or 128 + the signal that killed it.
+template <typename Body>
+int in_child(Body body) {
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(body());
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+// Closed stdout and stderr are reopened on /dev/null: the next file opened does not get their
+// numbers (it would receive the messages), and SIGPIPE and SIGXFSZ are ignored.
+TEST(Outputs, ClosedStandardStreamsAreReopened) {
+  const std::string d = test::scratch_dir();
+  const int code = in_child([&] {
+    ::close(1);
+    ::close(2);
+    protect_standard_streams();
+    const int fd = ::open((d + "/file").c_str(), O_WRONLY | O_CREAT, 0644);
+    if (fd <= 2) return 1;                                             // took a standard stream's number
+    if (::write(1, "x", 1) != 1 || ::write(2, "x", 1) != 1) return 2;  // not /dev/null
+    struct sigaction pipe {
+    }, size{};
+    ::sigaction(SIGPIPE, nullptr, &pipe);
+    ::sigaction(SIGXFSZ, nullptr, &size);
+    return pipe.sa_handler == SIG_IGN && size.sa_handler == SIG_IGN ? 0 : 3;
+  });
+  EXPECT_EQ(code, 0);
+  EXPECT_EQ(test::read_file(d + "/file"), "");
+}
+
+// Under a file size limit (ulimit -f) a write past it is an OutputError naming the file, not a
+// SIGXFSZ death: the temporary removed, the old file as it was.
+TEST(Outputs, FileSizeLimitIsAnOutputError) {
+  const std::string d = test::scratch_dir();
+  put(d + "/r.json", "old");
+  const int code = in_child([&] {
+    protect_standard_streams();
+    const struct rlimit limit { 1024, 1024 };
+    if (::setrlimit(RLIMIT_FSIZE, &limit) != 0) return 10;
+    OutputFiles set;
+    try {
+      write_text_file(d + "/r.json", set.add(d + "/r.json"), std::string(4096, 'x'));
+    } catch (const OutputError& e) {
+      return std::string(e.what()) == d + "/r.json: cannot write: File too large" ? 0 : 1;
+    }
+    return 2;
+  });
+  EXPECT_EQ(code, 0) << "1: another message, 2: no error, 128 + 25: killed by SIGXFSZ";
+  EXPECT_EQ(listing(d), std::vector<std::string>{"r.json"});
+  EXPECT_EQ(slurp(d + "/r.json"), "old");
+}
+
+// In a child process that removes temporaries on signals (nmdiff's and nmview's;
+// remove_temporaries_on_signals): `before`, then `path` written to a set not committed, then
+// SIGTERM. The child's status: 128 + SIGTERM when the signal ended it.
+template <typename Before>
+int sigterm_while_writing(const std::string& path, Before before) {
+  return in_child([&] {
+    remove_temporaries_on_signals();
+    before();
+    OutputFiles set;
+    write_text_file(path, set.add(path), "new");
+    ::raise(SIGTERM);
+    return 0;
+  });
+}
+
+// SIGTERM while an output is written removes its temporary and ends the process; the old file stays.
+TEST(Outputs, SignalRemovesTheTemporaries) {
+  const std::string d = test::scratch_dir();
+  put(d + "/m.png", "old");
+  EXPECT_EQ(sigterm_while_writing(d + "/m.png", [] {}), 128 + SIGTERM);
+  EXPECT_EQ(listing(d), std::vector<std::string>{"m.png"});
+  EXPECT_EQ(slurp(d + "/m.png"), "old");
+}
+
+// A set committed or discarded is forgotten (the handler's room is fixed): after many sets, the
+// temporary of the one being written is still removed.
+TEST(Outputs, SignalAfterManySetsStillRemovesTheTemporary) {
+  const std::string d = test::scratch_dir();
+  const int code = sigterm_while_writing(d + "/n.png", [&] {
+    for (int i = 0; i < 100; ++i) {
+      OutputFiles set;
+      write_text_file(d + "/m.png", set.add(d + "/m.png"), "new m");
+      if (i % 2 == 0) set.commit();
+    }
+  });
+  EXPECT_EQ(code, 128 + SIGTERM);
+  EXPECT_EQ(listing(d), std::vector<std::string>{"m.png"});
+  EXPECT_EQ(slurp(d + "/m.png"), "new m");
 }
 
 }  // namespace

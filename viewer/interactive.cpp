@@ -156,7 +156,7 @@ void run_interactive(const Scene& scene, const InteractiveOptions& options) {
       s.screenshot = false;
       std::string path = "nmview-" + std::to_string(++screenshots) + ".png";
       try {
-        write_screenshot(path, Renderer::read_framebuffer(0, width, height));
+        write_screenshot(path, Renderer::read_framebuffer(0, width, height), scene);
         std::cerr << "nmview: wrote " << path << "\n";
       } catch (const nmbake::Error& e) {
         std::cerr << "nmview: " << e.what() << "\n";

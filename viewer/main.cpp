@@ -23,6 +23,7 @@
 #include "core/memory_budget.h"
 #include "io/image_io.h"
 #include "io/mesh_io.h"
+#include "io/output_files.h"
 #include "gl_context.h"
 #include "interactive.h"
 #include "renderer.h"
@@ -78,13 +79,6 @@ void parse_show(const std::string& text, nmview::Toggles& toggles) {
   }
 }
 
-// A closed stdout (nmview ... --compare | head -0) is an error like any other failed write, not a
-// SIGPIPE death (main ignores SIGPIPE).
-void check_stdout() {
-  std::cout.flush();
-  if (!std::cout) throw nmbake::OutputError(std::string("stdout: cannot write: ") + std::strerror(errno));
-}
-
 // Mesa's software renderer crashes (SIGSEGV in shader compilation) instead of failing when it
 // cannot allocate. Measured under ulimit -v once the scene is loaded (torus sample, 200x100 panes):
 // with 483 MB of address space left it crashed 3 runs in 6, with 588 MB none in 6; a limit leaving
@@ -105,6 +99,10 @@ int run(const Options& o) {
   parse_pair("--light", o.light, io.light.azimuth, io.light.elevation);
   parse_show(o.show, io.toggles);
   io.toggles.map = !o.no_map;
+  // The screenshot may not be an input (exit 1) nor a file that cannot be written (exit 3): checked
+  // before anything is loaded or rendered.
+  nmbake::check_output_files({{"", o.low, "the low-poly"}, {"", o.map, "the map"}, {"", o.high, "the high-poly"}},
+                             {{"--screenshot", o.screenshot, "the screenshot"}});
 
   const nmview::Scene scene = nmview::load_scene(o.low, o.map, o.high, std::cerr, o.decoding, o.uv_set);
   check_renderer_headroom();
@@ -132,17 +130,16 @@ int run(const Options& o) {
       show.difference = true;
       nmview::Framebuffer target(3 * pane_width, pane_height);
       renderer.render(target.id(), 3 * pane_width, pane_height, result.views[result.worst].view, io.light, show);
-      nmview::write_screenshot(o.screenshot, nmview::Renderer::read_framebuffer(target.id(), 3 * pane_width, pane_height));
+      nmview::write_screenshot(o.screenshot, nmview::Renderer::read_framebuffer(target.id(), 3 * pane_width, pane_height), scene);
       std::cerr << "nmview: worst view written to " << o.screenshot << "\n";
     }
     nmview::print_compare(result, std::cout);
-    check_stdout();
     return 0;
   }
 
   nmview::Framebuffer target(io.width, io.height);
   renderer.render(target.id(), io.width, io.height, io.view, io.light, io.toggles);
-  nmview::write_screenshot(o.screenshot, nmview::Renderer::read_framebuffer(target.id(), io.width, io.height));
+  nmview::write_screenshot(o.screenshot, nmview::Renderer::read_framebuffer(target.id(), io.width, io.height), scene);
   std::cerr << "nmview: wrote " << o.screenshot << " (" << io.width << "x" << io.height << ")\n";
   return 0;
 }
@@ -220,7 +217,10 @@ int run_command_line(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::signal(SIGPIPE, SIG_IGN);
+  // A closed or full stdout or stderr loses messages, never changes the screenshot or the exit
+  // status; a file past ulimit -f is a failed write (exit 3).
+  nmbake::protect_standard_streams();
+  nmbake::remove_temporaries_on_signals();
   nmbake::preload_image_io();  // the image library module: loads beside the parsing, or first under ulimit -v
   const int code = run_command_line(argc, argv);
   nmbake::wait_for_image_io();  // never exit while the image library's constructors run

@@ -5,6 +5,7 @@
 #include "core/errors.h"
 #include "io/image_io.h"
 #include "io/mesh_io.h"
+#include "io/output_files.h"
 #include "core/normals.h"
 #include "core/tangent_frames.h"
 
@@ -60,11 +61,19 @@ Scene load_scene(const std::string& low_path, const std::string& map_path, const
   return scene;
 }
 
-void write_screenshot(const std::string& path, const Rgba8Image& image) {
+void write_screenshot(const std::string& path, const Rgba8Image& image, const Scene& scene) {
   nmbake::Image rgb(image.width, image.height, 3);
   for (std::size_t i = 0; i < std::size_t(image.width) * std::size_t(image.height); ++i)
     for (int c = 0; c < 3; ++c) rgb.pixels[3 * i + std::size_t(c)] = float(image.pixels[4 * i + std::size_t(c)]) / 255.0f;
-  nmbake::write_image(path, rgb);
+  // Checked again here: the interactive viewer's screenshots are checked nowhere else.
+  nmbake::check_output_files(
+      {{"", scene.low_name, "the low-poly"}, {"", scene.map_name, "the map"}, {"", scene.high_name, "the high-poly"}},
+      {{"--screenshot", path, "the screenshot"}});
+  nmbake::OutputFiles outputs;
+  nmbake::WriteOptions options;
+  options.temp_path = outputs.add(path);
+  nmbake::write_image(path, rgb, options);
+  outputs.commit();
 }
 
 }  // namespace nmview

@@ -34,7 +34,9 @@ struct Scene {
 Scene load_scene(const std::string& low_path, const std::string& map_path, const std::string& high_path, std::ostream& log,
                  const DecodingOverrides& overrides = {}, unsigned uv_set = 0);
 
-// Writes the RGB of `image` with nmbake::write_image (8-bit for PNG). Throws nmbake::OutputError.
-void write_screenshot(const std::string& path, const Rgba8Image& image);
+// Writes the RGB of `image` with nmbake::write_image (8-bit for PNG) under the output contract
+// (io/output_files.h): one of the scene's files (UsageError), a special file, a folder or a
+// dangling link (OutputError) refused, a temporary renamed into place when complete.
+void write_screenshot(const std::string& path, const Rgba8Image& image, const Scene& scene);
 
 }  // namespace nmview

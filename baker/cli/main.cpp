@@ -110,8 +110,9 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // A closed stdout (nmbake ... | head -0) is an error like any other write, not a SIGPIPE death.
-  std::signal(SIGPIPE, SIG_IGN);
+  // A closed or full stdout or stderr loses messages, never changes the outputs or the exit status;
+  // a file past ulimit -f is a failed write (exit 3), not a SIGXFSZ death.
+  protect_standard_streams();
   int code = 0;
   try {
     code = run(argc, argv);
@@ -133,10 +134,6 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     code = 2;
-  }
-  if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
-    std::fprintf(stderr, "error: stdout: cannot write: %s\n", std::strerror(errno));
-    if (code == 0) code = int(nmbake::ExitCode::output);
   }
   wait_for_image_io();  // never exit while the image library's constructors run
   return code;

@@ -1,67 +1,18 @@
-// The nmbake command's output files as one set: checked before the bake, each written to a
-// temporary file beside it, and renamed into place together only when every one is complete.
-//
-// A failed write, an interruption or --strict leaves every old file as it was and no temporary
-// behind. Temporaries are named ".<name>.nmbake-tmp.<pid>" (and, while the set is renamed into
-// place, the old file is kept as ".<name>.nmbake-old.<pid>"), so that those of a killed run can
-// be recognised: the next run removes its own outputs' ones whose process no longer exists.
+// The nmbake command's output set: the shared output contract (io/output_files.h) with the run's
+// interruption checked before the renames.
 #pragma once
 
 #include <functional>
-#include <string>
-#include <vector>
+
+#include "io/output_files.h"
 
 namespace nmbake {
 
-// A file named on the command line: its option ("--report"; "" for positional inputs), the path
-// as given, and what it holds ("the report"; used in messages).
-struct NamedFile {
-  std::string option, path, what;
-};
-
-// Refuses outputs that would destroy data or could not be written, before the bake (empty paths
-// are skipped):
-// - UsageError (exit 1) when an output is the same file as an input or as another output, by
-//   identity (device and inode where the file exists, so links and "./" do not slip through; the
-//   canonical folder and name where it does not yet): "--report low.obj is the same file as
-//   low.obj; nothing written";
-// - OutputError (exit 3) when an output is a folder, a special file (device, FIFO, socket, or a
-//   symbolic link to one), a symbolic link to nothing, in a missing or read-only folder, or has a
-//   name too long for its temporary file (NAME_MAX).
-// A symbolic link to a regular file is written through, as cp does: the link stays, its target
-// gets the new contents (the temporary is made beside the target).
-void check_output_files(const std::vector<NamedFile>& inputs, const std::vector<NamedFile>& outputs);
-
-// Whether two paths name one file (see check_output_files).
-bool same_file(const std::string& a, const std::string& b);
-
-class OutputSet {
+class OutputSet : public OutputFiles {
  public:
-  OutputSet() = default;
-  OutputSet(const OutputSet&) = delete;
-  OutputSet& operator=(const OutputSet&) = delete;
-  ~OutputSet();  // removes the temporaries of a set not committed
-
-  // The temporary file to write `path` to. Removes stale temporaries of `path` left by killed runs.
-  std::string add(const std::string& path);
-
-  // Renames every temporary over its output. Throws Cancelled, nothing renamed, when `cancelled`
-  // says so before the first rename (after it, the set is finished: the renames take
-  // microseconds). When a rename fails, the outputs already renamed get their old files back and
-  // OutputError names the file.
+  // Throws Cancelled, nothing renamed, when `cancelled` says so before the first rename; else
+  // OutputFiles::commit.
   void commit(const std::function<bool()>& cancelled);
-
-  // Removes every temporary (also done by the destructor). Safe to call more than once.
-  void discard();
-
- private:
-  struct File {
-    std::string path;    // as given (messages)
-    std::string target;  // the file replaced: path, or the regular file a symbolic link names
-    std::string temp, backup;
-  };
-  std::vector<File> files_;
-  bool committed_ = false;
 };
 
 }  // namespace nmbake

@@ -4,9 +4,10 @@
 # nmdiff A B --heatmap h.png --json d.json over old outputs (those of comparing A with itself) runs
 # once to count its calls (shim.cpp), once cleanly for the new outputs, then once per call with that
 # call failing (ENOSPC or EIO; ENOMEM for an allocation of 64 KiB or more). Each output is written
-# on its own, atomically: after any run each is byte-identical to the old one or to the new one, and
-# no temporary is left. A run exits as the clean one did, with every output new, or with 2 (a file
-# operation) or 4 (memory) and one short "error: ..." line. Exit 77 (skipped) without the shim.
+# to a temporary, and both are renamed into place together (io/output_files.h): after any run each is
+# byte-identical to the old one or to the new one, and no temporary is left. A run exits as the
+# clean one did, with every output new, or with 3 (a file operation) or 4 (memory) and one short
+# "error: ..." line. Exit 77 (skipped) without the shim.
 set -u
 nmdiff=$(realpath "$1") shim=$2 a=$(realpath "$3") b=$(realpath "$4") work=$5
 if [ "$shim" = none ] || [ ! -e "$shim" ] || ldd "$nmdiff" | grep -q -e libasan -e libubsan; then
@@ -46,14 +47,14 @@ run() {
   done
   if [ "$code" = "$clean" ]; then
     for f in $outputs; do cmp -s "$f" "$work/new/$f" || bad "$spec: exit $code but $f is not the new one"; done
-  elif [ "$code" = 2 ] || [ "$code" = 4 ]; then
+  elif [ "$code" = 3 ] || [ "$code" = 4 ]; then
     failures=$((failures + 1))
     [ "$(wc -l <"$log/stderr.txt")" = 1 ] || bad "$spec: stderr is not one line: $err"
     [ "${#err}" -lt 300 ] || bad "$spec: a ${#err}-byte error"
     case "$spec:$code" in
       alloc:*:4) echo "$err" | grep -q "^error: .*out of memory" || bad "$spec: no 'out of memory': $err" ;;
       alloc:*) bad "$spec: exit $code for an allocation" ;;
-      *:2) echo "$err" | grep -qE "^error: (h\.png|d\.json): cannot write: " || bad "$spec: the error names no output: $err" ;;
+      *:3) echo "$err" | grep -qE "^error: (h\.png|d\.json): cannot write: " || bad "$spec: the error names no output: $err" ;;
       *) bad "$spec: exit $code for a file operation" ;;
     esac
   else

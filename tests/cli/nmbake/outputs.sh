@@ -14,14 +14,8 @@
 set -u
 nmbake=$(realpath "$1") repo=$(realpath "$2") work=$3
 high=$repo/data/sample/torus_high.ply
-rm -rf "$work" && mkdir -p "$work/scene" && cd "$work/scene" || exit 1
-log=$work  # the command's output, outside the folder compared
-fail=0
-bad() { echo "FAIL: $*"; fail=1; }
-# Contents and links of every file in the folder, to compare before and after a run.
-state() { for f in $(ls -A | sort); do
-  if [ -L "$f" ]; then echo "$f -> $(readlink "$f")"; elif [ -f "$f" ]; then echo "$f $(md5sum <"$f")"; else echo "$f other"; fi
-done; }
+# shellcheck source=../scene_state.sh
+. "$(dirname "$(realpath "$0")")/../scene_state.sh"
 
 # The scene: a low-poly copy, links to it, an old set of outputs.
 cp "$repo/data/sample/torus_low.obj" low.obj

@@ -90,8 +90,8 @@ void write_hostile_fixtures(const std::string& dir) {
   nmbake::write_image(path("exr_small.exr"), nmbake::Image(32, 32, 3, 0.5f));
   widen_exr(path("exr_small.exr"), path("header_20000.exr"), 20000, 20000);
 
-  // nmbake's convention metadata: the same normals baked green up (PNG) and green down (EXR), and
-  // an object-space map.
+  // nmbake's convention metadata: the same normals baked green up (PNG) and green down (EXR), an
+  // object-space map, and per-pixel against per-vertex bitangents.
   nmbake::Image up(16, 16, 3), down(16, 16, 3);
   for (int y = 0; y < 16; ++y)
     for (int x = 0; x < 16; ++x) {
@@ -109,6 +109,11 @@ void write_hostile_fixtures(const std::string& dir) {
   o.metadata = {{"nmbake:space", "object"}, {"nmbake:green", "up"}};
   nmbake::write_image(path("meta_object.exr"), up, o);
   nmbake::write_image(path("untagged_green_down.exr"), down);
+  // The same normals said to be baked with per-pixel and with per-vertex bitangents.
+  o.metadata = {{"nmbake:space", "tangent"}, {"nmbake:green", "up"}, {"nmbake:bitangent", "pixel"}};
+  nmbake::write_image(path("meta_pixel.png"), up, o);
+  o.metadata = {{"nmbake:space", "tangent"}, {"nmbake:green", "up"}, {"nmbake:bitangent", "vertex"}};
+  nmbake::write_image(path("meta_vertex.png"), up, o);
 
   // A 2048^2 map (smooth, so the PNG stays small) for the runs under ulimit -v.
   nmbake::Image medium(2048, 2048, 3);
