@@ -19,6 +19,7 @@ struct Probe {
   glm::dvec3 p, n;
   std::uint32_t v[3];
   int nv;
+  std::uint32_t group;  // its triangle's match group (0 without groups)
 };
 
 glm::dvec3 unit_or_face(const glm::dvec3& n, const glm::dvec3& p0, const glm::dvec3& p1, const glm::dvec3& p2) {
@@ -52,6 +53,30 @@ void ease(std::vector<double>& value, const std::vector<std::vector<std::pair<st
   }
 }
 
+std::uint32_t group_of(const CageBase& low, std::size_t triangle) { return low.group ? (*low.group)[triangle] : 0u; }
+
+// Positions welded by value, and with groups, apart where their groups differ (a position takes
+// the group of the first triangle that uses it).
+std::vector<std::uint32_t> weld_in_groups(const CageBase& low, std::size_t* count) {
+  std::vector<std::uint32_t> weld = weld_positions(*low.positions, count);
+  if (!low.group) return weld;
+  const std::vector<std::uint32_t>& index = *low.index;
+  const std::uint32_t unset = std::numeric_limits<std::uint32_t>::max();
+  std::vector<std::uint32_t> group(low.positions->size(), unset);
+  for (std::size_t c = 0; c < index.size(); ++c)
+    if (group[index[c]] == unset) group[index[c]] = group_of(low, c / 3);
+  std::vector<std::pair<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t>> keys(weld.size());
+  for (std::uint32_t p = 0; p < weld.size(); ++p) keys[p] = {{weld[p], group[p]}, p};
+  std::sort(keys.begin(), keys.end());
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < keys.size(); ++k) {
+    if (k > 0 && keys[k].first != keys[k - 1].first) ++n;
+    weld[keys[k].second] = std::uint32_t(n);
+  }
+  *count = keys.empty() ? 0 : n + 1;
+  return weld;
+}
+
 // Probes: one at every welded vertex a face uses, and at the centre and near each corner of
 // every triangle (all three corners hear of these: the cage between them must cover them).
 std::vector<Probe> make_probes(const CageBase& low, const std::vector<std::uint32_t>& weld, std::size_t nw) {
@@ -62,11 +87,11 @@ std::vector<Probe> make_probes(const CageBase& low, const std::vector<std::uint3
   std::vector<Probe> probes;
   {
     std::vector<std::uint8_t> seen(nw, 0);
-    for (std::uint32_t pi : index) {
-      const std::uint32_t w = weld[pi];
+    for (std::size_t c = 0; c < index.size(); ++c) {
+      const std::uint32_t pi = index[c], w = weld[pi];
       if (seen[w]) continue;
       seen[w] = 1;
-      probes.push_back({glm::dvec3(pos[pi]), glm::normalize(glm::dvec3(rn[pi])), {w, w, w}, 1});
+      probes.push_back({glm::dvec3(pos[pi]), glm::normalize(glm::dvec3(rn[pi])), {w, w, w}, 1, group_of(low, c / 3)});
     }
   }
   const std::size_t stride = std::max<std::size_t>(1, tris / 50000);
@@ -78,7 +103,7 @@ std::vector<Probe> make_probes(const CageBase& low, const std::vector<std::uint3
     for (const auto& b : bary) {
       const glm::dvec3 p = b[0] * p0 + b[1] * p1 + b[2] * p2;
       const glm::dvec3 n = b[0] * glm::dvec3(rn[c[0]]) + b[1] * glm::dvec3(rn[c[1]]) + b[2] * glm::dvec3(rn[c[2]]);
-      probes.push_back({p, unit_or_face(n, p0, p1, p2), {weld[c[0]], weld[c[1]], weld[c[2]]}, 3});
+      probes.push_back({p, unit_or_face(n, p0, p1, p2), {weld[c[0]], weld[c[1]], weld[c[2]]}, 3, group_of(low, t)});
     }
   }
   return probes;
@@ -127,6 +152,19 @@ Adjacency welded_edges(const std::vector<glm::vec3>& pos, const std::vector<std:
 
 }  // namespace
 
+void intersect_first(const raycast::Scene& scene, const raycast::Ray* rays, raycast::Hit* hits, std::size_t count,
+                     const std::uint32_t* triangle_group, const std::uint32_t* ray_group) {
+  if (!triangle_group) return scene.intersect(rays, hits, count);
+  raycast::RayArrays arrays(rays, count);
+  raycast::RayBatch batch = arrays.rays();
+  batch.group = ray_group;
+  raycast::HitRule rule;
+  rule.skip_backfaces = false;  // every face counts, as without a rule
+  rule.group = triangle_group;
+  scene.intersect(batch, arrays.hits(), count, &rule);
+  for (std::size_t i = 0; i < count; ++i) hits[i] = arrays.hit(i);
+}
+
 LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& high, double reach, double floor,
                                        double front_base, double rear_base, double need_slope, double limit_slope, int threads) {
   const std::vector<glm::vec3>& pos = *low.positions;
@@ -134,7 +172,7 @@ LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& h
   const std::size_t tris = index.size() / 3;
   LocalDistances out;
   std::size_t nw = 0;
-  const std::vector<std::uint32_t> weld = weld_positions(pos, &nw);
+  const std::vector<std::uint32_t> weld = weld_in_groups(low, &nw);
   out.vertices = nw;
 
   const std::vector<Probe> probes = make_probes(low, weld, nw);
@@ -146,8 +184,10 @@ LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& h
   const raycast::Scene self(&pos[0].x, pos.size(), index.data(), tris, raycast::BuildQuality::low, threads);
   raycast::HitRule facing_start;  // an "inward" ray under this rule takes surfaces facing its start
   facing_start.facing = low_facing.data();
+  facing_start.group = low.group ? low.group->data() : nullptr;
   raycast::HitRule high_facing_start;
   high_facing_start.facing = high.facing;
+  high_facing_start.group = high.group;
 
   // Per probe: the distances found (infinity: none). Front/rear needs from the high-poly's first
   // hits that face the low-poly's outside; limits from the low-poly.
@@ -158,15 +198,18 @@ LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& h
   std::vector<double> need_out(probes.size(), inf), need_in(probes.size(), inf), gap_out(probes.size(), inf),
       gap_in(probes.size(), inf);
   const float tnear = float(1e-2 * floor);
+  const float inf_f = std::numeric_limits<float>::infinity();
   parallel_chunks(threads, probes.size(), 1024, [&](std::size_t i0, std::size_t i1) {
     std::vector<raycast::Ray> rays;
+    std::vector<std::uint32_t> ray_group;
     rays.reserve(2 * (i1 - i0));
     for (std::size_t i = i0; i < i1; ++i) {
       rays.push_back({glm::vec3(probes[i].p), 0.0f, glm::vec3(probes[i].n), float(reach)});
       rays.push_back({glm::vec3(probes[i].p), 0.0f, glm::vec3(-probes[i].n), float(reach)});
+      ray_group.insert(ray_group.end(), 2, probes[i].group);
     }
     std::vector<raycast::Hit> hits(rays.size());
-    high.scene->intersect(rays.data(), hits.data(), rays.size());
+    intersect_first(*high.scene, rays.data(), hits.data(), rays.size(), high.group, ray_group.data());
     for (std::size_t i = i0; i < i1; ++i)
       for (int k = 0; k < 2; ++k) {
         const raycast::Hit& h = hits[2 * (i - i0) + k];
@@ -181,7 +224,7 @@ LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& h
       raycast::Ray r = rays[i];
       r.tnear = tnear;
       for (int tries = 0; tries < 8; ++tries) {
-        const raycast::Hit h = self.intersect(r, facing_start);
+        const raycast::Hit h = self.intersect(r, facing_start, false, nullptr, 0.0f, inf_f, pr.group);
         if (!h.hit()) break;
         bool near = false;
         for (int c = 0; c < 3 && !near; ++c)
@@ -199,7 +242,7 @@ LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& h
     for (std::size_t i = i0; i < i1; ++i) {
       if (!(gap_out[i] < inf)) continue;
       const raycast::Ray r{glm::vec3(probes[i].p), tnear, glm::vec3(probes[i].n), float(0.5 * gap_out[i])};
-      const raycast::Hit h = high.scene->intersect(r, high_facing_start);
+      const raycast::Hit h = high.scene->intersect(r, high_facing_start, false, nullptr, 0.0f, inf_f, probes[i].group);
       if (h.hit()) high_back_out[i] = h.t;
     }
   });
