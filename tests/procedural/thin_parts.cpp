@@ -138,6 +138,16 @@ ThinParts make_thin_parts(const ThinPartsSpec& spec) {
   return out;
 }
 
+double diagonal(const ThinParts& parts) {
+  glm::dvec3 lo(1e300), hi(-1e300);
+  for (const Mesh* m : {&parts.low, &parts.high})
+    for (const glm::vec3& p : m->positions) {
+      lo = glm::min(lo, glm::dvec3(p));
+      hi = glm::max(hi, glm::dvec3(p));
+    }
+  return glm::length(hi - lo);
+}
+
 std::vector<ThinPartsSpec> thin_parts_family() {
   std::vector<ThinPartsSpec> f;
   ThinPartsSpec legs;  // the defaults: six-sided legs whose corners stand out

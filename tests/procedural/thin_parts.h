@@ -36,6 +36,9 @@ struct ThinParts {
 
 ThinParts make_thin_parts(const ThinPartsSpec& spec);
 
+// The diagonal of both meshes' bounding box (what nmbake's distances are shares of).
+double diagonal(const ThinParts& parts);
+
 // The family the tests judge the automatic cage on: legs, fingers, antennae, tails, low-polys
 // outside, inside and crossing the high surface, 1-5% of the high-poly's triangles.
 std::vector<ThinPartsSpec> thin_parts_family();
