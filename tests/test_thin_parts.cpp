@@ -6,7 +6,6 @@
 // tests/viewer/test_thin_parts_view.cpp.)
 #include <algorithm>
 #include <cstdio>
-#include <cstdlib>
 #include <string>
 #include <utility>
 #include <vector>
@@ -15,7 +14,6 @@
 
 #include "hard_asset_answers.h"
 #include "hard_assets.h"
-#include "io/mesh_io.h"
 #include "pipeline/bake.h"
 #include "test_support.h"
 #include "thin_parts.h"
@@ -120,18 +118,6 @@ TEST(ThinParts, CoarsePrismUnderCloseTubesGetsTheAnalyticNormals) {
   EXPECT_EQ(e.other_surface, 0u);
   EXPECT_LE(e.mean_deg, 0.25);
   EXPECT_LE(e.over1, 0.01);
-}
-
-// The family as OBJ files for the command line and nmview (NAME_low.obj, NAME_high.obj in
-// $NMBAKE_THIN_PARTS_DIR): --gtest_also_run_disabled_tests --gtest_filter=*WriteFamily.
-TEST(ThinParts, DISABLED_WriteFamily) {
-  const char* dir = std::getenv("NMBAKE_THIN_PARTS_DIR");
-  ASSERT_NE(dir, nullptr) << "set NMBAKE_THIN_PARTS_DIR";
-  for (const procedural::ThinPartsSpec& spec : procedural::thin_parts_family()) {
-    const procedural::ThinParts p = procedural::make_thin_parts(spec);
-    test::write_file(std::string(dir) + "/" + spec.name + "_low.obj", obj_text(p.low, spec.name + " low"));
-    test::write_file(std::string(dir) + "/" + spec.name + "_high.obj", obj_text(p.high, spec.name + " high"));
-  }
 }
 
 }  // namespace

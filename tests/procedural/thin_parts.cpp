@@ -149,64 +149,22 @@ double diagonal(const ThinParts& parts) {
 }
 
 std::vector<ThinPartsSpec> thin_parts_family() {
-  std::vector<ThinPartsSpec> f;
-  ThinPartsSpec legs;  // the defaults: six-sided legs whose corners stand out
-  legs.name = "legs";
-  f.push_back(legs);
-  ThinPartsSpec fingers;  // thick, close, the low-poly's corners on the high surface
-  fingers.name = "fingers";
-  fingers.legs = 4;
-  fingers.radius_min = 0.045;
-  fingers.radius_max = 0.06;
-  fingers.gap = 0.006;
-  fingers.bend = 0.1;
-  fingers.bump = 0.06;
-  fingers.low_scale = 1.0;
-  fingers.sides_low = 8;
-  fingers.rings_low = 5;
-  f.push_back(fingers);
-  ThinPartsSpec antennae;  // long and thin, the low-poly mostly outside
-  antennae.name = "antennae";
-  antennae.radius_min = 0.008;
-  antennae.radius_max = 0.014;
-  antennae.length = 0.8;
-  antennae.gap = 0.004;
-  antennae.bend = 0.25;
-  antennae.bump = 0.1;
-  antennae.low_scale = 1.15;
-  antennae.sides_low = 5;
-  antennae.rings_low = 8;
-  f.push_back(antennae);
-  ThinPartsSpec inside;  // the low-poly inside the high surface, legs closing in on each other
-  inside.name = "inside";
-  inside.low_scale = 0.92;
-  inside.splay = 0.003;
-  f.push_back(inside);
-  ThinPartsSpec tails;  // few rings along a strong bend: the chords cut through it
-  tails.name = "tails";
-  tails.legs = 4;
-  tails.radius_min = 0.025;
-  tails.radius_max = 0.035;
-  tails.bend = 0.35;
-  tails.rings_low = 3;
-  tails.sides_low = 8;
-  tails.gap = 0.007;
-  f.push_back(tails);
-  ThinPartsSpec spider;  // eight square legs, bumpier than they are apart, closing in
-  spider.name = "spider";
-  spider.legs = 8;
-  spider.radius_min = 0.012;
-  spider.radius_max = 0.03;
-  spider.gap = 0.003;
-  spider.bump = 0.15;
-  spider.splay = 0.001;
-  spider.sides_low = 4;
-  spider.rings_low = 5;
-  spider.low_scale = 1.0;
-  spider.around_high = 32;
-  spider.rows_high = 64;
-  f.push_back(spider);
-  return f;
+  // name, legs, radius_min, radius_max, gap, length, bend, splay, bump, low_scale, sides_low,
+  // rings_low, cap_rows_low, around_high, rows_high
+  return {
+      // six-sided legs whose corners stand out
+      {"legs", 5, 0.02, 0.04, 0.008, 0.6, 0.15, 0.0, 0.08, 1.06, 6, 6, 1, 40, 80},
+      // thick, close, the low-poly's corners on the high surface
+      {"fingers", 4, 0.045, 0.06, 0.006, 0.6, 0.1, 0.0, 0.06, 1.0, 8, 5, 1, 40, 80},
+      // long and thin, the low-poly mostly outside
+      {"antennae", 5, 0.008, 0.014, 0.004, 0.8, 0.25, 0.0, 0.1, 1.15, 5, 8, 1, 40, 80},
+      // the low-poly inside the high surface, legs closing in on each other
+      {"inside", 5, 0.02, 0.04, 0.008, 0.6, 0.15, 0.003, 0.08, 0.92, 6, 6, 1, 40, 80},
+      // few rings along a strong bend: the chords cut through it
+      {"tails", 4, 0.025, 0.035, 0.007, 0.6, 0.35, 0.0, 0.08, 1.06, 8, 3, 1, 40, 80},
+      // eight square legs, bumpier than they are apart, closing in
+      {"spider", 8, 0.012, 0.03, 0.003, 0.6, 0.15, 0.001, 0.15, 1.0, 4, 5, 1, 32, 64},
+  };
 }
 
 }  // namespace nmbake::procedural
