@@ -77,7 +77,11 @@ void add_leg(Mesh& m, const Leg& leg, const std::vector<double>& rows, int aroun
       m.positions.push_back(glm::vec3(leg.axis(s) + radial_scale * rho * detail * radial));
     }
     for (int i = 0; i <= around; ++i) {
-      const double u = (j == 0 || j == R) ? (i + 0.5) / around : double(i) / around;
+      // A pole's UV per triangle, half way across its column (the last row's triangles reach the
+      // pole from column i + 1, the first row's from column i).
+      const double u = j == 0   ? (std::min(i, around - 1) + 0.5) / around
+                       : j == R ? (std::max(i, 1) - 0.5) / around
+                                : double(i) / around;
       m.uvs.push_back(glm::vec2(uv0 + uv_size * glm::dvec2(u, rows[j] / leg.total())));
     }
   }
@@ -164,6 +168,8 @@ std::vector<ThinPartsSpec> thin_parts_family() {
       {"tails", 4, 0.025, 0.035, 0.007, 0.6, 0.35, 0.0, 0.08, 1.06, 8, 3, 1, 40, 80},
       // eight square legs, bumpier than they are apart, closing in
       {"spider", 8, 0.012, 0.03, 0.003, 0.6, 0.15, 0.001, 0.15, 1.0, 4, 5, 1, 32, 64},
+      // three-sided legs whose tips cross (the high-polys intersect there)
+      {"tripods", 6, 0.015, 0.03, 0.002, 0.6, 0.3, 0.004, 0.2, 1.0, 3, 6, 1, 32, 64},
   };
 }
 
