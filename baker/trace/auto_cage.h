@@ -8,9 +8,11 @@
 // normal, and the cage stops half way to it, so that cages of facing parts never cross and no ray
 // starts beyond a neighbouring part; where that part's high-poly stands out towards this one past
 // the half-way point, the cage stops before its surface. Needs are spread over neighbours and limits eased off with
-// distance (each changes by at most its edge's length along an edge), so the cage has neither
-// spikes nor notches; positions are welded by value first, so hard edges (split normals) open no
-// cracks. All coordinates are re-centred scene units.
+// distance (each changes by at most its edge's length along an edge, and a limit, across a coarse
+// part's sharp edge, by a bounded ratio, so that rays lean at most about 20 degrees), so the cage
+// has neither spikes nor notches; positions are welded by value first, so hard edges (split
+// normals) open no cracks. A low-poly with few triangles is probed densely (a grid over each).
+// All coordinates are re-centred scene units.
 #pragma once
 
 #include <cstddef>
