@@ -21,7 +21,7 @@ namespace {
 // suspect texels of three-sided legs (0.29%) at no cost on the others.
 constexpr double kMaxTilt = 0.349;
 // How many points the dense probes of a low-poly with few triangles take in all (make_probes).
-constexpr double kDenseProbes = 200000.0;
+constexpr double kDenseProbes = 100000.0;
 
 // A point the probes start from, the unit direction they go (out: +dir, in: -dir), and the welded
 // vertices its findings count for.
