@@ -24,6 +24,7 @@
 #include "io/mesh_io.h"
 #include "nmdiff.h"
 #include "pipeline/bake.h"
+#include "procedural.h"
 #include "test_support.h"
 
 namespace nmbake {
@@ -316,6 +317,128 @@ TEST(MatchNames, NodesOfAssetFormatsAreObjects) {
     const diff::DiffStats d = diff::compare_normal_maps(read_image(dir + "/m.exr"), expected);
     EXPECT_LT(d.max_deg, 0.05) << pair;
   }
+}
+
+// Two intersecting balls (issue 34, item 2), each a coarse low-poly sphere inside a fine bumped
+// high-poly one, named a_low/a_high and b_low/b_high, a UV half each. Ball b lies inside a's high
+// surface where they cross: probes from a that saw b's surfaces limited a's cage there.
+constexpr float kBallOffset = 0.6f;
+
+Mesh ball(bool high, float x) {
+  Mesh m = high ? procedural::make_sphere(
+                      64, 32, [](double t, double f) { return procedural::displaced_sphere_radius(0.04, 5, t, f); },
+                      [](double t, double f) { return procedural::displaced_sphere_normal(0.04, 5, t, f); })
+                : procedural::make_sphere(10, 6, [](double, double) { return 1.06; },
+                                          [](double t, double f) {
+                                            return glm::dvec3(std::sin(t) * std::cos(f), std::sin(t) * std::sin(f), std::cos(t));
+                                          });
+  for (glm::vec3& p : m.positions) p.x += x;
+  for (glm::vec2& uv : m.uvs) uv.x = 0.5f * uv.x + (x > 0.0f ? 0.5f : 0.0f);
+  return m;
+}
+
+// Meshes as one OBJ file, one `o` per mesh (positions, UVs when present, normals when present).
+std::string objects_obj(const std::vector<std::pair<std::string, Mesh>>& parts) {
+  std::string text;
+  char line[200];
+  std::size_t base_v = 0, base_t = 0, base_n = 0;
+  for (const auto& [name, m] : parts) {
+    text += "o " + name + "\n";
+    for (const glm::vec3& p : m.positions) {
+      std::snprintf(line, sizeof line, "v %.9g %.9g %.9g\n", double(p.x), double(p.y), double(p.z));
+      text += line;
+    }
+    for (const glm::vec2& t : m.uvs) {
+      std::snprintf(line, sizeof line, "vt %.9g %.9g\n", double(t.x), double(t.y));
+      text += line;
+    }
+    for (const glm::vec3& n : m.normals) {
+      std::snprintf(line, sizeof line, "vn %.9g %.9g %.9g\n", double(n.x), double(n.y), double(n.z));
+      text += line;
+    }
+    for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+      text += "f";
+      for (int c = 0; c < 3; ++c) {
+        text += " " + std::to_string(base_v + m.position_index[3 * t + c] + 1) + "/";
+        if (m.has_uvs()) text += std::to_string(base_t + m.uv_index[3 * t + c] + 1);
+        if (m.has_normals()) text += "/" + std::to_string(base_n + m.normal_index[3 * t + c] + 1);
+      }
+      text += "\n";
+    }
+    base_v += m.positions.size();
+    base_t += m.uvs.size();
+    base_n += m.normals.size();
+  }
+  return text;
+}
+
+std::string balls_obj(bool high, bool a, bool b) {
+  std::vector<std::pair<std::string, Mesh>> parts;
+  if (a) parts.push_back({high ? "a_high" : "a_low", ball(high, -kBallOffset)});
+  if (b) parts.push_back({high ? "b_high" : "b_low", ball(high, kBallOffset)});
+  return objects_obj(parts);
+}
+
+BakeOptions ball_options(const Mesh& low, const Mesh& high) {
+  BakeOptions o;
+  o.width = o.height = 128;
+  o.padding = 0;
+  std::vector<std::string> lows, highs;
+  for (const Mesh::Object& x : low.objects) lows.push_back(x.name);
+  for (const Mesh::Object& x : high.objects) highs.push_back(x.name);
+  const ObjectMatch m = match_objects(lows, highs, default_match_suffixes());
+  o.low_object_group = m.low_group;
+  o.high_object_group = m.high_group;
+  return o;
+}
+
+// With --match names the automatic cage of each ball is sized from its own group only: no
+// misses, and each ball's texels are those of the ball baked alone (the known answer).
+TEST(MatchNames, IntersectingBallsBakeAsIfAlone) {
+  const Mesh low = load_obj("low.obj", balls_obj(false, true, true));
+  const Mesh high = load_obj("high.obj", balls_obj(true, true, true));
+  ASSERT_EQ(low.objects.size(), 2u);
+  const BakeResult both = bake_normal_map(low, high, nullptr, ball_options(low, high));
+  EXPECT_EQ(both.stats.misses, 0u) << "of " << both.stats.samples_covered;
+  for (const bool a : {true, false}) {
+    const Mesh low1 = load_obj("low1.obj", balls_obj(false, a, !a)), high1 = load_obj("high1.obj", balls_obj(true, a, !a));
+    const BakeResult alone = bake_normal_map(low1, high1, nullptr, ball_options(low1, high1));
+    std::size_t texels = 0, over_rounding = 0;
+    for (std::size_t i = 0; i < alone.coverage.size(); ++i) {
+      if (!alone.coverage[i]) continue;
+      ++texels;
+      for (int c = 0; c < 3; ++c) over_rounding += std::abs(int(both.map.pixels[3 * i + c]) - int(alone.map.pixels[3 * i + c])) > 1;
+    }
+    ASSERT_GT(texels, 3000u);
+    EXPECT_EQ(over_rounding, 0u) << (a ? "ball a" : "ball b");
+    EXPECT_LT(largest_angle(both, alone, alone.coverage), 1.0) << (a ? "ball a" : "ball b");
+  }
+}
+
+// The same scene as GLB and as DAE (Assimp's exporter) gives the same cages, so the same maps.
+TEST(MatchNames, IntersectingBallsAgreeAcrossFormats) {
+  const std::string dir = test::scratch_dir();
+  test::write_file(dir + "/low.obj", balls_obj(false, true, true));
+  test::write_file(dir + "/high.obj", balls_obj(true, true, true));
+  for (const auto& [format, ext] : {std::pair{"glb2", "glb"}, std::pair{"collada", "dae"}})
+    for (const char* side : {"low", "high"}) {
+      Assimp::Importer importer;
+      const aiScene* scene = importer.ReadFile(dir + "/" + side + ".obj", aiProcess_ValidateDataStructure);
+      ASSERT_NE(scene, nullptr) << importer.GetErrorString();
+      Assimp::Exporter exporter;
+      ASSERT_EQ(exporter.Export(scene, format, dir + "/" + side + "." + ext), AI_SUCCESS) << exporter.GetErrorString();
+    }
+  const std::string options = " --size 128 --padding 0 --match names --report r.json";
+  const test::CliRun glb = run_nmbake("low.glb high.glb -o glb.png" + options, "", dir);
+  ASSERT_EQ(glb.code, 0) << glb.err;
+  EXPECT_EQ(glb.report["misses"], 0);
+  const test::CliRun dae = run_nmbake("low.dae high.dae -o dae.png" + options, "", dir);
+  ASSERT_EQ(dae.code, 0) << dae.err;
+  EXPECT_EQ(dae.report["misses"], 0);
+  const diff::DiffStats d = diff::compare_normal_maps(read_image(dir + "/dae.png"), read_image(dir + "/glb.png"));
+  EXPECT_TRUE(d.within) << "mean " << d.mean_deg << ", p99 " << d.p99_deg << ", max " << d.max_deg << ", over 1 degree "
+                        << d.over_1deg;
+  EXPECT_LT(d.over_1deg, 0.001);
 }
 
 }  // namespace

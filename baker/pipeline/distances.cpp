@@ -44,8 +44,11 @@ void summarize(const std::vector<float>& v, BakeStats::Range& out) {
 // The scene-wide probes: pairs of rays from points of the low-poly out and in along its ray
 // normals. They decide which way the high-poly's faces point (for the hit rule) and, when
 // measuring, the distances for the whole scene (returned as front, rear; 0 when not measured).
+// With match groups each probe sees only its own group's high-poly, as the bake's rays do (what
+// another object's high-poly shows them, its inside or its nearness, is not what they will meet),
+// and objects without a match are not probed (their texels are written flat).
 std::pair<double, double> probe_scene(const ReachMode& mode, const BakeOptions& opt, int threads, const Prepared& s,
-                                      const HighScene& h, BakeStats& st) {
+                                      const HighScene& h, const RayGroups& groups, BakeStats& st) {
   const std::vector<LowTriangle>& low_tris = s.low_tris;
   double global_front = 0.0, global_rear = 0.0;  // measured for the whole scene
   if (mode.probing || !opt.keep_backfaces) {
@@ -54,19 +57,24 @@ std::pair<double, double> probe_scene(const ReachMode& mode, const BakeOptions& 
     static const double probe_bary[4][3] = {
         {1 / 3.0, 1 / 3.0, 1 / 3.0}, {4 / 6.0, 1 / 6.0, 1 / 6.0}, {1 / 6.0, 4 / 6.0, 1 / 6.0}, {1 / 6.0, 1 / 6.0, 4 / 6.0}};
     std::vector<raycast::Ray> rays;
-    for (std::size_t t = 0; t < tris; t += stride)
+    std::vector<std::uint32_t> ray_group;
+    for (std::size_t t = 0; t < tris; t += stride) {
+      if (groups.active() && groups.low[t] == kNoMatch) continue;
       for (const auto& b : probe_bary) {
         const glm::dvec3 p = low_point(low_tris[t], b), n = low_ray_normal(low_tris[t], b);
         rays.push_back({glm::vec3(p), 0.0f, glm::vec3(n), float(mode.reach)});
         rays.push_back({glm::vec3(p), 0.0f, glm::vec3(-n), float(mode.reach)});
+        if (groups.active()) ray_group.insert(ray_group.end(), 2, groups.low[t]);
       }
+    }
     std::vector<raycast::Hit> hits(rays.size());
     const std::size_t pairs = rays.size() / 2;
     std::atomic<std::size_t> next{0};
     run_parallel(threads, [&](int) {
       for (std::size_t i; (i = next.fetch_add(4096)) < pairs;) {
         const std::size_t n = std::min<std::size_t>(4096, pairs - i);
-        h.scene->intersect(&rays[2 * i], &hits[2 * i], 2 * n);
+        intersect_first(*h.scene, &rays[2 * i], &hits[2 * i], 2 * n, groups.active() ? groups.high.data() : nullptr,
+                        groups.active() ? &ray_group[2 * i] : nullptr);
       }
     });
     std::size_t nearest_back = 0, probes_hit = 0;
@@ -141,12 +149,14 @@ void measure_reach(const ReachMode& mode, const Mesh& low, const BakeOptions& op
   BakeStats& st = result.stats;
   st.front = opt.front;
   st.rear = opt.rear;
-  const auto [global_front, global_rear] = probe_scene(mode, opt, threads, s, h, st);
+  const RayGroups groups = ray_groups(s, h, opt);
+  const auto [global_front, global_rear] = probe_scene(mode, opt, threads, s, h, groups, st);
   if (st.high_facing == BakeStats::HighFacing::inverted) turn_inverted_high(s, h, st.high_normals_computed);
   if (mode.local_rear) {
     // Per-vertex distances (after the facing decision: the probes judge faces by it).
     const LocalDistances ld =
-        measure_local_distances({&s.low_pos, &low.position_index, &s.ray_normal}, {&*h.scene, h.positions, h.index, h.facing},
+        measure_local_distances({&s.low_pos, &low.position_index, &s.ray_normal, groups.active() ? &groups.low : nullptr},
+                                {&*h.scene, h.positions, h.index, h.facing, groups.active() ? groups.high.data() : nullptr},
                                 mode.reach, mode.floor, global_front, global_rear, kNeedSlope, kLimitSlope, threads);
     st.auto_distances = true;
     st.cage_front_limited = mode.auto_cage ? ld.front_limited : 0;

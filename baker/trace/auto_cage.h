@@ -8,9 +8,11 @@
 // normal, and the cage stops half way to it, so that cages of facing parts never cross and no ray
 // starts beyond a neighbouring part; where that part's high-poly stands out towards this one past
 // the half-way point, the cage stops before its surface. Needs are spread over neighbours and limits eased off with
-// distance (each changes by at most its edge's length along an edge), so the cage has neither
-// spikes nor notches; positions are welded by value first, so hard edges (split normals) open no
-// cracks. All coordinates are re-centred scene units.
+// distance (each changes by at most its edge's length along an edge, and a limit, across a coarse
+// part's sharp edge, by a bounded ratio, so that rays lean at most about 20 degrees), so the cage
+// has neither spikes nor notches; positions are welded by value first, so hard edges (split
+// normals) open no cracks. A low-poly with few triangles is probed densely (a grid over each).
+// All coordinates are re-centred scene units.
 #pragma once
 
 #include <cstddef>
@@ -30,7 +32,15 @@ struct ProbeTarget {
   const glm::vec3* positions = nullptr;
   const std::uint32_t* index = nullptr;  // 3 per BVH triangle
   const std::int8_t* facing = nullptr;   // per BVH triangle (raycast::HitRule::facing: its sign)
+  // Per BVH triangle, its match group (raycast::HitRule::group), or null: one group. With groups a
+  // probe sees only its own group's triangles.
+  const std::uint32_t* group = nullptr;
 };
+
+// First hits of `count` rays on `scene`, whatever the faces; with `triangle_group` (per triangle)
+// and `ray_group` (per ray), each ray sees only the triangles of its own group.
+void intersect_first(const raycast::Scene& scene, const raycast::Ray* rays, raycast::Hit* hits, std::size_t count,
+                     const std::uint32_t* triangle_group, const std::uint32_t* ray_group);
 
 // For BVH triangle t: the dot product of its front's (unnormalized) normal with `dir`: positive
 // when its front faces along dir.
@@ -46,6 +56,11 @@ struct CageBase {
   const std::vector<glm::vec3>* positions = nullptr;
   const std::vector<std::uint32_t>* index = nullptr;
   const std::vector<glm::vec3>* ray_normals = nullptr;
+  // Per triangle, its match group (BakeOptions::low_object_group as RayGroups::low), or null: one
+  // group. With groups a vertex is probed against its own group's triangles only, of both meshes:
+  // another object's low-poly is not a next part (its rays pass through it), nor is its high-poly
+  // a surface to reach. Positions are welded within a group.
+  const std::vector<std::uint32_t>* group = nullptr;
 };
 
 struct LocalDistances {

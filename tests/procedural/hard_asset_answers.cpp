@@ -17,6 +17,15 @@ double angle_deg(const glm::dvec3& a, const glm::dvec3& b) {
 
 }  // namespace
 
+glm::dvec3 known_normal(const HardAsset& a, const glm::dvec3& p, const glm::dvec3& dir, int part) {
+  SurfacePoint sp = a.locate(p, dir, part);
+  if (sp.crossed && glm::dot(sp.normal, dir) < 0.0) {
+    const SurfacePoint other = a.locate(p - 2.0 * sp.s * dir, dir, part);
+    if (other.crossed && glm::dot(other.normal, dir) > 0.0) sp = other;
+  }
+  return sp.normal;
+}
+
 std::vector<KnownTexel> known_texels(const HardAsset& a, int size) {
   const std::vector<glm::vec3> ray_n = low_ray_normals(a.low);
   const std::vector<std::int32_t> owner = rasterize_texel_triangles(a.low, size, size);
@@ -38,13 +47,7 @@ std::vector<KnownTexel> known_texels(const HardAsset& a, int size) {
         p += kt.b[c] * glm::dvec3(a.low.corner_position(t, c));
         dir += kt.b[c] * glm::dvec3(ray_n[a.low.position_index[3 * t + c]]);
       }
-      dir = glm::normalize(dir);
-      SurfacePoint sp = a.locate(p, dir, kt.part);
-      if (sp.crossed && glm::dot(sp.normal, dir) < 0.0) {
-        const SurfacePoint other = a.locate(p - 2.0 * sp.s * dir, dir, kt.part);
-        if (other.crossed && glm::dot(other.normal, dir) > 0.0) sp = other;
-      }
-      kt.normal = sp.normal;
+      kt.normal = known_normal(a, p, glm::normalize(dir), kt.part);
       keep[k] = 1;
     }
   });

@@ -23,6 +23,10 @@ struct KnownTexel {
   glm::dvec3 normal{0.0};   // the exact unit normal (the crossing whose surface faces along the ray)
 };
 
+// The exact unit normal where the line through p along the unit outward direction dir crosses
+// part `part` (the crossing whose surface faces along dir, as below).
+glm::dvec3 known_normal(const HardAsset& asset, const glm::dvec3& p, const glm::dvec3& dir, int part);
+
 // The covered texel centres of a size x size map. The crossing nearest to the point may be the
 // part's far side, when its near side bulges out farther (a tall bulge): the answer is then the
 // crossing on the other side, whose surface faces along the ray.
