@@ -200,9 +200,10 @@ TEST(MatchNames, IntersectingPartsNeverImprintOnEachOther) {
   // The error estimate re-bakes with the same matching: it sees no error the matching removed.
   const std::vector<std::uint32_t> texels{64 * 128 + 20, 100 * 128 + 30};
   const std::vector<glm::dvec3> again = bake_texel_values(low, high, nullptr, o, matched, texels, 1);
-  for (std::size_t k = 0; k < texels.size(); ++k)
-    if (matched.coverage[texels[k]])
-      EXPECT_LT(test::angle_deg(again[k], test::decode_rgb(&matched.map.pixels[3 * texels[k]])), 0.5);
+  for (std::size_t k = 0; k < texels.size(); ++k) {
+    if (!matched.coverage[texels[k]]) continue;
+    EXPECT_LT(test::angle_deg(again[k], test::decode_rgb(&matched.map.pixels[3 * texels[k]])), 0.5);
+  }
 }
 
 TEST(MatchNames, AnUnmatchedObjectIsLeftFlat) {
@@ -325,13 +326,14 @@ TEST(MatchNames, NodesOfAssetFormatsAreObjects) {
 constexpr float kBallOffset = 0.6f;
 
 Mesh ball(bool high, float x) {
-  Mesh m = high ? procedural::make_sphere(
-                      64, 32, [](double t, double f) { return procedural::displaced_sphere_radius(0.04, 5, t, f); },
-                      [](double t, double f) { return procedural::displaced_sphere_normal(0.04, 5, t, f); })
-                : procedural::make_sphere(10, 6, [](double, double) { return 1.06; },
-                                          [](double t, double f) {
-                                            return glm::dvec3(std::sin(t) * std::cos(f), std::sin(t) * std::sin(f), std::cos(t));
-                                          });
+  Mesh m =
+      high
+          ? procedural::make_sphere(
+                64, 32, [](double t, double f) { return procedural::displaced_sphere_radius(0.04, 5, t, f); },
+                [](double t, double f) { return procedural::displaced_sphere_normal(0.04, 5, t, f); })
+          : procedural::make_sphere(
+                10, 6, [](double, double) { return 1.06; },
+                [](double t, double f) { return glm::dvec3(std::sin(t) * std::cos(f), std::sin(t) * std::sin(f), std::cos(t)); });
   for (glm::vec3& p : m.positions) p.x += x;
   for (glm::vec2& uv : m.uvs) uv.x = 0.5f * uv.x + (x > 0.0f ? 0.5f : 0.0f);
   return m;
@@ -407,7 +409,8 @@ TEST(MatchNames, IntersectingBallsBakeAsIfAlone) {
     for (std::size_t i = 0; i < alone.coverage.size(); ++i) {
       if (!alone.coverage[i]) continue;
       ++texels;
-      for (int c = 0; c < 3; ++c) over_rounding += std::abs(int(both.map.pixels[3 * i + c]) - int(alone.map.pixels[3 * i + c])) > 1;
+      for (int c = 0; c < 3; ++c)
+        over_rounding += std::abs(int(both.map.pixels[3 * i + c]) - int(alone.map.pixels[3 * i + c])) > 1;
     }
     ASSERT_GT(texels, 3000u);
     EXPECT_EQ(over_rounding, 0u) << (a ? "ball a" : "ball b");

@@ -60,8 +60,8 @@ std::vector<double> low_rows(const Leg& leg, int cap_rows, int rings) {
 
 // Appends one leg as rows of `around` corners between two poles (UVs: the island from uv0 of size
 // uv_size, u around, v along).
-void add_leg(Mesh& m, const Leg& leg, const std::vector<double>& rows, int around, double radial_scale, double bump,
-             int phase, glm::dvec2 uv0, glm::dvec2 uv_size) {
+void add_leg(Mesh& m, const Leg& leg, const std::vector<double>& rows, int around, double radial_scale, double bump, int phase,
+             glm::dvec2 uv0, glm::dvec2 uv_size) {
   const std::uint32_t base = std::uint32_t(m.positions.size()), uv_base = std::uint32_t(m.uvs.size());
   const int R = int(rows.size()) - 1;
   for (int j = 0; j <= R; ++j) {
@@ -115,7 +115,8 @@ ThinParts make_thin_parts(const ThinPartsSpec& spec) {
   std::vector<Leg> legs;
   double x = 0.0, width = 0.0, height = 0.0;
   for (int k = 0; k < spec.legs; ++k) {
-    const double r = spec.legs > 1 ? spec.radius_min + (spec.radius_max - spec.radius_min) * k / (spec.legs - 1) : spec.radius_min;
+    const double r =
+        spec.legs > 1 ? spec.radius_min + (spec.radius_max - spec.radius_min) * k / (spec.legs - 1) : spec.radius_min;
     if (k > 0) x += legs.back().radius + spec.gap + r;
     legs.push_back({glm::dvec3(x, 0, 0), r, spec.length, spec.bend, (k % 2 ? -1.0 : 1.0) * spec.splay});
     width += 2.0 * kPi * r;

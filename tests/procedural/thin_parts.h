@@ -19,12 +19,12 @@ struct ThinPartsSpec {
   std::string name;  // Mesh::source of both meshes; usable in file names
   int legs = 5;
   double radius_min = 0.02, radius_max = 0.04;  // the legs' radii, from the first leg to the last
-  double gap = 0.008;    // between neighbouring high-poly capsules (without bumps) at their roots
-  double length = 0.6;   // of each capsule's straight part (its caps add a radius at either end)
-  double bend = 0.15;    // every leg's tip moves this far along +y (a parabola: the legs stay parallel)
-  double splay = 0.0;    // and this far along x, alternately + and -: neighbours close in and part
-  double bump = 0.08;    // the high-poly's radial bumps, a share of the radius (both signs)
-  double low_scale = 1.06;  // the low-poly's corners lie at this share of the high-poly's radius
+  double gap = 0.008;                           // between neighbouring high-poly capsules (without bumps) at their roots
+  double length = 0.6;                          // of each capsule's straight part (its caps add a radius at either end)
+  double bend = 0.15;                           // every leg's tip moves this far along +y (a parabola: the legs stay parallel)
+  double splay = 0.0;                           // and this far along x, alternately + and -: neighbours close in and part
+  double bump = 0.08;                           // the high-poly's radial bumps, a share of the radius (both signs)
+  double low_scale = 1.06;                      // the low-poly's corners lie at this share of the high-poly's radius
   int sides_low = 6, rings_low = 6, cap_rows_low = 1;  // rings along the straight part, rows per cap
   int around_high = 40, rows_high = 80;
 };
