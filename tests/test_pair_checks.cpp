@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "cli/pair_checks.h"
+#include "core/normals.h"
 #include "core/uv_overlap.h"
 #include "io/mesh_io.h"
 #include "test_support.h"
@@ -31,21 +32,8 @@ Mesh uv_moved(Mesh m, float s, float du, float dv) {
   return m;
 }
 
-// a's triangles followed by b's (the same vertex layout kept: b's indices moved past a's arrays).
-Mesh joined(const Mesh& a, const Mesh& b) {
-  Mesh m = a;
-  const auto np = std::uint32_t(a.positions.size()), nn = std::uint32_t(a.normals.size()), nt = std::uint32_t(a.uvs.size());
-  m.positions.insert(m.positions.end(), b.positions.begin(), b.positions.end());
-  m.normals.insert(m.normals.end(), b.normals.begin(), b.normals.end());
-  m.uvs.insert(m.uvs.end(), b.uvs.begin(), b.uvs.end());
-  for (std::uint32_t i : b.position_index) m.position_index.push_back(i + np);
-  for (std::uint32_t i : b.normal_index) m.normal_index.push_back(i + nn);
-  for (std::uint32_t i : b.uv_index) m.uv_index.push_back(i + nt);
-  m.source_face.clear();
-  m.objects.clear();
-  m.triangle_object.clear();
-  return m;
-}
+// a's triangles followed by b's.
+Mesh joined(const Mesh& a, const Mesh& b) { return merge_meshes({a, b}); }
 
 // UVs repeating k times along u: each triangle's u times k, less the whole tiles of its centroid
 // (a UV per corner).

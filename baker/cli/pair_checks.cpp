@@ -2,22 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 
+#include "cli/format_line.h"
 #include "core/bounds.h"
 #include "pipeline/bake.h"
 
 namespace nmbake {
 
 namespace {
-
-template <typename... Args>
-std::string format(const char* fmt, Args... args) {
-  char buf[1024];
-  std::snprintf(buf, sizeof buf, fmt, args...);
-  return buf;
-}
 
 Box box_of(const Mesh& m, int threads) {
   const double inf = std::numeric_limits<double>::infinity();
@@ -28,7 +21,7 @@ Box box_of(const Mesh& m, int threads) {
 }
 
 std::string box_text(const Box& b) {
-  return format("(%.4g, %.4g, %.4g) to (%.4g, %.4g, %.4g)", b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);
+  return format_line("(%.4g, %.4g, %.4g) to (%.4g, %.4g, %.4g)", b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);
 }
 
 // The unit mix-up a size ratio looks like, or "" when none is within 10%.
@@ -40,7 +33,7 @@ std::string unit_hint(double ratio) {
                {30.48, "centimetres against feet"},     {39.37, "inches against metres"},    {100, "centimetres against metres"},
                {304.8, "millimetres against feet"},     {1000, "millimetres against metres"}};
   for (const auto& k : known)
-    if (std::abs(ratio / k.factor - 1.0) < 0.1) return format("different units (%s)?", k.units);
+    if (std::abs(ratio / k.factor - 1.0) < 0.1) return format_line("different units (%s)?", k.units);
   return "different units, or a scale applied to one on export?";
 }
 
@@ -80,24 +73,24 @@ std::string mismatch_text(const PairBoxes& b, const std::string& low_path, const
   if (b.mismatch == PairBoxes::Mismatch::none) return "";
   const std::string low = low_path + " (LOW)", high = high_path + " (HIGH)";
   const bool high_larger = b.high.diagonal() >= b.low.diagonal();
-  const std::string sizes = format("%s is %.3g times the size of %s", (high_larger ? high : low).c_str(), b.size_ratio,
-                                   (high_larger ? low : high).c_str());
+  const std::string sizes = format_line("%s is %.3g times the size of %s", (high_larger ? high : low).c_str(), b.size_ratio,
+                                        (high_larger ? low : high).c_str());
   const std::string boxes = "LOW's box is " + box_text(b.low) + ", HIGH's " + box_text(b.high);
   const std::string tail = allowed ? " (baked anyway: --allow-mismatch)" : " (--allow-mismatch bakes anyway)";
   if (b.mismatch == PairBoxes::Mismatch::apart)
-    return format(
+    return format_line(
         "%s and %s do not lie in one place (they share %.0f%% of the smaller extent along one axis): %s%s; most "
         "rays would miss. Was one moved, or exported with another transform or up axis?%s",
         low.c_str(), high.c_str(), 100.0 * b.overlap, boxes.c_str(), b.size_ratio < kSizeRatio ? "" : (", and " + sizes).c_str(),
         tail.c_str());
-  return format("%s: %s; %s Scale one to match the other%s", sizes.c_str(), boxes.c_str(), unit_hint(b.size_ratio).c_str(),
-                tail.c_str());
+  return format_line("%s: %s; %s Scale one to match the other%s", sizes.c_str(), boxes.c_str(), unit_hint(b.size_ratio).c_str(),
+                     tail.c_str());
 }
 
 std::optional<std::string> swap_warning(std::size_t low_triangles, std::size_t high_triangles, bool high_has_uvs,
                                         const std::string& low_path, const std::string& high_path) {
   if (!high_has_uvs || !(double(low_triangles) > kSwapRatio * double(high_triangles))) return std::nullopt;
-  return format(
+  return format_line(
       "warning: %s (LOW) has %s triangles and %s (HIGH) %s: the low-poly has %.3g times as many. Were LOW and HIGH "
       "given the wrong way round? (nmbake LOW HIGH -o MAP: the low-poly with UVs first)",
       low_path.c_str(), grouped(low_triangles).c_str(), high_path.c_str(), grouped(high_triangles).c_str(),
@@ -115,11 +108,11 @@ bool overlap_refused(const UvOverlap& o) { return o.stacked_share() > kStackedSh
 std::string overlap_text(const UvOverlap& o, std::uint64_t samples, const std::string& low_path, bool allowed) {
   if (!o.overlapped) return "";
   if (!overlap_refused(o))
-    return format(
+    return format_line(
         "%s: UV islands overlap (%llu samples covered twice; the lower face number wins): %.1f%% of the covered "
         "texels lie under more than one triangle (%.2f layers on average)",
         low_path.c_str(), (unsigned long long)samples, 100.0 * o.overlapped_share(), o.mean_layers());
-  return format(
+  return format_line(
       "%s (LOW): its UVs lie %.3g layers deep on average: %.1f%% of the covered texels lie under three or more "
       "triangles (UVs for a tiling texture, or every face mapped onto the whole square?), and the map would be "
       "pieces of all of them%s",

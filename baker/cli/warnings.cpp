@@ -3,31 +3,22 @@
 #include <cstdio>
 #include <string>
 
+#include "cli/format_line.h"
+
 namespace nmbake {
-
-namespace {
-
-template <typename... Args>
-std::string format(const char* fmt, Args... args) {
-  char buf[512];
-  std::snprintf(buf, sizeof buf, fmt, args...);
-  return buf;
-}
-
-}  // namespace
 
 std::vector<std::string> load_warnings(const MeshLoadInfo& info, const std::string& path) {
   std::vector<std::string> out;
   const char* lost = "all the file's normals were dropped and smooth normals computed (hard edges lost)";
   if (info.normals_dropped && info.faces_without_normals)
-    out.push_back(format("warning: %s: %zu of %zu faces %s no normals: %s", path.c_str(), info.faces_without_normals,
-                         info.file_faces, info.faces_without_normals == 1 ? "has" : "have", lost));
+    out.push_back(format_line("warning: %s: %zu of %zu faces %s no normals: %s", path.c_str(), info.faces_without_normals,
+                              info.file_faces, info.faces_without_normals == 1 ? "has" : "have", lost));
   else if (info.normals_dropped)
-    out.push_back(format("warning: %s: %zu %s length 0: %s", path.c_str(), info.zero_normals,
-                         info.zero_normals == 1 ? "normal has" : "normals have", lost));
+    out.push_back(format_line("warning: %s: %zu %s length 0: %s", path.c_str(), info.zero_normals,
+                              info.zero_normals == 1 ? "normal has" : "normals have", lost));
   if (info.uvs_dropped)
-    out.push_back(format("warning: %s: %zu of %zu faces %s no UVs: all the file's UVs were dropped", path.c_str(),
-                         info.faces_without_uvs, info.file_faces, info.faces_without_uvs == 1 ? "has" : "have"));
+    out.push_back(format_line("warning: %s: %zu of %zu faces %s no UVs: all the file's UVs were dropped", path.c_str(),
+                              info.faces_without_uvs, info.file_faces, info.faces_without_uvs == 1 ? "has" : "have"));
   return out;
 }
 
@@ -50,69 +41,70 @@ std::vector<std::string> bake_warnings(const BakeStats& s, const MeshTopology& t
                                        const UvTilesNote& uv_tiles, const PairNote& pair) {
   std::vector<std::string> out;
   if (s.degenerate_uv_triangles)
-    out.push_back(format("warning: %s: %zu triangles have zero UV area (they cover no texels and give no tangent)", low.c_str(),
-                         s.degenerate_uv_triangles));
+    out.push_back(format_line("warning: %s: %zu triangles have zero UV area (they cover no texels and give no tangent)",
+                              low.c_str(), s.degenerate_uv_triangles));
   if (s.degenerate_3d_triangles)
-    out.push_back(format("warning: %s: %zu triangles have zero area (their texels take the normal found from a point or a line)",
-                         low.c_str(), s.degenerate_3d_triangles));
+    out.push_back(
+        format_line("warning: %s: %zu triangles have zero area (their texels take the normal found from a point or a line)",
+                    low.c_str(), s.degenerate_3d_triangles));
   if (uv_tiles.udim) {  // udim.h: uv_outside_* count the triangles cut at their tile's edge and those in no tile
     if (s.uv_outside_triangles)
       out.push_back(
-          format("warning: %s: %zu triangles reach beyond their UDIM tile (by their UV centroid) and are cut at its edge",
-                 low.c_str(), s.uv_outside_triangles));
+          format_line("warning: %s: %zu triangles reach beyond their UDIM tile (by their UV centroid) and are cut at its edge",
+                      low.c_str(), s.uv_outside_triangles));
     if (s.uv_outside_entirely_triangles)
-      out.push_back(format("warning: %s: %zu triangles lie in no UDIM tile (u below 0 or from 10 on, v below 0): not baked",
-                           low.c_str(), s.uv_outside_entirely_triangles));
+      out.push_back(format_line("warning: %s: %zu triangles lie in no UDIM tile (u below 0 or from 10 on, v below 0): not baked",
+                                low.c_str(), s.uv_outside_entirely_triangles));
   } else if (s.uv_outside_triangles) {
     std::string tiles;
     if (uv_tiles.beyond_triangles)
-      tiles = format(
+      tiles = format_line(
           "; %zu triangles (%zu texels) lie in UDIM tiles %s: -o with <UDIM> (normal.<UDIM>.png) bakes them, one "
           "map per tile",
           uv_tiles.beyond_triangles, uv_tiles.beyond_texels, uv_tiles.beyond_tiles.c_str());
     out.push_back(
-        format("warning: %s: %zu triangles have UVs outside [0,1] (%zu entirely outside, not baked); only the part inside "
-               "the map is baked, UVs are not wrapped%s",
-               low.c_str(), s.uv_outside_triangles, s.uv_outside_entirely_triangles, tiles.c_str()));
+        format_line("warning: %s: %zu triangles have UVs outside [0,1] (%zu entirely outside, not baked); only the part inside "
+                    "the map is baked, UVs are not wrapped%s",
+                    low.c_str(), s.uv_outside_triangles, s.uv_outside_entirely_triangles, tiles.c_str()));
   }
   if (pair.overlap && pair.overlap->overlapped)
     out.push_back("warning: " + overlap_text(*pair.overlap, s.overlapping_samples, low, true));
   else if (s.overlapping_samples)  // too little to show on the overlap check's grid
-    out.push_back(format("warning: %s: UV islands overlap slightly (%llu samples covered twice; the lower face number wins)",
-                         low.c_str(), (unsigned long long)s.overlapping_samples));
+    out.push_back(format_line("warning: %s: UV islands overlap slightly (%llu samples covered twice; the lower face number wins)",
+                              low.c_str(), (unsigned long long)s.overlapping_samples));
   if (s.samples_covered && double(s.misses) > kMissShareWarn * double(s.samples_covered))
-    out.push_back(format("warning: %.1f%% of samples missed %s and were written flat; %s",
-                         100.0 * double(s.misses) / double(s.samples_covered), high.c_str(),
-                         pair.boxes_mismatch ? "LOW and HIGH do not lie in one place or differ in size (above)"
-                                             : "check --front/--rear (or --cage)"));
+    out.push_back(format_line("warning: %.1f%% of samples missed %s and were written flat; %s",
+                              100.0 * double(s.misses) / double(s.samples_covered), high.c_str(),
+                              pair.boxes_mismatch ? "LOW and HIGH do not lie in one place or differ in size (above)"
+                                                  : "check --front/--rear (or --cage)"));
   if (s.texels_covered && double(s.texels_facing_away) > kFacingAwayShareWarn * double(s.texels_covered))
     out.push_back(
-        format("warning: %.1f%% of covered texels point into the low-poly: are the normals or the winding of %s inverted?",
-               100.0 * double(s.texels_facing_away) / double(s.texels_covered), high.c_str()));
+        format_line("warning: %.1f%% of covered texels point into the low-poly: are the normals or the winding of %s inverted?",
+                    100.0 * double(s.texels_facing_away) / double(s.texels_covered), high.c_str()));
   if (s.high_facing == BakeStats::HighFacing::inverted)
-    out.push_back(
-        format("warning: %s: its faces look inverted (%.0f%% of the surfaces nearest the low-poly face into it): their fronts "
-               "were taken the other way round%s%s",
-               high.c_str(), 100.0 * s.backface_probe_share,
-               s.high_normals_computed ? " and the computed normals turned outwards"
-                                       : "; the file's normals are kept, so the map points into the surface",
-               pair.boxes_mismatch ? " (judged from the few probes that met it: LOW and HIGH do not match, above)" : ""));
+    out.push_back(format_line(
+        "warning: %s: its faces look inverted (%.0f%% of the surfaces nearest the low-poly face into it): their fronts "
+        "were taken the other way round%s%s",
+        high.c_str(), 100.0 * s.backface_probe_share,
+        s.high_normals_computed ? " and the computed normals turned outwards"
+                                : "; the file's normals are kept, so the map points into the surface",
+        pair.boxes_mismatch ? " (judged from the few probes that met it: LOW and HIGH do not match, above)" : ""));
   else if (s.high_facing == BakeStats::HighFacing::mixed)
     out.push_back(
-        format("warning: %s: some of its parts look inverted (%.0f%% of the surfaces nearest the low-poly face into it): "
-               "back faces are kept for this bake, as with --keep-backfaces",
-               high.c_str(), 100.0 * s.backface_probe_share));
+        format_line("warning: %s: some of its parts look inverted (%.0f%% of the surfaces nearest the low-poly face into it): "
+                    "back faces are kept for this bake, as with --keep-backfaces",
+                    high.c_str(), 100.0 * s.backface_probe_share));
   if (s.suspect_share > kSuspectShareWarn)
     out.push_back(
-        format("warning: %.2f%% of covered texels are suspect (normal tilted over %.0f degrees from the low-poly's, or "
-               "samples disagreeing), %.0f%% of them in UV u %.3g-%.3g, v %.3g-%.3g; see --suspect-mask",
-               100.0 * s.suspect_share, kSuspectTiltDeg, 100.0 * s.suspect_region_share, s.suspect_region[0], s.suspect_region[2],
-               s.suspect_region[1], s.suspect_region[3]));
+        format_line("warning: %.2f%% of covered texels are suspect (normal tilted over %.0f degrees from the low-poly's, or "
+                    "samples disagreeing), %.0f%% of them in UV u %.3g-%.3g, v %.3g-%.3g; see --suspect-mask",
+                    100.0 * s.suspect_share, kSuspectTiltDeg, 100.0 * s.suspect_region_share, s.suspect_region[0],
+                    s.suspect_region[2], s.suspect_region[1], s.suspect_region[3]));
   if (s.coordinate_spacing > kCoordinateSpacingWarn)
     out.push_back(
-        format("warning: coordinates reach %.3g, far from the origin for a scene this size: float precision there is "
-               "%.2g of the scene diagonal (above %.0e the map degrades measurably); move the meshes near the origin",
-               s.largest_coordinate, s.coordinate_spacing, kCoordinateSpacingWarn));
+        format_line("warning: coordinates reach %.3g, far from the origin for a scene this size: float precision there is "
+                    "%.2g of the scene diagonal (above %.0e the map degrades measurably); move the meshes near the origin",
+                    s.largest_coordinate, s.coordinate_spacing, kCoordinateSpacingWarn));
   std::string topo;
   auto add = [&](std::size_t n, const char* what) {
     if (!n) return;
