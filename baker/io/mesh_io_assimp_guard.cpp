@@ -1,0 +1,285 @@
+#include "io/mesh_io_assimp_guard.h"
+
+#include <pthread.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cstdint>
+#include <cstring>
+#include <exception>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace nmbake::mesh_io_detail {
+namespace {
+
+std::uint32_t u32(std::string_view bytes, std::size_t at) {
+  std::uint32_t v = 0;
+  std::memcpy(&v, bytes.data() + at, 4);  // little-endian hosts only, as the binary readers
+  return v;
+}
+
+std::uint64_t u64(std::string_view bytes, std::size_t at) {
+  std::uint64_t v = 0;
+  std::memcpy(&v, bytes.data() + at, 8);
+  return v;
+}
+
+std::string too_deep(std::size_t at) {
+  return "nested more than " + std::to_string(kMaxNesting) + " deep (at byte " + std::to_string(at) + ")";
+}
+
+// From `at` (just after an opening quote) to just after the closing one; backslash escapes.
+std::size_t skip_string(std::string_view t, std::size_t at) {
+  for (; at < t.size(); ++at) {
+    if (t[at] == '\\') ++at;
+    else if (t[at] == '"') return at + 1;
+  }
+  return at;
+}
+
+std::string json_or_brace_nesting(std::string_view t, bool json) {
+  std::size_t depth = 0;
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    const char c = t[i];
+    if (c == '"') {
+      i = skip_string(t, i + 1) - 1;
+    } else if (c == '{' || (json && c == '[')) {
+      if (++depth > kMaxNesting) return too_deep(i);
+    } else if ((c == '}' || (json && c == ']')) && depth > 0) {
+      --depth;
+    }
+  }
+  return "";
+}
+
+std::string xml_nesting(std::string_view t) {
+  std::size_t depth = 0;
+  for (std::size_t i = t.find('<'); i != std::string_view::npos; i = t.find('<', i + 1)) {
+    const char next = i + 1 < t.size() ? t[i + 1] : '\0';
+    std::string_view end = ">";
+    if (t.substr(i, 4) == "<!--") end = "-->";
+    else if (t.substr(i, 9) == "<![CDATA[") end = "]]>";
+    const std::size_t close = t.find(end, i + 1);
+    if (close == std::string_view::npos) return "";
+    if (next == '/') {
+      if (depth > 0) --depth;
+    } else if (next != '?' && next != '!' && t[close - 1] != '/') {
+      if (++depth > kMaxNesting) return too_deep(i);
+    }
+    i = close;
+  }
+  return "";
+}
+
+// Nodes and the nodes each holds or instantiates, as a file gives them.
+struct NodeGraph {
+  std::vector<std::vector<std::size_t>> children;
+  std::vector<std::string> names;  // for messages
+};
+
+// A node in a cycle, nested more than kMaxNesting deep, or standing for more than kMaxNodeCopies
+// nodes once every mention is a copy (as Assimp makes them: a chain of doubled children grows as
+// 2^n); "" when none. Iterative depth first, every node once.
+std::string node_graph_problem(const NodeGraph& g) {
+  constexpr std::uint64_t kMaxNodeCopies = 1u << 20;
+  const std::size_t n = g.children.size();
+  auto name = [&](std::size_t i) { return "node " + g.names[i].substr(0, 64); };
+  std::vector<char> state(n, 0);  // 1 on the path, 2 done
+  std::vector<std::uint64_t> copies(n, 1);
+  std::vector<std::pair<std::size_t, std::size_t>> path;  // (node, next child)
+  for (std::size_t root = 0; root < n; ++root) {
+    if (state[root]) continue;
+    path.push_back({root, 0});
+    state[root] = 1;
+    while (!path.empty()) {
+      auto& [node, next] = path.back();
+      if (next == g.children[node].size()) {
+        state[node] = 2;
+        for (std::size_t c : g.children[node]) copies[node] = std::min(copies[node] + copies[c], kMaxNodeCopies + 1);
+        if (copies[node] > kMaxNodeCopies) return name(node) + " stands for more than " + std::to_string(kMaxNodeCopies) + " copies of nodes";
+        path.pop_back();
+        continue;
+      }
+      const std::size_t child = g.children[node][next++];
+      if (state[child] == 1) return name(child) + " is its own ancestor (a cycle)";
+      if (state[child] == 2) continue;
+      if (path.size() >= kMaxNesting) return name(child) + " is nested more than " + std::to_string(kMaxNesting) + " deep";
+      state[child] = 1;
+      path.push_back({child, 0});
+    }
+  }
+  return "";
+}
+
+}  // namespace
+
+std::string glb_problem(std::string_view bytes, std::string_view& json) {
+  if (bytes.size() < 12 || bytes.substr(0, 4) != "glTF") return "GLB header shorter than 12 bytes";
+  const std::uint32_t version = u32(bytes, 4), length = u32(bytes, 8);
+  const std::string claims = "the GLB header claims ";
+  if (version != 1 && version != 2) return "GLB version " + std::to_string(version) + " (1 or 2 expected)";
+  if (length > bytes.size() || length < 12)
+    return claims + std::to_string(length) + " bytes, the file has " + std::to_string(bytes.size());
+  if (version == 1) {
+    if (length < 20) return claims + std::to_string(length) + " bytes: no room for the content header";
+    const std::uint32_t content = u32(bytes, 12);
+    if (content > length - 20) return "its content length " + std::to_string(content) + " runs past the file's " + std::to_string(length);
+    json = bytes.substr(20, content);
+    return "";
+  }
+  for (std::size_t at = 12, k = 0; at < length; ++k) {
+    if (length - at < 8) return "GLB chunk " + std::to_string(k) + " at byte " + std::to_string(at) + " is cut short";
+    const std::uint32_t chunk = u32(bytes, at);
+    if (chunk > length - at - 8)
+      return "GLB chunk " + std::to_string(k) + " claims " + std::to_string(chunk) + " bytes, " +
+             std::to_string(length - at - 8) + " are left";
+    if (k == 0) json = bytes.substr(at + 8, chunk);
+    at += 8 + std::size_t(chunk);
+  }
+  return "";
+}
+
+std::string nesting_problem(std::string_view bytes, bool json) {
+  if (std::memchr(bytes.data(), '\0', std::min<std::size_t>(bytes.size(), 4096))) return "";
+  std::size_t first = bytes.substr(0, 3) == "\xEF\xBB\xBF" ? 3 : 0;
+  while (first < bytes.size() && std::strchr(" \t\r\n", bytes[first]) && bytes[first]) ++first;
+  if (!json && first < bytes.size() && bytes[first] == '<') return xml_nesting(bytes);
+  return json_or_brace_nesting(bytes, json);
+}
+
+std::string gltf_nodes_problem(std::string_view json) {
+  const nlohmann::json doc = nlohmann::json::parse(json.begin(), json.end(), nullptr, false);
+  if (doc.is_discarded() || !doc.is_object() || !doc.contains("nodes") || !doc["nodes"].is_array()) return "";
+  const nlohmann::json& nodes = doc["nodes"];
+  NodeGraph graph;
+  graph.children.resize(nodes.size());
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    const nlohmann::json& node = nodes[i];
+    const auto name = node.is_object() ? node.find("name") : node.end();
+    graph.names.push_back(std::to_string(i) + (name != node.end() && name->is_string() ? " '" + name->get<std::string>() + "'" : ""));
+    if (!node.is_object() || !node.contains("children") || !node["children"].is_array()) continue;
+    for (const nlohmann::json& c : node["children"])
+      if (c.is_number_unsigned() && c.get<std::uint64_t>() < nodes.size()) graph.children[i].push_back(c.get<std::size_t>());
+  }
+  return node_graph_problem(graph);
+}
+
+std::string collada_nodes_problem(std::string_view xml) {
+  NodeGraph graph;
+  std::unordered_map<std::string, std::size_t> by_id;
+  std::vector<std::pair<std::size_t, std::string>> instances;  // (node, id it instantiates)
+  std::vector<std::size_t> open;
+  auto attribute = [](std::string_view tag, std::string_view name) {
+    for (std::size_t at = tag.find(name); at != std::string_view::npos; at = tag.find(name, at + 1)) {
+      const std::size_t quote = at + name.size() + 1;
+      if (at == 0 || !std::isspace(static_cast<unsigned char>(tag[at - 1])) || quote >= tag.size() || tag[quote - 1] != '=' ||
+          (tag[quote] != '"' && tag[quote] != '\''))
+        continue;
+      const std::size_t end = tag.find(tag[quote], quote + 1);
+      return std::string(tag.substr(quote + 1, end == std::string_view::npos ? std::string_view::npos : end - quote - 1));
+    }
+    return std::string();
+  };
+  for (std::size_t at = xml.find('<'); at != std::string_view::npos; at = xml.find('<', at + 1)) {
+    const std::size_t close = xml.find('>', at);
+    if (close == std::string_view::npos) break;
+    const std::string_view tag = xml.substr(at, close - at + 1);
+    const bool empty = tag.size() > 1 && tag[tag.size() - 2] == '/';
+    if (tag.substr(0, 7) == "</node>" || tag.substr(0, 7) == "</node ") {
+      if (!open.empty()) open.pop_back();
+    } else if (tag.substr(0, 6) == "<node " || tag.substr(0, 6) == "<node>" || tag.substr(0, 6) == "<node/") {
+      const std::size_t k = graph.children.size();
+      graph.children.emplace_back();
+      const std::string id = attribute(tag, "id");
+      graph.names.push_back("'" + id + "'");
+      if (!id.empty()) by_id.emplace(id, k);
+      if (!open.empty()) graph.children[open.back()].push_back(k);
+      if (!empty) open.push_back(k);
+    } else if (tag.substr(0, 15) == "<instance_node " && !open.empty()) {
+      const std::string url = attribute(tag, "url");
+      if (!url.empty() && url[0] == '#') instances.push_back({open.back(), url.substr(1)});
+    }
+  }
+  for (const auto& [node, id] : instances)
+    if (const auto it = by_id.find(id); it != by_id.end()) graph.children[node].push_back(it->second);
+  return node_graph_problem(graph);
+}
+
+std::string fbx_records_problem(std::string_view bytes) {
+  if (bytes.size() < 27 || bytes.substr(0, 18) != "Kaydara FBX Binary") return "";
+  const bool wide = u32(bytes, 23) >= 7500;  // 64-bit record offsets from FBX 7.5
+  const std::size_t header = wide ? 25 : 13;
+  std::vector<std::uint64_t> ends;  // of the records the walk is inside
+  std::size_t at = 27;
+  while (at + header <= bytes.size()) {
+    while (!ends.empty() && at >= ends.back()) ends.pop_back();
+    const std::uint64_t end = wide ? u64(bytes, at) : u32(bytes, at);
+    const std::uint64_t properties = wide ? u64(bytes, at + 16) : u32(bytes, at + 8);
+    const std::uint64_t body = at + header + std::uint8_t(bytes[at + header - 1]) + properties;
+    if (end == 0) {  // the null record closing a list of children
+      if (ends.empty()) return "";
+      at = std::size_t(ends.back());
+      ends.pop_back();
+      continue;
+    }
+    if (end <= at || end > bytes.size() || body > end || (!ends.empty() && end > ends.back())) return "";  // for Assimp
+    if (ends.size() >= kMaxNesting) return "FBX records " + too_deep(at);
+    if (body < end) ends.push_back(end);
+    at = std::size_t(body < end ? body : end);
+  }
+  return "";
+}
+
+std::string one_line(std::string_view text, std::size_t max) {
+  std::string out;
+  for (char c : text) {
+    const bool blank = c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v';
+    if (blank) {
+      if (!out.empty() && out.back() != ' ') out += ' ';
+    } else {
+      out += static_cast<unsigned char>(c) < 32 || c == 127 ? '?' : c;
+    }
+  }
+  while (!out.empty() && out.back() == ' ') out.pop_back();
+  if (out.size() > max) {
+    out.resize(max - 3);
+    while (!out.empty() && out.back() == ' ') out.pop_back();
+    out += "...";
+  }
+  return out;
+}
+
+std::size_t reader_stack_bytes(std::size_t size) {
+  const std::size_t mib = std::size_t(1) << 20;
+  return std::clamp<std::size_t>(size > (std::size_t(4096) * mib) / 256 ? 4096 * mib : size * 256, 256 * mib, 4096 * mib);
+}
+
+void run_on_big_stack(std::size_t stack_bytes, const std::function<void()>& read) {
+  struct Call {
+    const std::function<void()>* read;
+    std::exception_ptr error;
+  } call{&read, nullptr};
+  auto body = [](void* p) -> void* {
+    auto* c = static_cast<Call*>(p);
+    try {
+      (*c->read)();
+    } catch (...) {
+      c->error = std::current_exception();
+    }
+    return nullptr;
+  };
+  pthread_attr_t attr;
+  pthread_t thread;
+  if (pthread_attr_init(&attr) != 0) return read();
+  const bool started = pthread_attr_setstacksize(&attr, stack_bytes) == 0 && pthread_create(&thread, &attr, body, &call) == 0;
+  pthread_attr_destroy(&attr);
+  if (!started) return read();
+  pthread_join(thread, nullptr);
+  if (call.error) std::rethrow_exception(call.error);
+}
+
+}  // namespace nmbake::mesh_io_detail
