@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -120,10 +122,53 @@ TEST(AssimpGuard, ColladaNodeTrees) {
   EXPECT_EQ(collada_nodes_problem("<COLLADA><node id=\"a\"><instance_node url=\"#nowhere\"/></node></COLLADA>"), "");
 }
 
+// A binary FBX 7.4 of top-level records (NAME, properties already encoded) without children.
+std::string fbx_flat(const std::vector<std::pair<std::string, std::string>>& records) {
+  std::string out = std::string("Kaydara FBX Binary  \0\x1a\0", 23) + le32(7400);
+  for (const auto& [name, properties] : records) {
+    const std::size_t end = out.size() + 13 + name.size() + properties.size();
+    out += le32(std::uint32_t(end)) + le32(1) + le32(std::uint32_t(properties.size())) + char(name.size()) + name + properties;
+  }
+  return out + std::string(13, '\0');
+}
+
+std::string fbx_id(std::uint64_t id) { return "L" + std::string(reinterpret_cast<const char*>(&id), 8); }
+std::string fbx_text(const std::string& s) { return "S" + le32(std::uint32_t(s.size())) + s; }
+
+// A text FBX whose models 1000.. are connected child to parent by `links` (child, parent).
+std::string fbx_text_file(std::size_t models, const std::vector<std::pair<std::size_t, std::size_t>>& links) {
+  std::string s = "; FBX 7.4.0 project file\nObjects:  {\n";
+  for (std::size_t i = 0; i < models; ++i)
+    s += "\tModel: " + std::to_string(1000 + i) + ", \"Model::m" + std::to_string(i) + "\", \"Null\" {\n\t}\n";
+  s += "}\nConnections:  {\n\tC: \"OO\",1000,0\n";
+  for (const auto& [child, parent] : links) s += "\tC: \"OO\"," + std::to_string(1000 + child) + "," + std::to_string(1000 + parent) + "\n";
+  return s + "}\n";
+}
+
+TEST(AssimpGuard, FbxModelTrees) {
+  // Text: a cycle of two models made Assimp recurse until the stack ran out.
+  EXPECT_EQ(fbx_problem(fbx_text_file(2, {{1, 0}, {0, 1}})), "node '1000' is its own ancestor (a cycle)");
+  std::vector<std::pair<std::size_t, std::size_t>> chain;
+  for (std::size_t i = 1; i < 1001; ++i) chain.push_back({i, i - 1});
+  EXPECT_EQ(fbx_problem(fbx_text_file(1001, chain)), "node '2000' is nested more than 1000 deep");
+  chain.pop_back();
+  EXPECT_EQ(fbx_problem(fbx_text_file(1000, chain)), "");
+  // FBX 6 text names models and connects them by name.
+  EXPECT_EQ(fbx_problem("Model: \"Model::a\", \"Mesh\" {\n}\nModel: \"Model::b\", \"Mesh\" {\n}\n"
+                        "Connect: \"OO\", \"Model::a\", \"Model::b\"\nConnect: \"OO\", \"Model::b\", \"Model::a\"\n"),
+            "node 'Model::a' is its own ancestor (a cycle)");
+  // Binary: Model records with their ids, C records with "OO", child, parent.
+  const std::string a = fbx_id(7), b = fbx_id(8);
+  const std::pair<std::string, std::string> model_a{"Model", a + fbx_text("a")}, model_b{"Model", b + fbx_text("b")};
+  EXPECT_EQ(fbx_problem(fbx_flat({model_a, model_b, {"C", fbx_text("OO") + b + a}})), "");
+  EXPECT_EQ(fbx_problem(fbx_flat({model_a, model_b, {"C", fbx_text("OO") + b + a}, {"C", fbx_text("OO") + a + b}})),
+            "node '7' is its own ancestor (a cycle)");
+}
+
 TEST(AssimpGuard, FbxRecordsNestedTooDeep) {
-  EXPECT_EQ(fbx_records_problem(fbx_nested(1000)), "");
-  EXPECT_EQ(fbx_records_problem(fbx_nested(1001)), "FBX records nested more than 1000 deep (at byte 14027)");
-  EXPECT_EQ(fbx_records_problem("; FBX 7.4.0 project file"), "");
+  EXPECT_EQ(fbx_problem(fbx_nested(1000)), "");
+  EXPECT_EQ(fbx_problem(fbx_nested(1001)), "FBX records nested more than 1000 deep (at byte 14027)");
+  EXPECT_EQ(fbx_problem("; FBX 7.4.0 project file"), "");
 }
 
 TEST(AssimpGuard, LibraryTextIsOneShortLine) {
@@ -174,6 +219,10 @@ TEST(AssimpGuard, HostileFilesAreRefused) {
   expect_refused(dir + "/deep_text.fbx", "malformed: nested more than 1000 deep");
   test::write_file(dir + "/deep_binary.fbx", fbx_nested(100000));
   expect_refused(dir + "/deep_binary.fbx", "malformed: FBX records nested more than 1000 deep");
+  test::write_file(dir + "/cycle.fbx", fbx_text_file(2, {{1, 0}, {0, 1}}));
+  expect_refused(dir + "/cycle.fbx", "malformed: node '1000' is its own ancestor (a cycle)");
+  test::write_file(dir + "/cycle.fbx", fbx_text_file(2, {{1, 0}, {0, 1}}));
+  expect_refused(dir + "/cycle.fbx", "malformed: node '1000' is its own ancestor (a cycle)");
   const std::string liar = le32(0xF0000000u) + "JSON" + R"({"asset":{"version":"2.0"}} )";
   test::write_file(dir + "/liar.glb", glb(2, std::uint32_t(12 + liar.size()), liar));
   expect_refused(dir + "/liar.glb", "malformed: GLB chunk 0 claims 4026531840 bytes");

@@ -260,7 +260,7 @@ std::string shape_problem(const std::string& ext, std::string_view bytes) {
     std::string problem = nesting_problem(json, true);
     return problem.empty() ? gltf_nodes_problem(json) : problem;
   }
-  std::string problem = ext == "dae" ? collada_array_problem(bytes) : fbx_records_problem(bytes);
+  std::string problem = ext == "dae" ? collada_array_problem(bytes) : ext == "fbx" ? fbx_problem(bytes) : "";
   if (problem.empty()) problem = nesting_problem(bytes, false);
   return problem.empty() && ext == "dae" ? collada_nodes_problem(bytes) : problem;
 }

@@ -115,6 +115,83 @@ std::string node_graph_problem(const NodeGraph& g) {
   return "";
 }
 
+// The models of an FBX file (by id, or by name in FBX 6) and their "OO" connections.
+struct FbxModels {
+  std::vector<std::string> ids;
+  std::vector<std::pair<std::string, std::string>> parent_child;
+};
+
+std::string fbx_models_problem(const FbxModels& models) {
+  NodeGraph graph;
+  std::unordered_map<std::string, std::size_t> index;
+  for (const std::string& id : models.ids)
+    if (index.emplace(id, graph.children.size()).second) {
+      graph.children.emplace_back();
+      graph.names.push_back("'" + id + "'");
+    }
+  for (const auto& [parent, child] : models.parent_child) {
+    const auto p = index.find(parent), c = index.find(child);
+    if (p != index.end() && c != index.end()) graph.children[p->second].push_back(c->second);
+  }
+  return node_graph_problem(graph);
+}
+
+// The first `n` properties of a binary record that are ids (L) or text (S), as text.
+std::vector<std::string> fbx_ids(std::string_view p, std::size_t n) {
+  std::vector<std::string> out;
+  for (std::size_t at = 0; out.size() < n && at < p.size();) {
+    const char type = p[at++];
+    if (type == 'L' && p.size() - at >= 8) {
+      out.push_back(std::to_string(static_cast<long long>(u64(p, at))));
+      at += 8;
+    } else if (type == 'S' && p.size() - at >= 4 && u32(p, at) <= p.size() - at - 4) {
+      out.emplace_back(p.substr(at + 4, u32(p, at)));
+      at += 4 + std::size_t(u32(p, at));
+    } else {
+      break;
+    }
+  }
+  return out;
+}
+
+void fbx_connection(const std::vector<std::string>& v, FbxModels& models) {
+  if (v.size() == 3 && v[0] == "OO") models.parent_child.push_back({v[2], v[1]});
+}
+
+void fbx_record(std::string_view name, std::string_view properties, FbxModels& models) {
+  if (name == "Model")
+    if (const auto ids = fbx_ids(properties, 1); !ids.empty()) models.ids.push_back(ids[0]);
+  if (name == "C" || name == "Connect") fbx_connection(fbx_ids(properties, 3), models);
+}
+
+// Text FBX: "Model: 1000, "Model::a", "Mesh" {" and "C: "OO",1001,1000" (FBX 6: names, "Connect:").
+void fbx_text_models(std::string_view t, FbxModels& models) {
+  auto fields = [](std::string_view rest) {
+    std::vector<std::string> out;
+    for (std::size_t at = 0; at <= rest.size() && out.size() < 3;) {
+      std::size_t end = std::min(rest.find_first_of(",{", at), rest.size());
+      std::string_view f = rest.substr(at, end - at);
+      while (!f.empty() && std::strchr(" \t\r\"", f.front())) f.remove_prefix(1);
+      while (!f.empty() && std::strchr(" \t\r\"", f.back())) f.remove_suffix(1);
+      out.emplace_back(f);
+      if (end == rest.size() || rest[end] == '{') break;
+      at = end + 1;
+    }
+    return out;
+  };
+  for (std::size_t at = 0; at < t.size();) {
+    std::size_t end = std::min(t.find('\n', at), t.size());
+    std::string_view line = t.substr(at, end - at);
+    at = end + 1;
+    while (!line.empty() && (line.front() == ' ' || line.front() == '\t')) line.remove_prefix(1);
+    if (line.substr(0, 6) == "Model:") {
+      if (const auto f = fields(line.substr(6)); !f.empty()) models.ids.push_back(f[0]);
+    } else if (line.substr(0, 2) == "C:" || line.substr(0, 8) == "Connect:") {
+      fbx_connection(fields(line.substr(line[1] == ':' ? 2 : 8)), models);
+    }
+  }
+}
+
 }  // namespace
 
 std::string glb_problem(std::string_view bytes, std::string_view& json) {
@@ -209,8 +286,12 @@ std::string collada_nodes_problem(std::string_view xml) {
   return node_graph_problem(graph);
 }
 
-std::string fbx_records_problem(std::string_view bytes) {
-  if (bytes.size() < 27 || bytes.substr(0, 18) != "Kaydara FBX Binary") return "";
+std::string fbx_problem(std::string_view bytes) {
+  FbxModels models;
+  if (bytes.size() < 27 || bytes.substr(0, 18) != "Kaydara FBX Binary") {
+    fbx_text_models(bytes, models);
+    return fbx_models_problem(models);
+  }
   const bool wide = u32(bytes, 23) >= 7500;  // 64-bit record offsets from FBX 7.5
   const std::size_t header = wide ? 25 : 13;
   std::vector<std::uint64_t> ends;  // of the records the walk is inside
@@ -219,19 +300,21 @@ std::string fbx_records_problem(std::string_view bytes) {
     while (!ends.empty() && at >= ends.back()) ends.pop_back();
     const std::uint64_t end = wide ? u64(bytes, at) : u32(bytes, at);
     const std::uint64_t properties = wide ? u64(bytes, at + 16) : u32(bytes, at + 8);
-    const std::uint64_t body = at + header + std::uint8_t(bytes[at + header - 1]) + properties;
+    const std::size_t name = std::uint8_t(bytes[at + header - 1]);
+    const std::uint64_t body = at + header + name + properties;
     if (end == 0) {  // the null record closing a list of children
-      if (ends.empty()) return "";
+      if (ends.empty()) break;
       at = std::size_t(ends.back());
       ends.pop_back();
       continue;
     }
     if (end <= at || end > bytes.size() || body > end || (!ends.empty() && end > ends.back())) return "";  // for Assimp
     if (ends.size() >= kMaxNesting) return "FBX records " + too_deep(at);
+    fbx_record(bytes.substr(at + header, name), bytes.substr(at + header + name, std::size_t(properties)), models);
     if (body < end) ends.push_back(end);
     at = std::size_t(body < end ? body : end);
   }
-  return "";
+  return fbx_models_problem(models);
 }
 
 std::string one_line(std::string_view text, std::size_t max) {

@@ -32,9 +32,10 @@ std::string nesting_problem(std::string_view bytes, bool json);
 std::string gltf_nodes_problem(std::string_view json);
 std::string collada_nodes_problem(std::string_view xml);
 
-// A binary FBX's records nested more than kMaxNesting deep; other files and damaged records are
-// left to Assimp.
-std::string fbx_records_problem(std::string_view bytes);
+// An FBX file's records (binary) nested more than kMaxNesting deep, or its models' tree (by "OO"
+// connections, binary or text) failing as gltf_nodes_problem's (a cycle made Assimp recurse for
+// ever). Damaged records are left to Assimp.
+std::string fbx_problem(std::string_view bytes);
 
 // Assimp's error text as one short line: line breaks and runs of white space as one space,
 // control bytes as '?', cut to `max` characters with "...".
