@@ -60,7 +60,9 @@ std::string fbx_nested(std::size_t n) {
   for (std::size_t i = 0; i < n; ++i) {
     const std::size_t inside = n - i - 1;  // records inside this one
     const std::size_t end = out.size() + leaf * (inside + 1) + closing * inside;
-    out += le32(std::uint32_t(end)) + le32(0) + le32(0) + "\x01" "A";
+    out += le32(std::uint32_t(end)) + le32(0) + le32(0) +
+           "\x01"
+           "A";
   }
   out += std::string(closing * n, '\0');
   return out;
@@ -74,11 +76,13 @@ TEST(AssimpGuard, GlbLengthsAreCheckedAgainstTheFile) {
   EXPECT_EQ(found, json);
   // The case of the issue: a chunk claiming 0xF0000000 bytes was allocated before Assimp failed.
   const std::string liar = le32(0xF0000000u) + "JSON" + json;
-  EXPECT_EQ(glb_problem(glb(2, std::uint32_t(12 + liar.size()), liar), found), "GLB chunk 0 claims 4026531840 bytes, 27 are left");
+  EXPECT_EQ(glb_problem(glb(2, std::uint32_t(12 + liar.size()), liar), found),
+            "GLB chunk 0 claims 4026531840 bytes, 27 are left");
   EXPECT_EQ(glb_problem(glb(2, 4000000000u, chunk), found), "the GLB header claims 4000000000 bytes, the file has 47");
   EXPECT_EQ(glb_problem(glb(3, 12, ""), found), "GLB version 3 (1 or 2 expected)");
   EXPECT_EQ(glb_problem("glTF\x02", found), "GLB header shorter than 12 bytes");
-  EXPECT_EQ(glb_problem(glb(2, std::uint32_t(12 + chunk.size() + 4), chunk + "abcd"), found), "GLB chunk 1 at byte 47 is cut short");
+  EXPECT_EQ(glb_problem(glb(2, std::uint32_t(12 + chunk.size() + 4), chunk + "abcd"), found),
+            "GLB chunk 1 at byte 47 is cut short");
   // Version 1: a 20-byte header, then the content.
   EXPECT_EQ(glb_problem(glb(1, 20, le32(4000) + le32(0)), found), "its content length 4000 runs past the file's 20");
   EXPECT_EQ(glb_problem(glb(1, std::uint32_t(20 + json.size()), le32(std::uint32_t(json.size())) + le32(0) + json), found), "");
@@ -102,7 +106,8 @@ TEST(AssimpGuard, NestingIsCountedUpTo1000) {
 TEST(AssimpGuard, GltfNodeTrees) {
   EXPECT_EQ(gltf_nodes_problem(gltf_chain(1000)), "");
   EXPECT_EQ(gltf_nodes_problem(gltf_chain(1001)), "node 1000 is nested more than 1000 deep");
-  EXPECT_EQ(gltf_nodes_problem(R"({"nodes":[{"children":[1]},{"name":"loop","children":[0]}]})"), "node 0 is its own ancestor (a cycle)");
+  EXPECT_EQ(gltf_nodes_problem(R"({"nodes":[{"children":[1]},{"name":"loop","children":[0]}]})"),
+            "node 0 is its own ancestor (a cycle)");
   EXPECT_EQ(gltf_nodes_problem(R"({"nodes":[{"children":[0]}]})"), "node 0 is its own ancestor (a cycle)");
   // Each node listing the next twice: 2^21 - 1 nodes once copied.
   EXPECT_EQ(gltf_nodes_problem(gltf_chain(20, true)), "");
@@ -141,7 +146,8 @@ std::string fbx_text_file(std::size_t models, const std::vector<std::pair<std::s
   for (std::size_t i = 0; i < models; ++i)
     s += "\tModel: " + std::to_string(1000 + i) + ", \"Model::m" + std::to_string(i) + "\", \"Null\" {\n\t}\n";
   s += "}\nConnections:  {\n\tC: \"OO\",1000,0\n";
-  for (const auto& [child, parent] : links) s += "\tC: \"OO\"," + std::to_string(1000 + child) + "," + std::to_string(1000 + parent) + "\n";
+  for (const auto& [child, parent] : links)
+    s += "\tC: \"OO\"," + std::to_string(1000 + child) + "," + std::to_string(1000 + parent) + "\n";
   return s + "}\n";
 }
 
@@ -215,10 +221,12 @@ TEST(AssimpGuard, HostileFilesAreRefused) {
   const std::string dir = test::scratch_dir();
   test::write_file(dir + "/deep_nodes.gltf", gltf_chain(200000));
   expect_refused(dir + "/deep_nodes.gltf", "malformed: node 1000 is nested more than 1000 deep");
-  test::write_file(dir + "/deep_json.gltf", "{\"asset\":{\"version\":\"2.0\"},\"extras\":" + repeat("[", 200000) + repeat("]", 200000) + "}");
+  test::write_file(dir + "/deep_json.gltf",
+                   "{\"asset\":{\"version\":\"2.0\"},\"extras\":" + repeat("[", 200000) + repeat("]", 200000) + "}");
   expect_refused(dir + "/deep_json.gltf", "malformed: nested more than 1000 deep");
   test::write_file(dir + "/deep.dae", "<?xml version=\"1.0\"?><COLLADA><library_visual_scenes><visual_scene id=\"s\">" +
-                                          repeat("<node>", 200000) + repeat("</node>", 200000) + "</visual_scene></library_visual_scenes></COLLADA>");
+                                          repeat("<node>", 200000) + repeat("</node>", 200000) +
+                                          "</visual_scene></library_visual_scenes></COLLADA>");
   expect_refused(dir + "/deep.dae", "malformed: nested more than 1000 deep");
   test::write_file(dir + "/deep_text.fbx", "; FBX 7.4.0 project file\nFBXHeaderExtension: {\n}\n" + repeat("A: {\n", 200000));
   expect_refused(dir + "/deep_text.fbx", "malformed: nested more than 1000 deep");
@@ -238,7 +246,8 @@ TEST(AssimpGuard, HostileFilesAreRefused) {
   ::mkdir((dir + "/folder.bin").c_str(), 0700);
   for (const std::string bin : {"fifo.bin", "folder.bin"}) {
     test::write_file(dir + "/buffer.gltf", R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
-      "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"buffers":[{"byteLength":36,"uri":")" + bin + R"("}],
+      "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"buffers":[{"byteLength":36,"uri":")" +
+                                               bin + R"("}],
       "bufferViews":[{"buffer":0,"byteLength":36}],
       "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}]})");
     expect_refused(dir + "/buffer.gltf", "refers to " + dir + "/" + bin + ", which is not a regular file");
@@ -256,9 +265,12 @@ TEST(AssimpGuard, LongLibraryMessagesAreCut) {
     "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}]})");
   expect_refused(dir + "/texcoord.gltf", "cannot read as .gltf: GLTF: Invalid attribute");
   // COLLADA: a number Assimp cannot read, in a long <float_array> (its message quotes the text).
-  test::write_file(dir + "/long.dae", "<?xml version=\"1.0\"?><COLLADA><library_geometries><geometry id=\"g\"><mesh><source id=\"p\">"
-                                      "<float_array id=\"a\" count=\"3\">" + repeat("\n  x   \t ", 60) + "</float_array></source></mesh>"
-                                      "</geometry></library_geometries></COLLADA>");
+  test::write_file(dir + "/long.dae",
+                   "<?xml version=\"1.0\"?><COLLADA><library_geometries><geometry id=\"g\"><mesh><source id=\"p\">"
+                   "<float_array id=\"a\" count=\"3\">" +
+                       repeat("\n  x   \t ", 60) +
+                       "</float_array></source></mesh>"
+                       "</geometry></library_geometries></COLLADA>");
   expect_refused(dir + "/long.dae", "cannot read as .dae");
 }
 

@@ -56,10 +56,10 @@ std::vector<std::string> random_decimals(std::size_t n, std::uint64_t seed) {
     if (finite && end == s.c_str() + s.size()) out.push_back(s);
   }
   // Halfway between two floats and two doubles, and a hair above and below: the last digits decide.
-  out.push_back("0.70000001788139343261718750");                    // a float tie
-  out.push_back("0.70000001788139343261718750000000000000000000001");  // just above it
-  out.push_back("0.70000001788139343261718749999999999999999999999");  // just below it
-  out.push_back("1.00000000000000011102230246251565404236316680908203125");        // a double tie
+  out.push_back("0.70000001788139343261718750");                                    // a float tie
+  out.push_back("0.70000001788139343261718750000000000000000000001");               // just above it
+  out.push_back("0.70000001788139343261718749999999999999999999999");               // just below it
+  out.push_back("1.00000000000000011102230246251565404236316680908203125");         // a double tie
   out.push_back("1.000000000000000111022302462515654042363166809082031250000001");  // above
   out.push_back("7." + std::string(68, '0') + "1e-1");
   out.push_back("4.9406564584124654e-324");  // the smallest denormal double
@@ -105,7 +105,8 @@ TEST(MeshNumbers, PlyOffAndStlReadEveryDecimalAsStrtod) {
   const std::size_t n = numbers.size() / 3;
   const std::string ply = "ply\nformat ascii 1.0\nelement vertex " + std::to_string(n) +
                           "\nproperty double x\nproperty double y\nproperty double z\nelement face 1\n"
-                          "property list uchar int vertex_indices\nend_header\n" + lines(numbers, "") + "3 0 1 2\n";
+                          "property list uchar int vertex_indices\nend_header\n" +
+                          lines(numbers, "") + "3 0 1 2\n";
   expect_exact(mesh_io_detail::parse_ply("n.ply", ply).exact_positions, numbers, "PLY");
   const std::string off = "OFF\n" + std::to_string(n) + " 1 0\n" + lines(numbers, "") + "3 0 1 2\n";
   expect_exact(mesh_io_detail::parse_off("n.off", off).exact_positions, numbers, "OFF");

@@ -100,7 +100,8 @@ std::string node_graph_problem(const NodeGraph& g) {
       if (next == g.children[node].size()) {
         state[node] = 2;
         for (std::size_t c : g.children[node]) copies[node] = std::min(copies[node] + copies[c], kMaxNodeCopies + 1);
-        if (copies[node] > kMaxNodeCopies) return name(node) + " stands for more than " + std::to_string(kMaxNodeCopies) + " copies of nodes";
+        if (copies[node] > kMaxNodeCopies)
+          return name(node) + " stands for more than " + std::to_string(kMaxNodeCopies) + " copies of nodes";
         path.pop_back();
         continue;
       }
@@ -204,7 +205,8 @@ std::string glb_problem(std::string_view bytes, std::string_view& json) {
   if (version == 1) {
     if (length < 20) return claims + std::to_string(length) + " bytes: no room for the content header";
     const std::uint32_t content = u32(bytes, 12);
-    if (content > length - 20) return "its content length " + std::to_string(content) + " runs past the file's " + std::to_string(length);
+    if (content > length - 20)
+      return "its content length " + std::to_string(content) + " runs past the file's " + std::to_string(length);
     json = bytes.substr(20, content);
     return "";
   }
@@ -237,7 +239,8 @@ std::string gltf_nodes_problem(std::string_view json) {
   for (std::size_t i = 0; i < nodes.size(); ++i) {
     const nlohmann::json& node = nodes[i];
     const auto name = node.is_object() ? node.find("name") : node.end();
-    graph.names.push_back(std::to_string(i) + (name != node.end() && name->is_string() ? " '" + name->get<std::string>() + "'" : ""));
+    graph.names.push_back(std::to_string(i) +
+                          (name != node.end() && name->is_string() ? " '" + name->get<std::string>() + "'" : ""));
     if (!node.is_object() || !node.contains("children") || !node["children"].is_array()) continue;
     for (const nlohmann::json& c : node["children"])
       if (c.is_number_unsigned() && c.get<std::uint64_t>() < nodes.size()) graph.children[i].push_back(c.get<std::size_t>());
