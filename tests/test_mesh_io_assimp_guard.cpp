@@ -112,6 +112,10 @@ TEST(AssimpGuard, GltfNodeTrees) {
   // Each node listing the next twice: 2^21 - 1 nodes once copied.
   EXPECT_EQ(gltf_nodes_problem(gltf_chain(20, true)), "");
   EXPECT_EQ(gltf_nodes_problem(gltf_chain(21, true)), "node 0 stands for more than 1048576 copies of nodes");
+  // glTF 1.0: nodes by name, children by name.
+  EXPECT_EQ(gltf_nodes_problem(R"({"nodes":{"a":{"children":["b"]},"b":{"children":["a"]}}})"),
+            "node a is its own ancestor (a cycle)");
+  EXPECT_EQ(gltf_nodes_problem(R"({"nodes":{"a":{"children":["b"]},"b":{"children":[]}}})"), "");
   EXPECT_EQ(gltf_nodes_problem("not json"), "");
   EXPECT_EQ(gltf_nodes_problem(R"({"nodes":[{"children":[7, -1, "x"]}]})"), "") << "left to Assimp";
 }

@@ -232,18 +232,28 @@ std::string nesting_problem(std::string_view bytes, bool json) {
 
 std::string gltf_nodes_problem(std::string_view json) {
   const nlohmann::json doc = nlohmann::json::parse(json.begin(), json.end(), nullptr, false);
-  if (doc.is_discarded() || !doc.is_object() || !doc.contains("nodes") || !doc["nodes"].is_array()) return "";
+  if (doc.is_discarded() || !doc.is_object() || !doc.contains("nodes")) return "";
+  // glTF 2.0 lists nodes and children by index; glTF 1.0 names them ({"id": {...}}, children by id).
   const nlohmann::json& nodes = doc["nodes"];
+  if (!nodes.is_array() && !nodes.is_object()) return "";
   NodeGraph graph;
-  graph.children.resize(nodes.size());
-  for (std::size_t i = 0; i < nodes.size(); ++i) {
-    const nlohmann::json& node = nodes[i];
-    const auto name = node.is_object() ? node.find("name") : node.end();
-    graph.names.push_back(std::to_string(i) +
-                          (name != node.end() && name->is_string() ? " '" + name->get<std::string>() + "'" : ""));
-    if (!node.is_object() || !node.contains("children") || !node["children"].is_array()) continue;
-    for (const nlohmann::json& c : node["children"])
-      if (c.is_number_unsigned() && c.get<std::uint64_t>() < nodes.size()) graph.children[i].push_back(c.get<std::size_t>());
+  std::unordered_map<std::string, std::size_t> by_id;
+  for (auto it = nodes.begin(); it != nodes.end(); ++it) {
+    const auto name = it->is_object() ? it->find("name") : it->end();
+    const std::string id = nodes.is_array() ? std::to_string(graph.names.size()) : it.key();
+    by_id.emplace(id, graph.names.size());
+    graph.names.push_back(id + (name != it->end() && name->is_string() ? " '" + name->get<std::string>() + "'" : ""));
+  }
+  graph.children.resize(graph.names.size());
+  std::size_t i = 0;
+  for (auto it = nodes.begin(); it != nodes.end(); ++it, ++i) {
+    if (!it->is_object() || !it->contains("children") || !(*it)["children"].is_array()) continue;
+    for (const nlohmann::json& c : (*it)["children"]) {
+      const auto k = c.is_number_unsigned() ? by_id.find(std::to_string(c.get<std::uint64_t>()))
+                     : c.is_string()        ? by_id.find(c.get<std::string>())
+                                            : by_id.end();
+      if (k != by_id.end() && (nodes.is_array() == c.is_number_unsigned())) graph.children[i].push_back(k->second);
+    }
   }
   return node_graph_problem(graph);
 }
