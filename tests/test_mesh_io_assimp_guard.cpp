@@ -120,6 +120,17 @@ TEST(AssimpGuard, GltfNodeTrees) {
   EXPECT_EQ(gltf_nodes_problem(R"({"nodes":[{"children":[7, -1, "x"]}]})"), "") << "left to Assimp";
 }
 
+TEST(AssimpGuard, GltfAccessorsWithoutBufferViews) {
+  const std::string zeros = R"({"accessors":[{"bufferView":0,"count":4000000000,"type":"VEC3"},
+                                             {"count":1000,"type":"VEC3","sparse":{}},{"count":1001,"type":"VEC3"}]})";
+  EXPECT_EQ(gltf_accessor_problem(zeros, 4 * 12012), "");  // a buffer view: Assimp checks it against the view
+  EXPECT_EQ(gltf_accessor_problem(zeros, 4 * 12011),
+            "accessor 2 holds 12.0 kB of zeros (no buffer view); Assimp needs about 3 times that, the memory budget is 48.0 kB");
+  EXPECT_EQ(
+      gltf_accessor_problem(R"({"accessors":[{"count":100,"type":"MAT4"}]})", 4 * 6399),
+      "accessor 0 holds 6400 bytes of zeros (no buffer view); Assimp needs about 3 times that, the memory budget is 25.6 kB");
+}
+
 TEST(AssimpGuard, ColladaNodeTrees) {
   EXPECT_EQ(collada_nodes_problem(collada_chain(1000)), "");
   EXPECT_EQ(collada_nodes_problem(collada_chain(1001)), "node 'n1000' is nested more than 1000 deep");
@@ -236,8 +247,26 @@ TEST(AssimpGuard, HostileFilesAreRefused) {
   expect_refused(dir + "/deep_text.fbx", "malformed: nested more than 1000 deep");
   test::write_file(dir + "/deep_binary.fbx", fbx_nested(100000));
   expect_refused(dir + "/deep_binary.fbx", "malformed: FBX records nested more than 1000 deep");
+  // 2^60 zeros (a sparse accessor): refused as a size whatever the machine (500M took 19.5 GB, 55 s).
+  test::write_file(dir + "/zeros.gltf", R"({"asset":{"version":"2.0"},"accessors":[{"count":1152921504606846976,"type":"VEC3",
+    "componentType":5126,"sparse":{"count":1,"indices":{"bufferView":0,"componentType":5125},"values":{"bufferView":0}}}]})");
+  try {
+    load_mesh(dir + "/zeros.gltf");
+    ADD_FAILURE() << "zeros.gltf loaded";
+  } catch (const ResourceError& e) {
+    EXPECT_NE(std::string(e.what()).find("zeros.gltf: accessor 0 holds"), std::string::npos) << e.what();
+  }
   test::write_file(dir + "/cycle.fbx", fbx_text_file(2, {{1, 0}, {0, 1}}));
   expect_refused(dir + "/cycle.fbx", "malformed: node '1000' is its own ancestor (a cycle)");
+  // 2^60 zeros (a sparse accessor): refused as a size whatever the machine (500M took 19.5 GB, 55 s).
+  test::write_file(dir + "/zeros.gltf", R"({"asset":{"version":"2.0"},"accessors":[{"count":1152921504606846976,"type":"VEC3",
+    "componentType":5126,"sparse":{"count":1,"indices":{"bufferView":0,"componentType":5125},"values":{"bufferView":0}}}]})");
+  try {
+    load_mesh(dir + "/zeros.gltf");
+    ADD_FAILURE() << "zeros.gltf loaded";
+  } catch (const ResourceError& e) {
+    EXPECT_NE(std::string(e.what()).find("zeros.gltf: accessor 0 holds"), std::string::npos) << e.what();
+  }
   test::write_file(dir + "/cycle.fbx", fbx_text_file(2, {{1, 0}, {0, 1}}));
   expect_refused(dir + "/cycle.fbx", "malformed: node '1000' is its own ancestor (a cycle)");
   const std::string liar = le32(0xF0000000u) + "JSON" + R"({"asset":{"version":"2.0"}} )";

@@ -31,6 +31,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "core/memory_budget.h"
 #include "io/mesh_io_assimp_guard.h"
 #include "io/mesh_io_detail.h"
 
@@ -299,6 +300,12 @@ ParsedMesh parse_assimp(const std::string& path, const std::string& ext, std::st
                         unsigned uv_set) {
   if (!signature_fits(ext, bytes)) fail(path, "is not a ." + ext + " file (its first bytes say otherwise)");
   if (const std::string problem = shape_problem(ext, bytes); !problem.empty()) fail(path, "malformed: " + problem);
+  if (ext == "gltf" || ext == "glb") {
+    std::string_view json = bytes;
+    if (ext == "glb") glb_problem(bytes, json);  // passed in shape_problem
+    if (const std::string problem = gltf_accessor_problem(json, memory_budget_bytes()); !problem.empty())
+      throw ResourceError(path + ": " + problem);
+  }
   ParsedMesh parsed;
   // Assimp recurses over the file and its node tree; the importer (which frees the tree, again
   // recursively) lives and dies on the big stack.

@@ -13,6 +13,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/memory_budget.h"
+
 namespace nmbake::mesh_io_detail {
 namespace {
 
@@ -256,6 +258,25 @@ std::string gltf_nodes_problem(std::string_view json) {
     }
   }
   return node_graph_problem(graph);
+}
+
+std::string gltf_accessor_problem(std::string_view json, std::uint64_t budget) {
+  const nlohmann::json doc = nlohmann::json::parse(json.begin(), json.end(), nullptr, false);
+  if (doc.is_discarded() || !doc.is_object() || !doc.contains("accessors") || !doc["accessors"].is_array()) return "";
+  const std::unordered_map<std::string, std::uint64_t> components{{"SCALAR", 1}, {"VEC2", 2}, {"VEC3", 3}, {"VEC4", 4},
+                                                                  {"MAT2", 4},   {"MAT3", 9}, {"MAT4", 16}};
+  const nlohmann::json& accessors = doc["accessors"];
+  for (std::size_t i = 0; i < accessors.size(); ++i) {
+    const nlohmann::json& a = accessors[i];
+    if (!a.is_object() || a.contains("bufferView") || !a.contains("count") || !a["count"].is_number_unsigned()) continue;
+    const auto type =
+        a.contains("type") && a["type"].is_string() ? components.find(a["type"].get<std::string>()) : components.end();
+    const double bytes = double(a["count"].get<std::uint64_t>()) * double(type == components.end() ? 1 : type->second) * 4.0;
+    if (bytes > double(budget) / 4.0)
+      return "accessor " + std::to_string(i) + " holds " + format_bytes(bytes) +
+             " of zeros (no buffer view); Assimp needs about 3 times that, the memory budget is " + format_bytes(double(budget));
+  }
+  return "";
 }
 
 std::string collada_nodes_problem(std::string_view xml) {
