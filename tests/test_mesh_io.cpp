@@ -117,6 +117,15 @@ const Defect kDefects[] = {
     // Issue 21: a number longer than 63 characters was cut to its first 63 and read as 7.
     {"long_number.obj", {"line 1", "vertex 1", "non-finite"}},
     {"short_texcoords.off", {"line 5", "vertex 2 has fewer than 2 texture coordinate"}},
+    // Issue 34, item 8: checked before Assimp reads them (deeper ones crashed it, the GLB's claim
+    // was allocated, the cycles made it recurse for ever).
+    {"glb_chunk_claims_4gb.glb", {"malformed: GLB chunk 0 claims 4026531840 bytes, 31 are left"}},
+    {"gltf_nodes_1001_deep.gltf", {"malformed: node 1000 is nested more than 1000 deep"}},
+    {"json_1001_deep.gltf", {"malformed: nested more than 1000 deep (at byte 1035)"}},
+    {"dae_nodes_1001_deep.dae", {"malformed: nested more than 1000 deep (at byte 6073)"}},
+    {"dae_instance_cycle.dae", {"malformed: node 'a' is its own ancestor (a cycle)"}},
+    {"fbx_model_cycle.fbx", {"malformed: node '1000' is its own ancestor (a cycle)"}},
+    {"fbx_records_1001_deep.fbx", {"malformed: FBX records nested more than 1000 deep (at byte 14027)"}},
 };
 
 std::string defect_test_name(const ::testing::TestParamInfo<Defect>& info) {

@@ -1,6 +1,7 @@
 #include "cli/args.h"
 
 #include <cctype>
+#include <charconv>
 #include <climits>
 #include <cstdio>
 #include <filesystem>
@@ -29,7 +30,54 @@ void parse_size(const std::string& text, int& w, int& h) {
   h = int(std::min<long long>(b, INT_MAX));
 }
 
+// Whether `word` is a whole number (decimal digits with an optional sign) or, not `integer`, a
+// number as std::from_chars reads it (decimal, inf, nan); a leading '+' is allowed. CLI11 alone
+// took '' for 0 and let leading blanks, octal (010 was 8) and hex (0x10) through.
+bool is_number(const std::string& word, bool integer) {
+  std::size_t first = word.size() > 1 && word[0] == '+' && word[1] != '-' ? 1 : 0;
+  if (word.empty() || word.find_first_of(" \t\n\r\f\v") != std::string::npos) return false;
+  if (integer) {
+    if (word[first] == '-') ++first;
+    return first < word.size() && word.find_first_not_of("0123456789", first) == std::string::npos;
+  }
+  double value = 0.0;
+  const auto [end, ec] = std::from_chars(word.data() + first, word.data() + word.size(), value);
+  return end == word.data() + word.size() && (ec == std::errc() || ec == std::errc::result_out_of_range);
+}
+
+// A value for a one-line message: control characters as '?', at most 40 characters.
+std::string printable(const std::string& word) {
+  std::string s = word.substr(0, 40);
+  for (char& c : s)
+    if (static_cast<unsigned char>(c) < 32 || c == 127) c = '?';
+  return word.size() > 40 ? s + "..." : s;
+}
+
+// Decimal integers with leading zeros lose them: CLI11 reads "010" as octal.
+std::string without_leading_zeros(const std::string& word) {
+  std::size_t sign = word[0] == '+' || word[0] == '-' ? 1 : 0;
+  std::size_t digits = sign;
+  while (digits + 1 < word.size() && word[digits] == '0') ++digits;
+  return (word[0] == '-' ? "-" : "") + word.substr(digits);
+}
+
 }  // namespace
+
+void require_numbers(CLI::App& app) {
+  for (CLI::Option* option : app.get_options()) {
+    const std::string type = option->get_type_name();
+    const bool integer = type.rfind("INT", 0) == 0 || type.rfind("UINT", 0) == 0;
+    if (option->get_type_size() == 0 || (!integer && type.rfind("FLOAT", 0) != 0)) continue;  // flags, text
+    option->transform(CLI::Validator(
+        [integer](std::string& word) {
+          if (!is_number(word, integer))
+            return std::string("expected ") + (integer ? "a whole number" : "a number") + ", got '" + printable(word) + "'";
+          if (integer) word = without_leading_zeros(word);
+          return std::string();
+        },
+        "", "number"));
+  }
+}
 
 const char* kExitCodes =
     "Exit codes:\n"
@@ -141,6 +189,7 @@ void add_options(CLI::App& app, Args& a) {
                "angular error of the float map against them (one stderr line, \"error_estimate\" in --report); costs "
                "about 10% of a 2048^2 1-sample bake (measured on torus_s3 and suz_L4: 0.13-0.31 s, 6-12% of the command)");
   app.set_version_flag("--version", std::string("nmbake ") + NMBAKE_VERSION);
+  require_numbers(app);
 }
 
 // The library's options from the flags: translation only (validate_options checks them).
@@ -161,12 +210,12 @@ BakeOptions bake_options(const Args& a) {
   } else {
     std::size_t used = 0;
     try {
-      o.samples = std::stoi(a.samples, &used);
+      if (is_number(a.samples, true)) o.samples = std::stoi(a.samples, &used);
     } catch (const std::exception&) {
       used = 0;
     }
     if (used == 0 || used != a.samples.size())
-      throw UsageError("--samples takes a number of samples (1-1024) or auto, got '" + a.samples + "'");
+      throw UsageError("--samples takes a number of samples (1-1024) or auto, got '" + printable(a.samples) + "'");
     if (a.max_error_given) throw UsageError("--max-error applies to --samples auto");
   }
   o.front = a.front_given ? float(a.front) : -1.0f;

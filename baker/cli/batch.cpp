@@ -127,6 +127,7 @@ int parse_batch_args(int argc, char** argv, BatchArgs& b) {
   app.add_flag("--strict", b.strict, "Any warning fails its job (exit 5 for the batch); the others still run");
   app.add_flag("--no-warnings", b.no_warnings, "Do not print warnings");
   app.footer(std::string("\n") + kExitCodes);
+  require_numbers(app);
   for (int i = 1; i < argc; ++i)  // before parsing: `--batch --help` would read "--help" as the file
     if (std::strcmp(argv[i], "--help") == 0 || std::strcmp(argv[i], "-h") == 0) {
       std::printf("%s", app.help().c_str());

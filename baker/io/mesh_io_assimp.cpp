@@ -10,12 +10,17 @@
 // per corner, so hard edges and seams are kept as in an OBJ file. Points and lines are left out.
 // Each node with meshes is an object named after the node (Mesh::objects); a node name met twice
 // is one object.
+#include <assimp/DefaultIOSystem.h>
 #include <assimp/DefaultLogger.hpp>
 #include <assimp/Importer.hpp>
 #include <assimp/LogStream.hpp>
 #include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
@@ -26,6 +31,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include "core/memory_budget.h"
+#include "io/mesh_io_assimp_guard.h"
 #include "io/mesh_io_detail.h"
 
 namespace nmbake::mesh_io_detail {
@@ -78,18 +85,24 @@ class SceneReader {
   }
 
   ParsedMesh read() {
-    visit(*scene_.mRootNode, glm::dmat4(scale_), 0);
+    // Depth first without recursion: Assimp checks nothing of the tree's depth.
+    std::vector<std::pair<const aiNode*, glm::dmat4>> stack{{scene_.mRootNode, glm::dmat4(scale_)}};
+    while (!stack.empty()) {
+      const auto [node, parent] = stack.back();
+      stack.pop_back();
+      const glm::dmat4 world = parent * to_glm(node->mTransformation);
+      visit(*node, world);
+      for (unsigned i = node->mNumChildren; i-- > 0;) stack.push_back({node->mChildren[i], world});
+    }
     out_.mesh.positions.reserve(out_.exact_positions.size());
     for (const glm::dvec3& p : out_.exact_positions) out_.mesh.positions.emplace_back(p);
     return std::move(out_);
   }
 
  private:
-  void visit(const aiNode& node, const glm::dmat4& parent, int depth) {
-    if (depth > 1000) fail(path_, "node '" + std::string(node.mName.C_Str()) + "' is nested more than 1000 deep");
-    const glm::dmat4 world = parent * to_glm(node.mTransformation);
+  void visit(const aiNode& node, const glm::dmat4& world) {
     for (unsigned i = 0; i < node.mNumMeshes; ++i) {
-      if (node.mMeshes[i] >= scene_.mNumMeshes) fail(path_, "node '" + std::string(node.mName.C_Str()) + "' names no mesh");
+      if (node.mMeshes[i] >= scene_.mNumMeshes) fail(path_, "node " + quote(node.mName.C_Str()) + " names no mesh");
       // A node's meshes (one per material) are one object, named after the node (or its first mesh).
       if (i == 0) {
         const std::string mesh_name = scene_.mMeshes[node.mMeshes[0]]->mName.C_Str();
@@ -97,12 +110,11 @@ class SceneReader {
       }
       add_mesh(*scene_.mMeshes[node.mMeshes[i]], world);
     }
-    for (unsigned i = 0; i < node.mNumChildren; ++i) visit(*node.mChildren[i], world, depth + 1);
   }
 
   void add_mesh(const aiMesh& m, const glm::dmat4& world) {
     if (!(m.mPrimitiveTypes & (aiPrimitiveType_TRIANGLE | aiPrimitiveType_POLYGON))) return;
-    const std::string name = "mesh '" + std::string(m.mName.C_Str()) + "'";
+    const std::string name = "mesh " + quote(m.mName.C_Str());
     const glm::dmat3 normal_matrix = glm::transpose(glm::inverse(glm::dmat3(world)));
     const bool mirrored = glm::determinant(glm::dmat3(world)) < 0.0;
     std::vector<std::uint32_t> position(m.mNumVertices);
@@ -240,6 +252,43 @@ std::string collada_array_problem(std::string_view bytes) {
   return "";
 }
 
+// What the guards (mesh_io_assimp_guard.h) find in the bytes before Assimp reads them, or "".
+std::string shape_problem(const std::string& ext, std::string_view bytes) {
+  std::string_view json = bytes;
+  if (ext == "glb")
+    if (std::string problem = glb_problem(bytes, json); !problem.empty()) return problem;
+  if (ext == "glb" || ext == "gltf") {
+    std::string problem = nesting_problem(json, true);
+    return problem.empty() ? gltf_nodes_problem(json) : problem;
+  }
+  std::string problem = ext == "dae" ? collada_array_problem(bytes) : ext == "fbx" ? fbx_problem(bytes) : "";
+  if (problem.empty()) problem = nesting_problem(bytes, false);
+  return problem.empty() && ext == "dae" ? collada_nodes_problem(bytes) : problem;
+}
+
+// Assimp's file access, refusing what is not a regular file: a FIFO named as a glTF's buffer
+// blocked the read for ever. Exists() does not open (Assimp's own fopen()s, which blocks on a
+// FIFO); Open() looks at the file without blocking first.
+class RegularFiles : public Assimp::DefaultIOSystem {
+ public:
+  bool Exists(const char* file) const override {
+    struct stat st;
+    return ::stat(file, &st) == 0;
+  }
+  Assimp::IOStream* Open(const char* file, const char* mode) override {
+    const int fd = ::open(file, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    struct stat st;
+    const bool regular = fd >= 0 && ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode);
+    if (fd >= 0) ::close(fd);
+    if (fd >= 0 && !regular) {
+      if (refused.empty()) refused = file;
+      return nullptr;
+    }
+    return DefaultIOSystem::Open(file, mode);
+  }
+  std::string refused;  // the first file refused
+};
+
 }  // namespace
 
 bool assimp_reads(const std::string& ext) {
@@ -249,29 +298,39 @@ bool assimp_reads(const std::string& ext) {
 
 ParsedMesh parse_assimp(const std::string& path, const std::string& ext, std::string_view bytes, bool read_path,
                         unsigned uv_set) {
-  Assimp::Importer importer;
-  // Points and lines are dropped by the reader; the scene is checked for indices out of range.
-  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  const unsigned flags = aiProcess_ValidateDataStructure | aiProcess_SortByPType;
   if (!signature_fits(ext, bytes)) fail(path, "is not a ." + ext + " file (its first bytes say otherwise)");
-  if (ext == "dae")
-    if (const std::string problem = collada_array_problem(bytes); !problem.empty()) fail(path, "malformed: " + problem);
-  // A file beside others (a .gltf and its .bin) is read by name; bytes alone for the fuzz target.
-  const aiScene* scene = nullptr;
-  const std::string dropped = DroppedDataLog::instance().collect([&] {
-    scene =
-        read_path ? importer.ReadFile(path, flags) : importer.ReadFileFromMemory(bytes.data(), bytes.size(), flags, ext.c_str());
-  });
-  if (scene && !dropped.empty()) fail(path, "malformed: " + dropped);
-  if (!scene || !scene->mRootNode) {
-    std::string why = importer.GetErrorString();
-    for (char& c : why)
-      if (c == '\n' || c == '\r') c = ' ';
-    if (why.size() > 200) why = why.substr(0, 200) + "...";
-    fail(path, "cannot read as ." + ext + (why.empty() ? std::string() : ": " + why));
+  if (const std::string problem = shape_problem(ext, bytes); !problem.empty()) fail(path, "malformed: " + problem);
+  if (ext == "gltf" || ext == "glb") {
+    std::string_view json = bytes;
+    if (ext == "glb") glb_problem(bytes, json);  // passed in shape_problem
+    if (const std::string problem = gltf_accessor_problem(json, memory_budget_bytes()); !problem.empty())
+      throw ResourceError(path + ": " + problem);
   }
-  const double scale = unit_scale_to_metres(*scene, ext);
-  ParsedMesh parsed = SceneReader(path, *scene, scale, uv_set).read();
+  ParsedMesh parsed;
+  // Assimp recurses over the file and its node tree; the importer (which frees the tree, again
+  // recursively) lives and dies on the big stack.
+  run_on_big_stack(reader_stack_bytes(bytes.size()), [&] {
+    Assimp::Importer importer;
+    auto* files = new RegularFiles;  // owned by the importer
+    importer.SetIOHandler(files);
+    // Points and lines are dropped by the reader; the scene is checked for indices out of range.
+    importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+    const unsigned flags = aiProcess_ValidateDataStructure | aiProcess_SortByPType;
+    // A file beside others (a .gltf and its .bin) is read by name; bytes alone for the fuzz target.
+    const aiScene* scene = nullptr;
+    const std::string dropped = DroppedDataLog::instance().collect([&] {
+      scene = read_path ? importer.ReadFile(path, flags)
+                        : importer.ReadFileFromMemory(bytes.data(), bytes.size(), flags, ext.c_str());
+    });
+    if (!files->refused.empty())
+      fail(path, "refers to " + files->refused + ", which is not a regular file (a FIFO, a device or a folder)");
+    if (scene && !dropped.empty()) fail(path, "malformed: " + one_line(dropped));
+    if (!scene || !scene->mRootNode) {
+      const std::string why = one_line(importer.GetErrorString());
+      fail(path, "cannot read as ." + ext + (why.empty() ? std::string() : ": " + why));
+    }
+    parsed = SceneReader(path, *scene, unit_scale_to_metres(*scene, ext), uv_set).read();
+  });
   parsed.format = ext == "glb" || ext == "gltf" ? "gltf" : ext;
   return parsed;
 }
