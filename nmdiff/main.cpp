@@ -15,6 +15,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "cli/numbers.h"
 #include "core/errors.h"
 #include "io/image_io.h"
 #include "io/mesh_io.h"
@@ -212,6 +213,7 @@ std::optional<int> parse_command_line(int argc, char** argv, CommandLine& cl) {
       "nmdiff: compare two tangent-space normal maps by the angle between their normals.\n"
       "Texels decode as n = normalize(rgb * 2 - 1); the angle is reported in degrees."};
   add_arguments(app, cl);
+  nmbake::require_numbers(app);
 
   try {
     app.parse(argc, argv);

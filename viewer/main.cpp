@@ -18,6 +18,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli/numbers.h"
 #include "compare.h"
 #include "core/errors.h"
 #include "core/memory_budget.h"
@@ -188,6 +189,7 @@ int run_command_line(int argc, char** argv) {
       ->check(CLI::Range(0u, nmbake::kMaxUvSets - 1))
       ->capture_default_str();
   app.add_option("--show", o.show, "Start with toggles on: wire,diff,tangent,specular,nolabels");
+  nmbake::require_numbers(app);
 
   try {
     app.parse(argc, argv);

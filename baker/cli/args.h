@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli/numbers.h"
 #include "pipeline/bake.h"
 
 namespace nmbake {
@@ -42,10 +43,6 @@ struct Args {
 
 // The command line's options on `app`, with their help text.
 void add_options(CLI::App& app, Args& a);
-
-// Every numeric option of `app` (CLI11's INT, UINT, FLOAT) refuses, as a usage error naming it, an
-// empty value, white space, trailing characters, octal and hex; decimal leading zeros are dropped.
-void require_numbers(CLI::App& app);
 
 // What parsing leaves to be set from `app`: `high` (for messages) and whether --front and --rear
 // were given.
