@@ -71,8 +71,9 @@ std::string fbx_nested(std::size_t n) {
 TEST(AssimpGuard, GlbLengthsAreCheckedAgainstTheFile) {
   const std::string json = R"({"asset":{"version":"2.0"}})";
   const std::string chunk = le32(std::uint32_t(json.size())) + "JSON" + json;
-  std::string_view found;
-  EXPECT_EQ(glb_problem(glb(2, std::uint32_t(12 + chunk.size()), chunk), found), "");
+  std::string_view found;  // views into the file's bytes: they must outlive it
+  const std::string file = glb(2, std::uint32_t(12 + chunk.size()), chunk);
+  EXPECT_EQ(glb_problem(file, found), "");
   EXPECT_EQ(found, json);
   // The case of the issue: a chunk claiming 0xF0000000 bytes was allocated before Assimp failed.
   const std::string liar = le32(0xF0000000u) + "JSON" + json;
@@ -85,7 +86,8 @@ TEST(AssimpGuard, GlbLengthsAreCheckedAgainstTheFile) {
             "GLB chunk 1 at byte 47 is cut short");
   // Version 1: a 20-byte header, then the content.
   EXPECT_EQ(glb_problem(glb(1, 20, le32(4000) + le32(0)), found), "its content length 4000 runs past the file's 20");
-  EXPECT_EQ(glb_problem(glb(1, std::uint32_t(20 + json.size()), le32(std::uint32_t(json.size())) + le32(0) + json), found), "");
+  const std::string v1 = glb(1, std::uint32_t(20 + json.size()), le32(std::uint32_t(json.size())) + le32(0) + json);
+  EXPECT_EQ(glb_problem(v1, found), "");
   EXPECT_EQ(found, json);
 }
 
