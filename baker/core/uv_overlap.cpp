@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <utility>
 #include <vector>
 
 #include "core/parallel.h"
@@ -12,27 +13,34 @@ namespace nmbake {
 
 namespace {
 
-// One triangle in its tile: the UVs moved into the unit square of the tile it counts in.
-struct TileTriangle {
-  int tile;  // 0 without UDIM, else u + 10 v of the tile
-  glm::vec2 uv[3];
-};
+constexpr int kBandRows = 16;  // rows a chunk of work counts
 
-std::vector<TileTriangle> place_triangles(const Mesh& mesh, bool udim) {
-  std::vector<TileTriangle> out;
-  out.reserve(mesh.triangle_count());
-  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
-    TileTriangle tt{0, {mesh.corner_uv(t, 0), mesh.corner_uv(t, 1), mesh.corner_uv(t, 2)}};
-    if (udim) {
-      const glm::dvec2 c = (glm::dvec2(tt.uv[0]) + glm::dvec2(tt.uv[1]) + glm::dvec2(tt.uv[2])) / 3.0;
-      if (!(c.x >= 0.0 && c.x < 10.0 && c.y >= 0.0 && c.y < 1e6)) continue;  // in no tile (NaN too)
-      const double tu = std::floor(c.x), tv = std::floor(c.y);
-      tt.tile = int(tu) + 10 * int(tv);
-      for (glm::vec2& uv : tt.uv) uv = glm::vec2(glm::dvec2(uv) - glm::dvec2(tu, tv));
-    }
-    out.push_back(tt);
+// Triangle t's UVs, moved with UDIM into the unit square of the tile of its UV centroid (`tile`:
+// u + 10 v). False when it lies in no tile (u below 0 or from 10 on, v below 0, NaN).
+bool tile_uvs(const Mesh& mesh, std::size_t t, bool udim, glm::vec2 uv[3], int& tile) {
+  for (int c = 0; c < 3; ++c) uv[c] = mesh.corner_uv(t, c);
+  tile = 0;
+  if (!udim) return true;
+  const glm::dvec2 centre = (glm::dvec2(uv[0]) + glm::dvec2(uv[1]) + glm::dvec2(uv[2])) / 3.0;
+  if (!(centre.x >= 0.0 && centre.x < 10.0 && centre.y >= 0.0 && centre.y < 1e6)) return false;
+  const double tu = std::floor(centre.x), tv = std::floor(centre.y);
+  tile = int(tu) + 10 * int(tv);
+  for (int c = 0; c < 3; ++c) uv[c] = glm::vec2(glm::dvec2(uv[c]) - glm::dvec2(tu, tv));
+  return true;
+}
+
+// The bands of rows a triangle's UVs reach (a superset of the rows it covers), as [first, last];
+// first > last when none.
+std::pair<int, int> bands_reached(const glm::vec2 uv[3], int height) {
+  double lo = 1e300, hi = -1e300;
+  for (int c = 0; c < 3; ++c) {
+    const double y = (1.0 - double(uv[c].y)) * height;
+    lo = std::min(lo, y);
+    hi = std::max(hi, y);
   }
-  return out;
+  if (!(lo <= hi) || hi < -1.0 || lo > height + 1.0) return {1, 0};
+  const int first = int(std::max(0.0, std::floor(lo) - 1.0)), last = int(std::min(double(height - 1), std::floor(hi) + 1.0));
+  return {first / kBandRows, last / kBandRows};
 }
 
 }  // namespace
@@ -42,28 +50,36 @@ UvOverlap measure_uv_overlap(const Mesh& mesh, int width, int height, bool udim,
   result.width = width;
   result.height = height;
   if (width <= 0 || height <= 0 || !mesh.has_uvs()) return result;
-  const std::vector<TileTriangle> tris = place_triangles(mesh, udim);
-  std::map<int, std::vector<std::uint32_t>> by_tile;  // the triangles of each tile, in index order
-  for (std::uint32_t i = 0; i < tris.size(); ++i) by_tile[tris[i].tile].push_back(i);
+  // Per tile, per band of rows, the triangles that reach it in index order (4 bytes an entry: a
+  // triangle is set up again in each band it reaches, so nothing the size of a triangle's setup is
+  // kept per triangle).
+  const std::size_t bands = (std::size_t(height) + kBandRows - 1) / kBandRows;
+  std::map<int, std::vector<std::vector<std::uint32_t>>> tiles;
+  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+    glm::vec2 uv[3];
+    int tile = 0;
+    if (!tile_uvs(mesh, t, udim, uv, tile)) continue;
+    const auto [first, last] = bands_reached(uv, height);
+    if (first > last) continue;
+    auto& lists = tiles[tile];
+    if (lists.empty()) lists.resize(bands);
+    for (int b = first; b <= last; ++b) lists[std::size_t(b)].push_back(std::uint32_t(t));
+  }
   const std::size_t row = std::size_t(width);
-  for (const auto& [tile, members] : by_tile) {
-    std::vector<TexelTriangle> setup;
-    setup.reserve(members.size());
-    for (std::uint32_t i : members) {
-      setup.push_back(setup_texel_triangle(tris[i].uv[0], tris[i].uv[1], tris[i].uv[2], width, height));
-      if (!setup.back().valid() || setup.back().xmax < setup.back().xmin) setup.pop_back();
-    }
-    // Rows in bands, one band per chunk: each counts its own rows over every triangle of the tile.
-    const std::size_t band_rows = 16;
-    const std::size_t bands = (std::size_t(height) + band_rows - 1) / band_rows;
+  for (const auto& entry : tiles) {
+    const std::vector<std::vector<std::uint32_t>>& lists = entry.second;
     std::vector<UvOverlap> band_counts(bands);
     parallel_chunks(threads, bands, 1, [&](std::size_t b0, std::size_t b1) {
-      std::vector<std::uint16_t> depth(band_rows * row);
+      std::vector<std::uint16_t> depth(std::size_t(kBandRows) * row);
       for (std::size_t b = b0; b < b1; ++b) {
-        const int y_lo = int(b * band_rows), y_hi = std::min(height, int((b + 1) * band_rows)) - 1;
+        const int y_lo = int(b) * kBandRows, y_hi = std::min(height, int(b + 1) * kBandRows) - 1;
         std::fill(depth.begin(), depth.end(), std::uint16_t(0));
-        for (const TexelTriangle& tri : setup) {
-          if (tri.ymax < y_lo || tri.ymin > y_hi) continue;
+        for (std::uint32_t t : lists[b]) {
+          glm::vec2 uv[3];
+          int tile = 0;
+          tile_uvs(mesh, t, udim, uv, tile);
+          const TexelTriangle tri = setup_texel_triangle(uv[0], uv[1], uv[2], width, height);
+          if (!tri.valid()) continue;
           for (int y = std::max(tri.ymin, y_lo); y <= std::min(tri.ymax, y_hi); ++y)
             for (int x = tri.xmin; x <= tri.xmax; ++x) {
               double bary[3];
