@@ -46,13 +46,20 @@ glm::dvec3 unit_or_face(const glm::dvec3& n, const glm::dvec3& p0, const glm::dv
   return fl > 0.0 ? f / fl : glm::dvec3(0, 0, 1);
 }
 
-// An edge of the welded low-poly: the other end, the length, and the angle between the ray normals
-// at its ends (radians).
+// An edge of the welded low-poly: the other end, the length, and, where the ray normals at its ends
+// differ by more than twice kMaxTilt (a coarse part's sharp edge, the only ones tilt_ratio bounds),
+// the index of that angle in Adjacency::sharp_angle (kNotSharp otherwise: 16 bytes an edge end,
+// as many as a low-poly of a million triangles keeps six million of).
+constexpr std::uint32_t kNotSharp = std::numeric_limits<std::uint32_t>::max();
 struct Edge {
   std::uint32_t to;
-  double length, angle;
+  std::uint32_t sharp;
+  double length;
 };
-using Adjacency = std::vector<std::vector<Edge>>;
+struct Adjacency {
+  std::vector<std::vector<Edge>> edges;  // per welded vertex
+  std::vector<double> sharp_angle;       // radians, between the ray normals at the ends
+};
 
 // The largest ratio of the front distances at an edge's ends that keeps the rays between them
 // within `tilt` (radians) of the ray normals: a cage point interpolates the corners moved by
@@ -65,9 +72,9 @@ double tilt_ratio(double angle, double tilt) {
 
 // Over the edges: raises values so that none is more than slope x length below a neighbour's
 // (spread = true, from the largest down), or lowers them so that none is more than slope x length
-// above a neighbour's (spread = false, from the smallest up), nor, with tilt > 0, more than
-// tilt_ratio times it. Exact, in one pass of a heap.
-void ease(std::vector<double>& value, const Adjacency& adjacent, double slope, bool spread, double tilt = 0.0) {
+// above a neighbour's (spread = false, from the smallest up), nor, with `tilt`, more than
+// tilt_ratio(angle, kMaxTilt) times it. Exact, in one pass of a heap.
+void ease(std::vector<double>& value, const Adjacency& adjacent, double slope, bool spread, bool tilt = false) {
   using Item = std::pair<double, std::uint32_t>;
   auto cmp = [spread](const Item& a, const Item& b) { return spread ? a.first < b.first : a.first > b.first; };
   std::priority_queue<Item, std::vector<Item>, decltype(cmp)> heap(cmp);
@@ -76,10 +83,11 @@ void ease(std::vector<double>& value, const Adjacency& adjacent, double slope, b
     const auto [val, v] = heap.top();
     heap.pop();
     if (val != value[v]) continue;  // stale
-    for (const Edge& e : adjacent[v]) {
+    for (const Edge& e : adjacent.edges[v]) {
       const std::uint32_t u = e.to;
       double bound = spread ? val - slope * e.length : val + slope * e.length;
-      if (!spread && tilt > 0.0) bound = std::min(bound, val * tilt_ratio(e.angle, tilt));
+      if (!spread && tilt && e.sharp != kNotSharp)
+        bound = std::min(bound, val * tilt_ratio(adjacent.sharp_angle[e.sharp], kMaxTilt));
       if (spread ? bound > value[u] : bound < value[u]) {
         value[u] = bound;
         heap.push({bound, u});
@@ -183,7 +191,8 @@ std::vector<std::int8_t> facing_of(const CageBase& low) {
 Adjacency welded_edges(const CageBase& low, const std::vector<std::uint32_t>& weld, std::size_t nw) {
   const std::vector<glm::vec3>& pos = *low.positions;
   const std::vector<std::uint32_t>& index = *low.index;
-  Adjacency adjacent(nw);
+  Adjacency adjacent;
+  adjacent.edges.resize(nw);
   std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
   for (std::size_t t = 0; t < index.size() / 3; ++t)
     for (int c = 0; c < 3; ++c) {
@@ -202,8 +211,13 @@ Adjacency welded_edges(const CageBase& low, const std::vector<std::uint32_t>& we
   for (const auto& [a, b] : edges) {
     const double len = glm::length(wpos[a] - wpos[b]);
     const double angle = std::acos(std::clamp(glm::dot(wn[a], wn[b]), -1.0, 1.0));
-    adjacent[a].push_back({b, len, angle});
-    adjacent[b].push_back({a, len, angle});
+    std::uint32_t sharp = kNotSharp;
+    if (std::isfinite(tilt_ratio(angle, kMaxTilt))) {
+      sharp = std::uint32_t(adjacent.sharp_angle.size());
+      adjacent.sharp_angle.push_back(angle);
+    }
+    adjacent.edges[a].push_back({b, sharp, len});
+    adjacent.edges[b].push_back({a, sharp, len});
   }
   return adjacent;
 }
@@ -328,7 +342,7 @@ LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& h
   const Adjacency adjacent = welded_edges(low, weld, nw);
   ease(front, adjacent, need_slope, true);
   ease(rear, adjacent, need_slope, true);
-  ease(front_cap, adjacent, limit_slope, false, kMaxTilt);
+  ease(front_cap, adjacent, limit_slope, false, true);
   ease(rear_cap, adjacent, limit_slope, false);
   const std::vector<double> search = front;
   for (std::size_t w = 0; w < nw; ++w) {
