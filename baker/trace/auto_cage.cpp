@@ -278,10 +278,10 @@ LocalDistances measure_local_distances(const CageBase& low, const ProbeTarget& h
     for (std::size_t i = i0; i < i1; ++i) {
       rays.push_back({glm::vec3(probes[i].p), 0.0f, glm::vec3(probes[i].n), float(reach)});
       rays.push_back({glm::vec3(probes[i].p), 0.0f, glm::vec3(-probes[i].n), float(reach)});
-      ray_group.insert(ray_group.end(), 2, probes[i].group);
+      if (high.group) ray_group.insert(ray_group.end(), 2, probes[i].group);
     }
     std::vector<raycast::Hit> hits(rays.size());
-    intersect_first(*high.scene, rays.data(), hits.data(), rays.size(), high.group, ray_group.data());
+    intersect_first(*high.scene, rays.data(), hits.data(), rays.size(), high.group, high.group ? ray_group.data() : nullptr);
     for (std::size_t i = i0; i < i1; ++i)
       for (int k = 0; k < 2; ++k) {
         const raycast::Hit& h = hits[2 * (i - i0) + k];
