@@ -69,6 +69,9 @@ struct Conventions {
   bool same_convention = false;  // --same-convention
 };
 
+// nmdiff's verdict: the angles within tolerance and the conventions the same (exit 0).
+bool verdict_within(const DiffStats& s, const Conventions& seen) { return s.within && seen.verdict.differences.empty(); }
+
 nlohmann::json or_null(const std::string& s) { return s.empty() ? nlohmann::json(nullptr) : nlohmann::json(s); }
 
 nlohmann::json to_json(const std::string& a, const std::string& b, const DiffStats& s, const nmbake::diff::DiffOptions& o,
@@ -87,8 +90,8 @@ nlohmann::json to_json(const std::string& a, const std::string& b, const DiffSta
   j["over_5deg"] = s.over_5deg;
   j["texels_compared"] = s.texels_compared;
   j["worst"] = s.worst_x >= 0 ? nlohmann::json{{"x", s.worst_x}, {"y", s.worst_y}, {"deg", s.max_deg}} : nlohmann::json(nullptr);
-  j["within"] = s.within && seen.verdict.differences.empty();  // the verdict: the exit status is 0
-  j["within_tolerance"] = s.within;                            // the angles alone
+  j["within"] = verdict_within(s, seen);  // the verdict: the exit status is 0
+  j["within_tolerance"] = s.within;       // the angles alone
   j["tolerances"] = {
       {"max_mean_deg", o.tolerances.max_mean_deg}, {"max_p99_deg", o.tolerances.max_p99_deg}, {"max_deg", o.tolerances.max_deg}};
   j["skipped"] = {{"mask", s.skipped_mask}, {"alpha", s.skipped_alpha}, {"invalid_a", s.invalid_a}, {"invalid_b", s.invalid_b}};
@@ -326,7 +329,7 @@ void report(const CommandLine& cl, const Comparison& c) {
   outputs.commit();
   if (!cl.heatmap_path.empty()) std::cout << "heatmap: " << cl.heatmap_path << " (0 to " << fmt("%.3g", scale) << " deg)\n";
   DiffStats verdict = c.stats;
-  verdict.within = c.stats.within && c.seen.verdict.differences.empty();
+  verdict.within = verdict_within(c.stats, c.seen);
   std::cout << diff::summary_line(verdict) << std::endl;
 }
 
@@ -350,7 +353,7 @@ int run(int argc, char** argv) {
     check_outputs(cl);
     const Comparison c = compare_files(cl);
     report(cl, c);
-    return c.stats.within && c.seen.verdict.differences.empty() ? kWithin : kOutside;
+    return verdict_within(c.stats, c.seen) ? kWithin : kOutside;
   } catch (const nmbake::Error& e) {
     std::cerr << "error: " << one_line(e.what()) << "\n";
     if (e.code() == nmbake::ExitCode::memory) return kMemory;
