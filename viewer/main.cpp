@@ -102,8 +102,7 @@ int run(const Options& o) {
   io.toggles.map = !o.no_map;
   // The screenshot may not be an input (exit 1) nor a file that cannot be written (exit 3): checked
   // before anything is loaded or rendered.
-  nmbake::check_output_files({{"", o.low, "the low-poly"}, {"", o.map, "the map"}, {"", o.high, "the high-poly"}},
-                             {{"--screenshot", o.screenshot, "the screenshot"}});
+  nmview::check_screenshot(o.screenshot, o.low, o.map, o.high);
 
   const nmview::Scene scene = nmview::load_scene(o.low, o.map, o.high, std::cerr, o.decoding, o.uv_set);
   check_renderer_headroom();

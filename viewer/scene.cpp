@@ -61,14 +61,18 @@ Scene load_scene(const std::string& low_path, const std::string& map_path, const
   return scene;
 }
 
+void check_screenshot(const std::string& path, const std::string& low_path, const std::string& map_path,
+                      const std::string& high_path) {
+  nmbake::check_output_files({{"", low_path, "the low-poly"}, {"", map_path, "the map"}, {"", high_path, "the high-poly"}},
+                             {{"--screenshot", path, "the screenshot"}});
+}
+
 void write_screenshot(const std::string& path, const Rgba8Image& image, const Scene& scene) {
   nmbake::Image rgb(image.width, image.height, 3);
   for (std::size_t i = 0; i < std::size_t(image.width) * std::size_t(image.height); ++i)
     for (int c = 0; c < 3; ++c) rgb.pixels[3 * i + std::size_t(c)] = float(image.pixels[4 * i + std::size_t(c)]) / 255.0f;
   // Checked again here: the interactive viewer's screenshots are checked nowhere else.
-  nmbake::check_output_files(
-      {{"", scene.low_name, "the low-poly"}, {"", scene.map_name, "the map"}, {"", scene.high_name, "the high-poly"}},
-      {{"--screenshot", path, "the screenshot"}});
+  check_screenshot(path, scene.low_name, scene.map_name, scene.high_name);
   nmbake::OutputFiles outputs;
   nmbake::WriteOptions options;
   options.temp_path = outputs.add(path);

@@ -34,6 +34,12 @@ struct Scene {
 Scene load_scene(const std::string& low_path, const std::string& map_path, const std::string& high_path, std::ostream& log,
                  const DecodingOverrides& overrides = {}, unsigned uv_set = 0);
 
+// Refuses a screenshot path that is one of the scene's three files (UsageError) or a file that
+// cannot be written (OutputError: a special file, a folder, a dangling link), before anything is
+// written (io/output_files.h). An empty path passes.
+void check_screenshot(const std::string& path, const std::string& low_path, const std::string& map_path,
+                      const std::string& high_path);
+
 // Writes the RGB of `image` with nmbake::write_image (8-bit for PNG) under the output contract
 // (io/output_files.h): one of the scene's files (UsageError), a special file, a folder or a
 // dangling link (OutputError) refused, a temporary renamed into place when complete.
