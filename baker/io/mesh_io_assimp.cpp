@@ -253,8 +253,9 @@ std::string collada_array_problem(std::string_view bytes) {
 }
 
 // What the guards (mesh_io_assimp_guard.h) find in the bytes before Assimp reads them, or "".
-std::string shape_problem(const std::string& ext, std::string_view bytes) {
-  std::string_view json = bytes;
+// `json` receives a glTF's JSON: a .glb's JSON chunk, else the bytes.
+std::string shape_problem(const std::string& ext, std::string_view bytes, std::string_view& json) {
+  json = bytes;
   if (ext == "glb")
     if (std::string problem = glb_problem(bytes, json); !problem.empty()) return problem;
   if (ext == "glb" || ext == "gltf") {
@@ -299,13 +300,11 @@ bool assimp_reads(const std::string& ext) {
 ParsedMesh parse_assimp(const std::string& path, const std::string& ext, std::string_view bytes, bool read_path,
                         unsigned uv_set) {
   if (!signature_fits(ext, bytes)) fail(path, "is not a ." + ext + " file (its first bytes say otherwise)");
-  if (const std::string problem = shape_problem(ext, bytes); !problem.empty()) fail(path, "malformed: " + problem);
-  if (ext == "gltf" || ext == "glb") {
-    std::string_view json = bytes;
-    if (ext == "glb") glb_problem(bytes, json);  // passed in shape_problem
+  std::string_view json;
+  if (const std::string problem = shape_problem(ext, bytes, json); !problem.empty()) fail(path, "malformed: " + problem);
+  if (ext == "gltf" || ext == "glb")
     if (const std::string problem = gltf_accessor_problem(json, memory_budget_bytes()); !problem.empty())
       throw ResourceError(path + ": " + problem);
-  }
   ParsedMesh parsed;
   // Assimp recurses over the file and its node tree; the importer (which frees the tree, again
   // recursively) lives and dies on the big stack.
