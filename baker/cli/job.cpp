@@ -313,13 +313,12 @@ void bake_job(const Args& a, const JobEnv& env) {
   // HIGH the wrong way round, UVs stacked deep.
   const PairBoxes boxes = compare_boxes(low, high, o.threads);
   run.pair = pair_report(boxes);
-  if (boxes.mismatch != PairBoxes::Mismatch::none && !a.allow_mismatch)
-    throw InputError(mismatch_text(boxes, a.low, a.high, false));
+  if (boxes.mismatched() && !a.allow_mismatch) throw InputError(mismatch_text(boxes, a.low, a.high, false));
   const UvOverlap overlap = measure_map_overlap(low, o.width, o.height, has_udim(a.output), o.threads);
   run.uv_overlap = overlap_report(overlap);
   if (overlap_refused(overlap) && !a.allow_overlap) throw InputError(overlap_text(overlap, 0, a.low, false));
   env.progress.above([&] {
-    if (boxes.mismatch != PairBoxes::Mismatch::none) warnings.add({"warning: " + mismatch_text(boxes, a.low, a.high, true)});
+    if (boxes.mismatched()) warnings.add({"warning: " + mismatch_text(boxes, a.low, a.high, true)});
     if (const auto swapped = swap_warning(low.triangle_count(), high.triangle_count(), high.has_uvs(), a.low, a.high))
       warnings.add({*swapped});
     warnings.add(load_warnings(run.low_info, a.low));
@@ -371,7 +370,7 @@ void bake_job(const Args& a, const JobEnv& env) {
   if (env.keep_progress) env.progress.hold();
   else env.progress.finish();
   warnings.add(bake_warnings(s, run.high_topology, a.low, a.high, uv_tiles_note(low, a, o.width, o.height),
-                             {boxes.mismatch != PairBoxes::Mismatch::none, &overlap}));
+                             {boxes.mismatched(), &overlap}));
   warnings.check_strict();
   run.warnings = warnings.all();
   run.seconds_total = std::chrono::duration<double>(Clock::now() - env.start).count();

@@ -70,7 +70,7 @@ PairBoxes compare_boxes(const Mesh& low, const Mesh& high, int threads) {
 }
 
 std::string mismatch_text(const PairBoxes& b, const std::string& low_path, const std::string& high_path, bool allowed) {
-  if (b.mismatch == PairBoxes::Mismatch::none) return "";
+  if (!b.mismatched()) return "";
   const std::string low = low_path + " (LOW)", high = high_path + " (HIGH)";
   const bool high_larger = b.high.diagonal() >= b.low.diagonal();
   const std::string sizes = format_line("%s is %.3g times the size of %s", (high_larger ? high : low).c_str(), b.size_ratio,

@@ -31,6 +31,7 @@ struct PairBoxes {
   // has a length): 1 when one box's extent holds the other's, 0 when they are apart.
   double overlap = 1.0;
   enum class Mismatch { none, apart, size } mismatch = Mismatch::none;
+  bool mismatched() const { return mismatch != Mismatch::none; }
 };
 
 // Thresholds: boxes sharing less than a quarter of the smaller extent along some axis lie apart (most
