@@ -8,7 +8,6 @@
 #include <fstream>
 #include <iostream>
 #include <map>
-#include <new>
 #include <optional>
 #include <string>
 
@@ -16,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/numbers.h"
+#include "cli/shell.h"
 #include "core/errors.h"
 #include "io/image_io.h"
 #include "io/mesh_io.h"
@@ -31,13 +31,6 @@ using diff::DiffStats;
 
 // Exit status, as documented in --help.
 constexpr int kWithin = 0, kOutside = 1, kError = 2, kOutput = 3, kMemory = 4;
-
-std::string one_line(std::string s) {
-  for (char& c : s)
-    if (c == '\n' || c == '\r') c = ' ';
-  while (!s.empty() && s.back() == ' ') s.pop_back();
-  return s;
-}
 
 std::string fmt(const char* format, double v) {
   char buf[64];
@@ -218,14 +211,7 @@ std::optional<int> parse_command_line(int argc, char** argv, CommandLine& cl) {
   add_arguments(app, cl);
   nmbake::require_numbers(app);
 
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    std::cerr << "error: " << one_line(e.what()) << " (see nmdiff --help)\n";
-    return kError;
-  }
+  if (const std::optional<int> status = nmbake::parse_command_line(app, argc, argv, "nmdiff")) return status;
   cl.green_given = app.count("--green-a") + app.count("--green-b") > 0;
   apply_choices(cl);
   return std::nullopt;
@@ -343,35 +329,23 @@ void check_outputs(const CommandLine& cl) {
 
 }  // namespace
 
-// The comparison's exit status, or that of the error. Messages that cannot be written (a closed
-// or full stdout) change neither the status nor the files (protect_standard_streams).
+// The comparison's exit status. Messages that cannot be written (a closed or full stdout) change
+// neither the status nor the files (protect_standard_streams).
 int run(int argc, char** argv) {
   CommandLine cl;
   if (const std::optional<int> status = parse_command_line(argc, argv, cl)) return *status;
-
-  try {
-    check_outputs(cl);
-    const Comparison c = compare_files(cl);
-    report(cl, c);
-    return verdict_within(c.stats, c.seen) ? kWithin : kOutside;
-  } catch (const nmbake::Error& e) {
-    std::cerr << "error: " << one_line(e.what()) << "\n";
-    if (e.code() == nmbake::ExitCode::memory) return kMemory;
-    if (e.code() == nmbake::ExitCode::output) return kOutput;
-  } catch (const std::bad_alloc&) {
-    std::cerr << "error: out of memory\n";
-    return kMemory;
-  } catch (const std::exception& e) {
-    std::cerr << "error: " << one_line(e.what()) << "\n";
-  }
-  return kError;
+  check_outputs(cl);
+  const Comparison c = compare_files(cl);
+  report(cl, c);
+  return verdict_within(c.stats, c.seen) ? kWithin : kOutside;
 }
 
 int main(int argc, char** argv) {
   nmbake::protect_standard_streams();
   nmbake::remove_temporaries_on_signals();
   nmbake::preload_image_io();  // the image library module: loads beside the parsing, or first under ulimit -v
-  const int code = run(argc, argv);
+  // Errors: 2, also for a bad command line (1 means "outside tolerance"), 3 output, 4 memory.
+  const int code = nmbake::run_command([&] { return run(argc, argv); }, {kError, kError, kOutput, kMemory});
   nmbake::wait_for_image_io();  // never exit while the image library's constructors run
   return code;
 }

@@ -194,13 +194,11 @@ TEST(AssimpGuard, FbxRecordsNestedTooDeep) {
   EXPECT_EQ(fbx_problem("; FBX 7.4.0 project file"), "");
 }
 
-TEST(AssimpGuard, LibraryTextIsOneShortLine) {
-  EXPECT_EQ(one_line("  a\n\n b\t\tc \r\n"), "a b c");
-  EXPECT_EQ(one_line(std::string("x\x01y", 3)), "x?y");
-  const std::string cut = one_line(repeat("word ", 100));
+TEST(AssimpGuard, LibraryTextIsCutTo160Characters) {
+  const std::string cut = one_line(repeat("word ", 100), kAssimpMessageMax);
   EXPECT_EQ(cut.size(), 160u);
   EXPECT_EQ(cut.substr(cut.size() - 10), "word wo...");
-  EXPECT_EQ(one_line(repeat("x", 160)), repeat("x", 160));
+  EXPECT_EQ(one_line(repeat("x", 160), kAssimpMessageMax), repeat("x", 160));
 }
 
 TEST(AssimpGuard, StackGrowsWithTheFile) {

@@ -12,13 +12,14 @@
 #include <cstdint>
 #include <cstring>
 #include <iostream>
-#include <new>
+#include <optional>
 #include <sstream>
 #include <string>
 
 #include <CLI/CLI.hpp>
 
 #include "cli/numbers.h"
+#include "cli/shell.h"
 #include "compare.h"
 #include "core/errors.h"
 #include "core/memory_budget.h"
@@ -190,29 +191,8 @@ int run_command_line(int argc, char** argv) {
   app.add_option("--show", o.show, "Start with toggles on: wire,diff,tangent,specular,nolabels");
   nmbake::require_numbers(app);
 
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    std::cerr << "error: " << e.what() << " (see --help)\n";
-    return int(nmbake::ExitCode::usage);
-  }
-
-  try {
-    return run(o);
-  } catch (const nmbake::Error& e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return int(e.code());
-  } catch (const std::bad_alloc&) {
-    std::cerr << "error: out of memory\n";
-    return int(nmbake::ExitCode::memory);
-  } catch (const std::exception& e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return int(nmbake::ExitCode::output);
-  }
+  if (const std::optional<int> status = nmbake::parse_command_line(app, argc, argv, "nmview")) return *status;
+  return run(o);
 }
 
 }  // namespace
@@ -223,7 +203,7 @@ int main(int argc, char** argv) {
   nmbake::protect_standard_streams();
   nmbake::remove_temporaries_on_signals();
   nmbake::preload_image_io();  // the image library module: loads beside the parsing, or first under ulimit -v
-  const int code = run_command_line(argc, argv);
+  const int code = nmbake::run_command([&] { return run_command_line(argc, argv); });
   nmbake::wait_for_image_io();  // never exit while the image library's constructors run
   return code;
 }

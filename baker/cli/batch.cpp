@@ -12,6 +12,7 @@
 #include "cli/job.h"
 #include "cli/outputs.h"
 #include "cli/progress.h"
+#include "cli/shell.h"
 #include "core/errors.h"
 #include "io/text_file.h"
 #include "pipeline/bake.h"
@@ -236,15 +237,10 @@ int run_batch(const BatchArgs& b, const std::function<bool()>& interrupted, cons
       bake_job(a, env);
     } catch (const Cancelled&) {
       throw;
-    } catch (const Error& e) {
-      code = int(e.code());
-      error = e.what();
-    } catch (const std::bad_alloc&) {
-      code = int(ExitCode::memory);
-      error = std::string("out of memory") + (*doing ? std::string(" while ") + *doing : "");
-    } catch (const std::exception& e) {
-      code = int(ExitCode::input);
-      error = e.what();
+    } catch (...) {
+      const Failure f = failure_of(std::current_exception(), {}, doing);
+      code = f.status;
+      error = f.message;
     }
     if (code) {
       progress.above([&] {

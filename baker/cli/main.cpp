@@ -2,41 +2,23 @@
 #include <unistd.h>
 
 #include <atomic>
-#include <cctype>
-#include <cerrno>
 #include <chrono>
-#include <climits>
 #include <csignal>
 #include <cstdio>
-#include <cstring>
-#include <ctime>
-#include <filesystem>
-#include <future>
-#include <iostream>
-#include <new>
-#include <sstream>
+#include <optional>
 #include <string>
-#include <system_error>
-#include <thread>
-#include <tuple>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "pipeline/bake.h"
-#include "pipeline/error_estimate.h"
-#include "core/errors.h"
-#include "core/normals.h"
 #include "io/image_io.h"
-#include "io/mesh_io.h"
-#include "io/text_file.h"
+#include "io/output_files.h"
 #include "cli/args.h"
 #include "cli/batch.h"
 #include "cli/job.h"
-#include "cli/outputs.h"
 #include "cli/progress.h"
-#include "cli/report.h"
-#include "core/parallel.h"
-#include "cli/warnings.h"
+#include "cli/shell.h"
 
 namespace {
 
@@ -84,15 +66,7 @@ int run(int argc, char** argv) {
   Args a;
   CLI::App app{"nmbake: bake a tangent-space normal map from a high-poly mesh onto a low-poly mesh with UVs.", "nmbake"};
   add_options(app, a);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForVersion& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    throw UsageError(e.what());
-  }
+  if (const std::optional<int> status = parse_command_line(app, argc, argv, "nmbake")) return *status;
   // OpenImageIO loads on its own thread while the meshes are read; not for --help, --version or a
   // command line in error (loading it took 0.37 s of `nmbake --version`), nor when every image is
   // a PNG, which nmbake writes itself (the load took 0.2 s of CPU from a 2-core bake).
@@ -107,34 +81,24 @@ int run(int argc, char** argv) {
   return 0;
 }
 
+// A bake stopped by SIGINT, SIGTERM or SIGHUP: exit 128 + the signal's number.
+int run_interruptible(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const Cancelled&) {
+    const int sig = g_signal.load() ? g_signal.load() : SIGINT;
+    std::fprintf(stderr, "error: interrupted by %s; no output written\n", signal_name(sig));
+    return 128 + sig;
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   // A closed or full stdout or stderr loses messages, never changes the outputs or the exit status;
   // a file past ulimit -f is a failed write (exit 3), not a SIGXFSZ death.
   protect_standard_streams();
-  int code = 0;
-  try {
-    code = run(argc, argv);
-  } catch (const nmbake::Cancelled&) {
-    const int sig = g_signal.load() ? g_signal.load() : SIGINT;
-    std::fprintf(stderr, "error: interrupted by %s; no output written\n", signal_name(sig));
-    code = 128 + sig;
-  } catch (const nmbake::Error& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    code = int(e.code());
-  } catch (const std::bad_alloc&) {
-    std::fprintf(stderr, "error: out of memory%s%s\n", g_doing ? " while " : "", g_doing ? g_doing : "");
-    code = int(nmbake::ExitCode::memory);
-  } catch (const std::system_error& e) {
-    // A thread or resource the system would not give (EAGAIN under ulimit -v): out of memory.
-    const bool memory = e.code() == std::errc::resource_unavailable_try_again || e.code() == std::errc::not_enough_memory;
-    std::fprintf(stderr, "error: %s%s\n", memory ? "out of memory: " : "", e.what());
-    code = memory ? int(nmbake::ExitCode::memory) : 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    code = 2;
-  }
+  const int code = run_command([&] { return run_interruptible(argc, argv); }, {}, &g_doing);
   wait_for_image_io();  // never exit while the image library's constructors run
   return code;
 }

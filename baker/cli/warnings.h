@@ -33,11 +33,9 @@ std::vector<std::string> bake_warnings(const BakeStats& stats, const MeshTopolog
 // (normals) one had length 0. `path` names the file.
 std::vector<std::string> load_warnings(const MeshLoadInfo& info, const std::string& path);
 
-// Exit code of --strict when there were warnings: no output written.
-constexpr int kStrictExitCode = 5;
-
+// --strict when there were warnings (exit 5): no output written.
 struct StrictError : Error {
-  explicit StrictError(const std::string& what) : Error(static_cast<ExitCode>(kStrictExitCode), what) {}
+  explicit StrictError(const std::string& what) : Error(ExitCode::strict, what) {}
 };
 
 // Every warning of a run, in order: printed as it comes ("nmbake: warning: ..."; not with

@@ -5,8 +5,10 @@
 // are asserts, degenerate but legal geometry is counted and never throws.
 #pragma once
 
+#include <cstddef>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace nmbake {
 
@@ -16,6 +18,7 @@ enum class ExitCode : int {
   input = 2,   // unreadable or invalid input file
   output = 3,  // output could not be written
   memory = 4,  // out of memory or refused size
+  strict = 5,  // a warning under --strict
 };
 
 class Error : public std::runtime_error {
@@ -39,5 +42,10 @@ struct OutputError : Error {
 struct ResourceError : Error {
   explicit ResourceError(const std::string& what) : Error(ExitCode::memory, what) {}
 };
+
+// A message as one line, as every error of the three commands is printed: line breaks and runs of
+// white space as one space, control bytes as '?', no blanks at either end; cut to `max` characters
+// with "..." when max > 0.
+std::string one_line(std::string_view text, std::size_t max = 0);
 
 }  // namespace nmbake

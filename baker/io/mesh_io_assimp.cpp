@@ -323,9 +323,9 @@ ParsedMesh parse_assimp(const std::string& path, const std::string& ext, std::st
     });
     if (!files->refused.empty())
       fail(path, "refers to " + files->refused + ", which is not a regular file (a FIFO, a device or a folder)");
-    if (scene && !dropped.empty()) fail(path, "malformed: " + one_line(dropped));
+    if (scene && !dropped.empty()) fail(path, "malformed: " + one_line(dropped, kAssimpMessageMax));
     if (!scene || !scene->mRootNode) {
-      const std::string why = one_line(importer.GetErrorString());
+      const std::string why = one_line(importer.GetErrorString(), kAssimpMessageMax);
       fail(path, "cannot read as ." + ext + (why.empty() ? std::string() : ": " + why));
     }
     parsed = SceneReader(path, *scene, unit_scale_to_metres(*scene, ext), uv_set).read();

@@ -351,25 +351,6 @@ std::string fbx_problem(std::string_view bytes) {
   return fbx_models_problem(models);
 }
 
-std::string one_line(std::string_view text, std::size_t max) {
-  std::string out;
-  for (char c : text) {
-    const bool blank = c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v';
-    if (blank) {
-      if (!out.empty() && out.back() != ' ') out += ' ';
-    } else {
-      out += static_cast<unsigned char>(c) < 32 || c == 127 ? '?' : c;
-    }
-  }
-  while (!out.empty() && out.back() == ' ') out.pop_back();
-  if (out.size() > max) {
-    out.resize(max - 3);
-    while (!out.empty() && out.back() == ' ') out.pop_back();
-    out += "...";
-  }
-  return out;
-}
-
 std::size_t reader_stack_bytes(std::size_t size) {
   const std::size_t mib = std::size_t(1) << 20;
   return std::clamp<std::size_t>(size > (std::size_t(4096) * mib) / 256 ? 4096 * mib : size * 256, 256 * mib, 4096 * mib);

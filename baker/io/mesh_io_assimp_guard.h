@@ -42,9 +42,8 @@ std::string gltf_accessor_problem(std::string_view json, std::uint64_t budget);
 // ever). Damaged records are left to Assimp.
 std::string fbx_problem(std::string_view bytes);
 
-// Assimp's error text as one short line: line breaks and runs of white space as one space,
-// control bytes as '?', cut to `max` characters with "...".
-std::string one_line(std::string_view text, std::size_t max = 160);
+// The longest line of Assimp's own error text an error message carries (one_line, errors.h).
+constexpr std::size_t kAssimpMessageMax = 160;
 
 // The stack for reading a file of `size` bytes: 256 times the size, at least 256 MiB, at most 4 GiB
 // (reserved, not used: pages are touched only as deep as the reader goes).
