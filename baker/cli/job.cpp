@@ -345,8 +345,7 @@ void bake_job(const Args& a, const JobEnv& env) {
   }
   const BakeStats& s = r.stats;
   // Topology checks are only reported: they run beside the image write, after the bake has freed
-  // its BVH (0.1 s of CPU and 45 MB for 1M triangles; beside the bake they took time from its
-  // threads and raised its peak).
+  // its BVH, so that they take neither the bake's threads nor its peak memory.
   auto topology = std::async(std::launch::async, [&high, threads = o.threads] { return inspect_topology(high, threads); });
   if (!a.quiet) env.progress.above([&] { print_distances(s); });
   o.on_stage = nullptr;  // the estimate's re-bake is one stage

@@ -5,7 +5,7 @@
 
 namespace nmbake {
 
-// CLI11 alone took '' for 0 and let leading blanks, octal (010 was 8) and hex (0x10) through.
+// What CLI11 alone would take: '' as 0, leading blanks, octal (010 as 8) and hex (0x10).
 bool is_number(const std::string& word, bool integer) {
   std::size_t first = word.size() > 1 && word[0] == '+' && word[1] != '-' ? 1 : 0;
   if (word.empty() || word.find_first_of(" \t\n\r\f\v") != std::string::npos) return false;

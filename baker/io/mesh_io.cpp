@@ -57,10 +57,9 @@ void check_regular_file(const std::string& path) {
   if (!S_ISREG(st.st_mode)) fail(path, "is not a regular file");
 }
 
-// The whole file, read into memory left unset (a std::string would be zeroed first: a
-// third pass over the 25 MB of a 1M-triangle sculpt). Mapping the file instead was 0.015 s faster
-// still, but raised the bake's peak memory by 16 MiB in most runs of that sculpt: the C library
-// sizes its later allocations by the largest block freed so far, and this one was it.
+// The whole file, read into memory left unset (a std::string would be zeroed first: a third pass
+// over the file). Not mapped: the C library sizes its later allocations by the largest block
+// freed so far, and a mapping freed after loading raised the bake's peak memory.
 class FileBytes {
  public:
   explicit FileBytes(const std::string& path) {

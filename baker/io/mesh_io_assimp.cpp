@@ -229,7 +229,7 @@ bool signature_fits(const std::string& ext, std::string_view bytes) {
 }
 
 // A COLLADA array (<p>, <vcount>, <float_array>, ...) holding bytes that are not text: Assimp's
-// reader takes them for numbers (a fuzzed <p> made it allocate 12 GB over 40 s before it gave up).
+// reader takes them for numbers and can allocate without bound (tests/fuzz found it).
 // Returns the problem, or "" when every array holds printable ASCII and white space (exporters
 // write commas and such, which Assimp reads).
 std::string collada_array_problem(std::string_view bytes) {

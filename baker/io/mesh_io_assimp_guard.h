@@ -1,7 +1,6 @@
 // Checks made before a file reaches Assimp, and the thread it reads on (mesh_io_assimp.cpp).
-// Assimp recurses over what it reads (JSON, XML, FBX records, node trees: a 10000-deep DAE or a
-// 50000-node glTF chain overflowed the stack, SIGSEGV) and trusts lengths in headers (a GLB chunk
-// claiming 4 GB was allocated). Each check returns the problem, or "" when it finds none; what a
+// Assimp recurses over what it reads (JSON, XML, FBX records, node trees: deep enough ones
+// overflow the stack) and trusts lengths in headers (it allocates what a GLB chunk claims). Each check returns the problem, or "" when it finds none; what a
 // check cannot see is left to Assimp, which reads on a thread whose stack grows with the file.
 // Pure functions of the bytes: no Assimp here.
 #pragma once
@@ -33,8 +32,8 @@ std::string gltf_nodes_problem(std::string_view json);
 std::string collada_nodes_problem(std::string_view xml);
 
 // A glTF accessor without a buffer view (zeros, or sparse) of more than a quarter of `budget` bytes
-// (counted at 4 bytes a component): Assimp allocates it, about three times over (500M sparse
-// VEC3s took 19.5 GB and 55 s). The caller refuses it as a size (exit 4).
+// (counted at 4 bytes a component): Assimp allocates it, about three times over. The caller
+// refuses it as a size (exit 4).
 std::string gltf_accessor_problem(std::string_view json, std::uint64_t budget);
 
 // An FBX file's records (binary) nested more than kMaxNesting deep, or its models' tree (by "OO"

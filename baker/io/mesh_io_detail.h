@@ -99,8 +99,8 @@ constexpr std::size_t kMaxFanCorners = 64;
 // most tools cut it, up to kMaxFanCorners; beyond, corners are cut off in passes (every second
 // corner of what is left, each with its two neighbours), so triangles halve in number and double in
 // size from pass to pass. A fan of n corners is n thin triangles spanning the polygon, whose boxes
-// all overlap: every ray met all of them (a one-million-corner disc took minutes at 64^2); the
-// passes give boxes that overlap about log n deep. Both cover a convex polygon exactly.
+// all overlap, so every ray would meet all of them; the passes give boxes that overlap about
+// log n deep. Both cover a convex polygon exactly.
 inline void add_polygon(ParsedMesh& out, const Corner* corners, std::size_t n, std::uint32_t face) {
   Mesh& m = out.mesh;
   auto triangle = [&](std::size_t a, std::size_t b, std::size_t c) {
@@ -165,7 +165,7 @@ bool parse_real(std::string_view token, Real& out) {
   if (first == last || result.ptr != last) return false;
   if (result.ec == std::errc::result_out_of_range) {
     // from_chars leaves `out` untouched here; strtod tells overflow (inf) from underflow (0). The
-    // whole token is copied: a fixed buffer cut "7.000...0001e400" to "7.000..." and read 7.
+    // whole token is copied, however long (a fixed buffer would cut "7.000...0001e400" to 7).
     const std::string whole(first, last);
     out = static_cast<Real>(std::strtod(whole.c_str(), nullptr));
     return true;

@@ -16,15 +16,13 @@ namespace {
 // How far (radians) rays between two corners may lean from the ray normals where a neighbouring
 // part limits one corner's front distance (ease): 20 degrees. Only edges whose ray normals differ
 // by more than twice that are bound (a coarse part of fewer than 9 sides): along gentler ones the
-// distances' weighting cannot lean rays that far. Measured on the generated thin parts
-// (tests/procedural/thin_parts.h): 2 degrees cost nmview --compare up to 1 dB, 20 removed the
-// suspect texels of three-sided legs (0.29%) at no cost on the others.
+// distances' weighting cannot lean rays that far. Chosen on the generated thin parts
+// (tests/procedural/thin_parts.h): a tighter bound cost appearance, a looser one left suspect
+// texels on three-sided legs.
 constexpr double kMaxTilt = 0.349;
 // How many points the dense probes of a low-poly with few triangles take in all (make_probes): the
 // full 8 x 8 grid up to kDenseProbes / 64 triangles (the coarse parts this is for), beyond that a
-// quarter of it, so a low-poly of a few thousand triangles pays for its edge midpoints only (the
-// distances stage of torus_s3 at 73k points took 0.055 s more than without; 18k points on 6144
-// triangles).
+// quarter of it, so a low-poly of a few thousand triangles pays for its edge midpoints only.
 constexpr double kDenseProbes = 100000.0;
 constexpr double kDenseProbesFiner = 25000.0;
 
