@@ -370,8 +370,5 @@ int run(int argc, char** argv) {
 int main(int argc, char** argv) {
   nmbake::protect_standard_streams();
   nmbake::remove_temporaries_on_signals();
-  nmbake::preload_image_io();  // the image library module: loads beside the parsing, or first under ulimit -v
-  const int code = run(argc, argv);
-  nmbake::wait_for_image_io();  // never exit while the image library's constructors run
-  return code;
+  return run(argc, argv);
 }

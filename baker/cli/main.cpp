@@ -26,7 +26,6 @@
 #include "pipeline/error_estimate.h"
 #include "core/errors.h"
 #include "core/normals.h"
-#include "io/image_io.h"
 #include "io/mesh_io.h"
 #include "io/text_file.h"
 #include "cli/args.h"
@@ -76,7 +75,6 @@ int run(int argc, char** argv) {
   if (wants_batch(argc, argv)) {
     BatchArgs b;
     if (const int code = parse_batch_args(argc, argv, b); code >= 0) return code;
-    preload_image_io();
     const auto start = Clock::now();
     install_signal_handlers();
     return run_batch(b, interrupted, &g_doing, start);
@@ -93,10 +91,6 @@ int run(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     throw UsageError(e.what());
   }
-  // OpenImageIO loads on its own thread while the meshes are read; not for --help, --version or a
-  // command line in error (loading it took 0.37 s of `nmbake --version`), nor when every image is
-  // a PNG, which nmbake writes itself (the load took 0.2 s of CPU from a 2-core bake).
-  if (needs_image_module(a)) preload_image_io();
   finish_args(a, app);
   const auto start = Clock::now();
   install_signal_handlers();
@@ -135,6 +129,5 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "error: %s\n", e.what());
     code = 2;
   }
-  wait_for_image_io();  // never exit while the image library's constructors run
   return code;
 }
