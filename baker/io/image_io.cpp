@@ -47,9 +47,8 @@ std::string one_line(std::string s) {
 }
 
 // The encoders' bytes go through this proxy straight to a file descriptor, so that the first
-// system error (ENOSPC, EIO) is known exactly: through stdio, OpenImageIO's PNG writer only says
-// "Write error at position N" once per failed call (a 29 KB message on a full disk). Small writes
-// (libpng writes chunk headers of 4-13 bytes) are gathered in a buffer.
+// system error (ENOSPC, EIO) is known exactly, not as OpenImageIO's "Write error at position N"
+// once per failed call. Small writes are gathered in a buffer.
 class FileProxy final : public OIIO::Filesystem::IOProxy {
  public:
   FileProxy(const std::string& name, int fd) : IOProxy(name, Write), fd_(fd) { buffer_.reserve(kBuffer); }
@@ -203,7 +202,7 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
     const std::function<void()> run;
     ~OnExit() { run(); }
   } on_exit{abandon};
-  made.emplace(temp, fd);  // its buffer allocated here, not while libpng's C code calls it
+  made.emplace(temp, fd);  // its buffer allocated here, not while an encoder's C code calls it
   FileProxy& proxy = *made;
   // The first failure's reason: the system's for a failed write, else OpenImageIO's.
   auto discard = [&](const std::string& message, int err) {

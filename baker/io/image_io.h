@@ -34,7 +34,7 @@ struct WriteOptions {
   // 8-bit output: triangular noise of one step before rounding, the same for a texel whatever
   // thread or run writes it.
   bool dither = false;
-  // Threads an encoder may use (the quantization to 8 or 16 bits, PNG's bands, png_parallel.h): 0 =
+  // Threads an encoder may use (the quantization to 8 or 16 bits, PNG's bands, png_write.h): 0 =
   // all cores. The bytes written do not depend on it.
   int threads = 0;
 };

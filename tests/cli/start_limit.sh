@@ -20,3 +20,9 @@ start_limit() {
     high=$((high + 20))
   done
 }
+# Sets `start` to start_limit CMD [ARGS...], or fails the test (exit 1) where there is none.
+find_start() {
+  start=$(start_limit "$@")
+  [ -n "$start" ] || { echo "FAIL: $* does not start under 4000 MB"; exit 1; }
+  echo "$* starts under ulimit -v $start MB"
+}

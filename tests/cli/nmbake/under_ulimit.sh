@@ -9,9 +9,7 @@ nmbake=$1 out=$2 low=$3 high=$4 repeats=$5
 shift 5
 source "$(dirname "$0")/../start_limit.sh"
 mkdir -p "$out"
-start=$(start_limit "$nmbake" --version)
-[ -n "$start" ] || { echo "FAIL: nmbake --version does not start under 4000 MB"; exit 1; }
-echo "nmbake starts under ulimit -v $start MB"
+find_start "$nmbake" --version
 failed=0 refused=0 baked=0
 for offset in "$@"; do
   mb=$((start + offset))

@@ -8,9 +8,7 @@ set -u
 nmdiff=$1 out=$2 map=$3
 shift 3
 source "$(dirname "$0")/../start_limit.sh"
-start=$(start_limit "$nmdiff" --help)
-[ -n "$start" ] || { echo "FAIL: nmdiff --help does not start under 4000 MB"; exit 1; }
-echo "nmdiff starts under ulimit -v $start MB"
+find_start "$nmdiff" --help
 failed=0 refused=0 compared=0
 for offset in "$@"; do
   mb=$((start + offset))
