@@ -1,7 +1,7 @@
 // The PNG encoder's settings measured on a real map (the 1M-triangle sculpt's 2048^2 8-bit map of
 // section 3): zlib level, libpng's row filters and zlib's strategy against file size and encode
-// time, which is how PngSettings' defaults (baker/io/png_write.h) were chosen; and the default
-// settings in bands on several threads (io/png_parallel.h), as nmbake writes PNG.
+// time (libpng's own encoder, png_libpng.h), which is how PngSettings' defaults (baker/io/png_write.h)
+// were chosen; and the default settings in bands on several threads, as nmbake writes PNG.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -14,8 +14,8 @@
 #include "bench_bake.h"
 #include "bench_support.h"
 #include "io/image_io.h"
-#include "io/png_parallel.h"
 #include "io/png_write.h"
+#include "png_libpng.h"
 
 namespace nmbake::bench {
 
@@ -29,7 +29,7 @@ bool fs_exists(const std::string& path) {
 struct Setting {
   const char* name;
   PngSettings s;
-  int threads = -1;  // -1: libpng's one stream (encode_png); else png_parallel's bands on this many (0: all cores)
+  int threads = -1;  // -1: libpng's one stream (encode_png_libpng); else nmbake's bands on this many (0: all cores)
 };
 
 }  // namespace
@@ -81,9 +81,8 @@ void run_png_settings(BenchRun& run, const Scenes& scenes) {
       const auto t0 = Clock::now();
       std::string error;
       const std::vector<unsigned char> bytes =
-          st.threads < 0
-              ? encode_png(rows.data(), image.width, image.height, image.channels, 8, {}, st.s, &error)
-              : encode_png_parallel(rows.data(), image.width, image.height, image.channels, 8, {}, st.s, st.threads, &error);
+          st.threads < 0 ? encode_png_libpng(rows.data(), image.width, image.height, image.channels, 8, {}, st.s, &error)
+                         : encode_png(rows.data(), image.width, image.height, image.channels, 8, {}, st.s, st.threads, &error);
       best = std::min(best, since(t0));
       size = bytes.size();
     }

@@ -19,9 +19,9 @@ endif()
 add_library(nmbake_oiio INTERFACE)
 add_library(nmbake::oiio ALIAS nmbake_oiio)
 target_link_libraries(nmbake_oiio INTERFACE PkgConfig::OIIO)
-# PNG maps are written with libpng directly (baker/io/png_write.cpp), without OpenImageIO.
+# libpng: the bench's and tests' reference PNG encoder (bench/png_libpng.cpp).
 nmbake_require(PNG libpng-dev)
-# zlib compresses PNG's bands on several threads (baker/io/png_parallel.cpp).
+# zlib compresses PNG's bands on several threads (baker/io/png_write.cpp).
 nmbake_require(ZLIB zlib1g-dev)
 nmbake_require(glm libglm-dev)
 nmbake_require(nlohmann_json nlohmann-json3-dev)

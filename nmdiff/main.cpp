@@ -343,9 +343,6 @@ int run(int argc, char** argv) {
 int main(int argc, char** argv) {
   nmbake::protect_standard_streams();
   nmbake::remove_temporaries_on_signals();
-  nmbake::preload_image_io();  // the image library module: loads beside the parsing, or first under ulimit -v
   // Errors: 2, also for a bad command line (1 means "outside tolerance"), 3 output, 4 memory.
-  const int code = nmbake::run_command([&] { return run(argc, argv); }, {kError, kError, kOutput, kMemory});
-  nmbake::wait_for_image_io();  // never exit while the image library's constructors run
-  return code;
+  return nmbake::run_command([&] { return run(argc, argv); }, {kError, kError, kOutput, kMemory});
 }

@@ -1,8 +1,8 @@
-// PNG on several threads (io/png_parallel.cpp): for every single filter, strategy, channel count and
+// PNG on several threads (io/png_write.cpp): for every single filter, strategy, channel count and
 // bit depth, the file reads back (through OpenImageIO) as exactly the rows given, as libpng's own
-// encoding of them does; its bytes are the same on 1, 2 and 3 threads; images shorter than its
-// bands, one texel wide, or one texel at all work; settings it does not take go to libpng;
-// malformed input is an error, not a file.
+// encoding of them does (bench/png_libpng.cpp); its bytes are the same on 1, 2 and 3 threads;
+// images shorter than its bands, one texel wide, or one texel at all work; settings it does not
+// take and malformed input are an error, not a file.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -14,7 +14,8 @@
 
 #include "io/image_io.h"
 #include "io/image_write.h"
-#include "io/png_parallel.h"
+#include "io/png_write.h"
+#include "png_libpng.h"
 #include "test_support.h"
 
 namespace {
@@ -78,14 +79,13 @@ TEST(PngParallel, EveryFilterReadsBackAsTheRowsOnAnyThreadCount) {
             const std::vector<std::pair<std::string, std::string>> meta = {{"nmbake:green", "up"},
                                                                            {"DateTime", "2023:11:14 22:13:20"}};
             std::string error;
-            const std::vector<unsigned char> one =
-                nmbake::encode_png_parallel(rows.data(), w, h, channels, bits, meta, s, 1, &error);
+            const std::vector<unsigned char> one = nmbake::encode_png(rows.data(), w, h, channels, bits, meta, s, 1, &error);
             const std::string what = std::to_string(w) + "x" + std::to_string(h) + ", " + std::to_string(channels) +
                                      " channels, " + std::to_string(bits) + " bits, filters " + std::to_string(filters) +
                                      ", strategy " + std::to_string(strategy);
             ASSERT_FALSE(one.empty()) << what << ": " << error;
             for (int threads : {2, 3})
-              EXPECT_TRUE(nmbake::encode_png_parallel(rows.data(), w, h, channels, bits, meta, s, threads, &error) == one)
+              EXPECT_TRUE(nmbake::encode_png(rows.data(), w, h, channels, bits, meta, s, threads, &error) == one)
                   << what << ", " << threads << " threads";
             ASSERT_EQ(read_back(one, bits), expected(rows, bits)) << what;
             ++files;
@@ -94,8 +94,8 @@ TEST(PngParallel, EveryFilterReadsBackAsTheRowsOnAnyThreadCount) {
   // Against libpng's encoding of the same rows: the same samples (and a similar size).
   const std::vector<unsigned char> rows = sample_rows(256, 128, 3, 8, 5);
   std::string error;
-  const auto ours = nmbake::encode_png_parallel(rows.data(), 256, 128, 3, 8, {}, nmbake::PngSettings{}, 0, &error);
-  const auto theirs = nmbake::encode_png(rows.data(), 256, 128, 3, 8, {}, nmbake::PngSettings{}, &error);
+  const auto ours = nmbake::encode_png(rows.data(), 256, 128, 3, 8, {}, nmbake::PngSettings{}, 0, &error);
+  const auto theirs = nmbake::bench::encode_png_libpng(rows.data(), 256, 128, 3, 8, {}, nmbake::PngSettings{}, &error);
   EXPECT_EQ(read_back(ours, 8), read_back(theirs, 8));
   EXPECT_LT(double(ours.size()), 1.05 * double(theirs.size()) + 200.0);
 }
@@ -103,7 +103,7 @@ TEST(PngParallel, EveryFilterReadsBackAsTheRowsOnAnyThreadCount) {
 TEST(PngParallel, MetadataReadsBack) {
   const std::vector<unsigned char> rows = sample_rows(9, 12, 3, 8, 3);
   std::string error;
-  const auto png = nmbake::encode_png_parallel(
+  const auto png = nmbake::encode_png(
       rows.data(), 9, 12, 3, 8,
       {{"nmbake:space", "tangent"}, {"ImageDescription", "a tangent-space normal map"}, {"DateTime", "2023:11:14 22:13:20"}},
       nmbake::PngSettings{}, 2, &error);
@@ -116,23 +116,23 @@ TEST(PngParallel, MetadataReadsBack) {
   EXPECT_EQ(metadata.at("DateTime"), "2023:11:14 22:13:20");
 }
 
-TEST(PngParallel, OtherSettingsGoToLibpngAndBadInputIsAnError) {
+TEST(PngParallel, OtherSettingsAndBadInputAreAnError) {
   const std::vector<unsigned char> rows = sample_rows(16, 16, 3, 8, 4);
   std::string error;
   const nmbake::PngSettings adaptive{6, 0xF8, 0};
-  EXPECT_TRUE(nmbake::encode_png_parallel(rows.data(), 16, 16, 3, 8, {}, adaptive, 2, &error) ==
-              nmbake::encode_png(rows.data(), 16, 16, 3, 8, {}, adaptive, &error));
+  EXPECT_TRUE(nmbake::encode_png(rows.data(), 16, 16, 3, 8, {}, adaptive, 2, &error).empty());
+  EXPECT_NE(error.find("filters"), std::string::npos) << error;
   for (const auto& bad : {std::vector<int>{0, 16, 3, 8}, std::vector<int>{16, 0, 3, 8}, std::vector<int>{16, 16, 5, 8},
                           std::vector<int>{16, 16, 3, 12}}) {
     error.clear();
-    EXPECT_TRUE(nmbake::encode_png_parallel(rows.data(), bad[0], bad[1], bad[2], bad[3], {}, {}, 2, &error).empty());
+    EXPECT_TRUE(nmbake::encode_png(rows.data(), bad[0], bad[1], bad[2], bad[3], {}, {}, 2, &error).empty());
     EXPECT_NE(error.find("IHDR"), std::string::npos) << error;
   }
   error.clear();
-  EXPECT_TRUE(nmbake::encode_png_parallel(rows.data(), 16, 16, 3, 8, {}, nmbake::PngSettings{12, 0x80, 3}, 2, &error).empty());
+  EXPECT_TRUE(nmbake::encode_png(rows.data(), 16, 16, 3, 8, {}, nmbake::PngSettings{12, 0x80, 3}, 2, &error).empty());
   EXPECT_FALSE(error.empty());
   error.clear();
-  EXPECT_TRUE(nmbake::encode_png_parallel(rows.data(), 16, 16, 3, 8, {{" bad", "x"}}, {}, 2, &error).empty());
+  EXPECT_TRUE(nmbake::encode_png(rows.data(), 16, 16, 3, 8, {{" bad", "x"}}, {}, 2, &error).empty());
   EXPECT_NE(error.find("keyword"), std::string::npos) << error;
 }
 

@@ -1,7 +1,7 @@
-// The PNG writer (io/png_write.cpp, libpng directly) against OpenImageIO: every sample a PNG
+// The PNG writer (io/png_write.cpp, without OpenImageIO) against OpenImageIO: every sample a PNG
 // holds reads back as the TIFF writer (through OpenImageIO) stores it, for every channel count
 // and both bit depths; the encoder's settings change the bytes, never the pixels; the metadata and
-// the reproducible time read back under OpenImageIO's names; libpng's errors come back as errors.
+// the reproducible time read back under OpenImageIO's names.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -62,9 +62,9 @@ TEST(PngWrite, SettingsChangeTheBytesNotThePixels) {
   Image reference;
   std::size_t sizes = 0;
   for (const nmbake::PngSettings s : {nmbake::PngSettings{0, 0x08, 0}, nmbake::PngSettings{1, 0x20, 0},
-                                      nmbake::PngSettings{6, 0xF8, 1}, nmbake::PngSettings{9, 0x80, 3}}) {
+                                      nmbake::PngSettings{6, 0x40, 1}, nmbake::PngSettings{9, 0x80, 3}}) {
     std::string error;
-    const std::vector<unsigned char> bytes = nmbake::encode_png(rows.data(), 64, 48, 3, 8, {}, s, &error);
+    const std::vector<unsigned char> bytes = nmbake::encode_png(rows.data(), 64, 48, 3, 8, {}, s, 2, &error);
     ASSERT_FALSE(bytes.empty()) << error;
     nmbake::test::write_file(dir + "/s.png", std::string(bytes.begin(), bytes.end()));
     const Image back = nmbake::read_image(dir + "/s.png");
@@ -90,16 +90,6 @@ TEST(PngWrite, MetadataAndTheReproducibleTimeReadBack) {
   const std::string first = nmbake::test::read_file(path);
   nmbake::write_image(path, Image(3, 2, 3, 0.5f));
   EXPECT_TRUE(first == nmbake::test::read_file(path));
-}
-
-TEST(PngWrite, LibpngErrorsComeBackAsMessages) {
-  std::string error;
-  const unsigned char row[3] = {1, 2, 3};
-  EXPECT_TRUE(nmbake::encode_png(row, 0, 1, 3, 8, {}, {}, &error).empty());
-  EXPECT_NE(error.find("IHDR"), std::string::npos) << error;  // libpng: "Invalid IHDR data"
-  error.clear();
-  EXPECT_TRUE(nmbake::encode_png(row, 1, 1, 3, 8, {}, nmbake::PngSettings{12, 0x20, 0}, &error).empty());
-  EXPECT_FALSE(error.empty());
 }
 
 }  // namespace

@@ -22,7 +22,6 @@
 #include "cli/shell.h"
 #include "compare.h"
 #include "core/errors.h"
-#include "core/memory_budget.h"
 #include "io/image_io.h"
 #include "io/mesh_io.h"
 #include "io/output_files.h"
@@ -81,19 +80,6 @@ void parse_show(const std::string& text, nmview::Toggles& toggles) {
   }
 }
 
-// Mesa's software renderer crashes (SIGSEGV in shader compilation) instead of failing when it
-// cannot allocate. Measured under ulimit -v once the scene is loaded (torus sample, 200x100 panes):
-// with 483 MB of address space left it crashed 3 runs in 6, with 588 MB none in 6; a limit leaving
-// less than this is refused as out of memory rather than left to crash.
-constexpr std::uint64_t kRendererAddressSpace = std::uint64_t(560) << 20;
-
-void check_renderer_headroom() {
-  const std::uint64_t left = nmbake::address_space_headroom();
-  if (left < kRendererAddressSpace)
-    throw nmbake::ResourceError("out of memory: rendering needs about " + nmbake::format_bytes(double(kRendererAddressSpace)) +
-                                " of address space, ulimit -v leaves " + nmbake::format_bytes(double(left)));
-}
-
 int run(const Options& o) {
   nmview::InteractiveOptions io;
   parse_size(o.size, io.width, io.height);
@@ -106,7 +92,6 @@ int run(const Options& o) {
   nmview::check_screenshot(o.screenshot, o.low, o.map, o.high);
 
   const nmview::Scene scene = nmview::load_scene(o.low, o.map, o.high, std::cerr, o.decoding, o.uv_set);
-  check_renderer_headroom();
 
   if (!o.compare && o.screenshot.empty()) {
     nmview::run_interactive(scene, io);
@@ -202,8 +187,5 @@ int main(int argc, char** argv) {
   // status; a file past ulimit -f is a failed write (exit 3).
   nmbake::protect_standard_streams();
   nmbake::remove_temporaries_on_signals();
-  nmbake::preload_image_io();  // the image library module: loads beside the parsing, or first under ulimit -v
-  const int code = nmbake::run_command([&] { return run_command_line(argc, argv); });
-  nmbake::wait_for_image_io();  // never exit while the image library's constructors run
-  return code;
+  return nmbake::run_command([&] { return run_command_line(argc, argv); });
 }

@@ -190,12 +190,6 @@ BakeOptions bake_options(const Args& a) {
   return o;
 }
 
-bool needs_image_module(const Args& a) {
-  for (const std::string* path : {&a.output, &a.miss_mask, &a.suspect_mask})
-    if (!path->empty() && image_io_detail::lower_extension(*path) != ".png") return true;
-  return false;
-}
-
 // Fails early, before a long bake, on outputs that cannot be written.
 void check_outputs(const Args& a, int bits) {
   if (!a.save_cage.empty()) {
@@ -217,10 +211,6 @@ void check_outputs(const Args& a, int bits) {
     throw UsageError("--compression " + a.compression + " applies to EXR output, not " + a.output);
   if (a.dither && bits != 8)
     throw UsageError("--dither applies to 8-bit output; " + a.output + " is " + std::to_string(bits) + "-bit");
-  if (const std::string problem = needs_image_module(a) ? image_io_problem() : ""; !problem.empty()) {
-    if (problem.rfind("out of memory", 0) == 0) throw ResourceError(a.output + ": " + problem);
-    throw OutputError(a.output + ": " + problem);
-  }
   if (!a.miss_mask.empty()) check_output_format(a.miss_mask, default_bits_for(a.miss_mask));
   if (!a.suspect_mask.empty()) check_output_format(a.suspect_mask, default_bits_for(a.suspect_mask));
 }

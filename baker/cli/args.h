@@ -54,10 +54,6 @@ BakeOptions bake_options(const Args& a);
 // Fails early, before a long bake, on outputs that cannot be written.
 void check_outputs(const Args& a, int bits);
 
-// Whether an image output needs the image library module (OpenImageIO): every format but PNG,
-// which nmbake writes itself (io/png_write.h).
-bool needs_image_module(const Args& a);
-
 // 1234567 as "1.23M".
 std::string human(double v);
 

@@ -12,7 +12,6 @@
 #include <CLI/CLI.hpp>
 
 #include "pipeline/bake.h"
-#include "io/image_io.h"
 #include "io/output_files.h"
 #include "cli/args.h"
 #include "cli/batch.h"
@@ -58,7 +57,6 @@ int run(int argc, char** argv) {
   if (wants_batch(argc, argv)) {
     BatchArgs b;
     if (const int code = parse_batch_args(argc, argv, b); code >= 0) return code;
-    preload_image_io();
     const auto start = Clock::now();
     install_signal_handlers();
     return run_batch(b, interrupted, &g_doing, start);
@@ -67,10 +65,6 @@ int run(int argc, char** argv) {
   CLI::App app{"nmbake: bake a tangent-space normal map from a high-poly mesh onto a low-poly mesh with UVs.", "nmbake"};
   add_options(app, a);
   if (const std::optional<int> status = parse_command_line(app, argc, argv, "nmbake")) return *status;
-  // OpenImageIO loads on its own thread while the meshes are read; not for --help, --version or a
-  // command line in error (loading it took 0.37 s of `nmbake --version`), nor when every image is
-  // a PNG, which nmbake writes itself (the load took 0.2 s of CPU from a 2-core bake).
-  if (needs_image_module(a)) preload_image_io();
   finish_args(a, app);
   const auto start = Clock::now();
   install_signal_handlers();
@@ -98,7 +92,5 @@ int main(int argc, char** argv) {
   // A closed or full stdout or stderr loses messages, never changes the outputs or the exit status;
   // a file past ulimit -f is a failed write (exit 3), not a SIGXFSZ death.
   protect_standard_streams();
-  const int code = run_command([&] { return run_interruptible(argc, argv); }, {}, &g_doing);
-  wait_for_image_io();  // never exit while the image library's constructors run
-  return code;
+  return run_command([&] { return run_interruptible(argc, argv); }, {}, &g_doing);
 }

@@ -46,8 +46,7 @@ std::uint64_t cgroup_headroom() {
   return limit > usage ? limit - usage : 0;
 }
 
-}  // namespace
-
+// What the address-space limit (ulimit -v) leaves beyond what the process maps now.
 std::uint64_t address_space_headroom() {
   rlimit rl{};
   if (getrlimit(RLIMIT_AS, &rl) != 0 || rl.rlim_cur == RLIM_INFINITY) return kUnknown;
@@ -57,6 +56,8 @@ std::uint64_t address_space_headroom() {
   const std::uint64_t mapped = pages * std::uint64_t(sysconf(_SC_PAGESIZE));
   return rl.rlim_cur > mapped ? rl.rlim_cur - mapped : 0;
 }
+
+}  // namespace
 
 std::uint64_t memory_budget_bytes() { return std::min({mem_available(), cgroup_headroom(), address_space_headroom()}); }
 

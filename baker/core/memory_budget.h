@@ -1,5 +1,5 @@
-// How much memory a bake, an image read or a library load may take on this machine, checked
-// before the big buffers exist.
+// How much memory a bake or an image read may take on this machine, checked before the big
+// buffers exist.
 #pragma once
 
 #include <cstdint>
@@ -11,10 +11,6 @@ namespace nmbake {
 // cgroup v2 memory.max or v1 memory.limit_in_bytes), and the address-space limit (ulimit -v) minus
 // what the process already maps. UINT64_MAX when none is known.
 std::uint64_t memory_budget_bytes();
-
-// What the address-space limit (ulimit -v) leaves beyond what the process maps now; UINT64_MAX
-// when there is no limit.
-std::uint64_t address_space_headroom();
 
 // "4.8 GB", "812 bytes": a byte count for a message (decimal units).
 std::string format_bytes(double bytes);

@@ -1,5 +1,4 @@
-// The image formats nmbake writes and their bit depths: no OpenImageIO here, so the nmbake command
-// can check its output options before the image library is loaded (image_io_loader.cpp).
+// The image formats nmbake writes and their bit depths, checked before a bake.
 #include <algorithm>
 #include <cctype>
 #include <filesystem>

@@ -21,7 +21,6 @@
 #include <system_error>
 
 #include <fcntl.h>
-#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -39,18 +38,9 @@ using image_write::fail_write;
 
 namespace fs = std::filesystem;
 
-// OpenImageIO messages may span lines; our errors are printed as one line.
-std::string one_line(std::string s) {
-  for (char& c : s)
-    if (c == '\n' || c == '\r') c = ' ';
-  while (!s.empty() && s.back() == ' ') s.pop_back();
-  return s.empty() ? std::string("unknown error") : s;
-}
-
 // The encoders' bytes go through this proxy straight to a file descriptor, so that the first
-// system error (ENOSPC, EIO) is known exactly: through stdio, OpenImageIO's PNG writer only says
-// "Write error at position N" once per failed call (a 29 KB message on a full disk). Small writes
-// (libpng writes chunk headers of 4-13 bytes) are gathered in a buffer.
+// system error (ENOSPC, EIO) is known exactly, not as OpenImageIO's "Write error at position N"
+// once per failed call. Small writes are gathered in a buffer.
 class FileProxy final : public OIIO::Filesystem::IOProxy {
  public:
   FileProxy(const std::string& name, int fd) : IOProxy(name, Write), fd_(fd) { buffer_.reserve(kBuffer); }
@@ -121,57 +111,11 @@ class FileProxy final : public OIIO::Filesystem::IOProxy {
 // The first message of an OpenImageIO error (it repeats one per failed call), on one line.
 std::string first_message(const std::string& text) {
   const std::size_t start = text.find_first_not_of("\r\n");
-  std::string s = one_line(start == std::string::npos ? text : text.substr(start, text.find_first_of("\r\n", start) - start));
-  const std::size_t repeat = s.find("  ");
-  if (repeat != std::string::npos) s.resize(repeat);
-  if (s.size() > 240) s = s.substr(0, 240) + "...";
-  return s;
+  std::string s = start == std::string::npos ? "" : text.substr(start, text.find_first_of("\r\n", start) - start);
+  s.resize(std::min(s.size(), s.find("  ")));  // where the message starts again
+  s = one_line(s, 243);
+  return s.empty() ? "unknown error" : s;
 }
-
-// libpng prints its errors on stderr itself ("libpng error: insufficient memory", "libpng error:
-// No IDATs written into file") besides the message OpenImageIO returns, which makes one error
-// three lines. While an encoder runs, stderr goes to a memory file; afterwards its lines go on to
-// stderr, libpng's left out. Without a memory file or a spare descriptor, nothing is redirected.
-class EncoderStderr {
- public:
-  EncoderStderr() {
-    std::fflush(stderr);
-    memory_ = ::memfd_create("nmbake-encoder-stderr", MFD_CLOEXEC);
-    if (memory_ < 0) return;
-    saved_ = ::fcntl(2, F_DUPFD_CLOEXEC, 3);
-    if (saved_ < 0 || ::dup2(memory_, 2) < 0) restore();
-  }
-  ~EncoderStderr() { restore(); }
-  EncoderStderr(const EncoderStderr&) = delete;
-  EncoderStderr& operator=(const EncoderStderr&) = delete;
-
- private:
-  void restore() {
-    std::fflush(stderr);
-    if (saved_ >= 0) {
-      ::dup2(saved_, 2);
-      ::close(saved_);
-      saved_ = -1;
-      pass_on();
-    }
-    if (memory_ >= 0) ::close(memory_);
-    memory_ = -1;
-  }
-  void pass_on() const {
-    std::string text;
-    char buf[4096];
-    for (ssize_t n; (n = ::pread(memory_, buf, sizeof buf, off_t(text.size()))) > 0;) text.append(buf, std::size_t(n));
-    for (std::size_t start = 0; start < text.size();) {
-      std::size_t end = text.find('\n', start);
-      end = end == std::string::npos ? text.size() : end + 1;
-      if (text.compare(start, 7, "libpng ") != 0)
-        if (::write(2, text.data() + start, end - start) < 0) return;
-      start = end;
-    }
-  }
-  int memory_ = -1;
-  int saved_ = -1;
-};
 
 // The header written: size, stored type, metadata, and the encoder's settings for `ext`.
 OIIO::ImageSpec output_spec(const Image& image, OIIO::TypeDesc stored, const std::string& ext, const WriteOptions& options) {
@@ -249,7 +193,7 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
     const std::function<void()> run;
     ~OnExit() { run(); }
   } on_exit{abandon};
-  made.emplace(temp, fd);  // its buffer allocated here, not while libpng's C code calls it
+  made.emplace(temp, fd);  // its buffer allocated here, not while an encoder's C code calls it
   FileProxy& proxy = *made;
   // The first failure's reason: the system's for a failed write, else OpenImageIO's.
   auto discard = [&](const std::string& message, int err) {
@@ -258,7 +202,6 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
     fail_write(path, err ? std::string(std::strerror(err)) : first_message(message));
   };
   out->set_ioproxy(&proxy);
-  std::optional<EncoderStderr> quiet(std::in_place);
   if (!out->open(temp, spec)) discard(out->geterror(), 0);
   if (!out->write_image(given, data) || out->has_error() || proxy.failure()) {
     std::string reason = out->geterror();
@@ -270,7 +213,6 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
   if (!out->close() || !proxy.flush_buffer()) discard(out->geterror(), 0);
   out->geterror();  // drop that message
   out.reset();
-  quiet.reset();
   // A full disk or a failing device may only show here (delayed allocation, NFS).
   if (::fsync(fd) != 0) discard("", errno);
   open = false;
@@ -289,9 +231,5 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
 }
 
 // read_image and read_image_metadata: image_read.cpp.
-
-void preload_image_io() {}  // linked directly: nothing to load
-void wait_for_image_io() {}
-std::string image_io_problem() { return {}; }
 
 }  // namespace nmbake

@@ -1,9 +1,5 @@
-// Reading and writing images through OpenImageIO: the only code that includes OpenImageIO.
-//
-// Two builds of the same interface: image_io.cpp links OpenImageIO directly (the library nmbake::io
-// that nmdiff, nmview and the tests use); the nmbake command instead loads it as a module on a
-// background thread (image_io_loader.cpp), because loading OpenImageIO and its ~260 libraries takes
-// a sizeable part of a quick bake.
+// Reading and writing images: PNG is written by png_write.cpp, everything else goes through
+// OpenImageIO (image_io.cpp, image_read.cpp: the only code that includes it).
 #pragma once
 
 #include <map>
@@ -38,7 +34,7 @@ struct WriteOptions {
   // 8-bit output: triangular noise of one step before rounding, the same for a texel whatever
   // thread or run writes it.
   bool dither = false;
-  // Threads an encoder may use (the quantization to 8 or 16 bits, PNG's bands, png_parallel.h): 0 =
+  // Threads an encoder may use (the quantization to 8 or 16 bits, PNG's bands, png_write.h): 0 =
   // all cores. The bytes written do not depend on it.
   int threads = 0;
 };
@@ -59,21 +55,6 @@ Image read_image(const std::string& path);
 // where TIFF keeps them. Reads the header only. Throws InputError naming the file when it cannot
 // be opened.
 std::map<std::string, std::string> read_image_metadata(const std::string& path);
-
-// Starts loading the image library in the background where it is a module (the nmbake command);
-// does nothing where it is linked. Optional: the functions above load it when first called.
-void preload_image_io();
-
-// Waits until a background load started by preload_image_io() has finished and its thread ended (at once where there
-// is none). Call before the process exits: exiting while the library's static constructors run
-// can abort (one of OpenImageIO's plugins, gdcm, asserts), which turned an early error's exit
-// code 2 into an abort.
-void wait_for_image_io();
-
-// Why images cannot be written, found without waiting for the background load (the module file
-// is missing or already failed to load), or "" (always "" where OpenImageIO is linked). It starts
-// with "out of memory" when memory (ulimit -v) is what is missing.
-std::string image_io_problem();
 
 namespace image_io_detail {
 std::string lower_extension(const std::string& path);  // ".png" for "A/b.PNG"

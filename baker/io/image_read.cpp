@@ -18,14 +18,6 @@
 namespace nmbake {
 namespace {
 
-// OpenImageIO messages may span lines; our errors are printed as one line.
-std::string one_line(std::string s) {
-  for (char& c : s)
-    if (c == '\n' || c == '\r') c = ' ';
-  while (!s.empty() && s.back() == ' ') s.pop_back();
-  return s.empty() ? std::string("unknown error") : s;
-}
-
 std::string lower(std::string s) {
   for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
   return s;
@@ -34,7 +26,9 @@ std::string lower(std::string s) {
 // A reader's failure: out of memory when its message says so (OpenImageIO and OpenEXR catch
 // std::bad_alloc and report it as text), otherwise unreadable input.
 [[noreturn]] void fail_read(const std::string& path, const std::string& message) {
-  const std::string text = one_line(message), low = lower(text);
+  std::string text = one_line(message);
+  if (text.empty()) text = "unknown error";
+  const std::string low = lower(text);
   if (low.find("bad_alloc") != std::string::npos || low.find("out of memory") != std::string::npos ||
       low.find("cannot allocate") != std::string::npos || low.find("memory allocation") != std::string::npos)
     throw ResourceError(path + ": out of memory reading the image (" + text + ")");

@@ -68,7 +68,7 @@ Samples<std::uint8_t> quantize_dithered(const Image::Pixels& values, int threads
   return out;
 }
 
-// A reason that is memory running out (libpng's "insufficient memory", ENOMEM): exit 4, not 3.
+// A reason that is memory running out (the PNG encoder's "insufficient memory", ENOMEM): exit 4, not 3.
 bool memory_reason(const std::string& reason) {
   return reason.find("insufficient memory") != std::string::npos || reason.find("out of memory") != std::string::npos ||
          reason.find("Out of memory") != std::string::npos || reason == std::strerror(ENOMEM);

@@ -1,4 +1,4 @@
-// What every image writer shares (image_io.cpp through OpenImageIO, png_write.cpp through libpng):
+// What every image writer shares (image_io.cpp through OpenImageIO, png_write.cpp through zlib):
 // the checks before a write, quantization to the stored integers, the temporary file and its
 // rename, and the one-line errors. Internal to io/.
 #pragma once

@@ -1,8 +1,8 @@
 // Checks made before a file reaches Assimp, and the thread it reads on (mesh_io_assimp.cpp).
 // Assimp recurses over what it reads (JSON, XML, FBX records, node trees: deep enough ones
-// overflow the stack) and trusts lengths in headers (it allocates what a GLB chunk claims). Each check returns the problem, or "" when it finds none; what a
-// check cannot see is left to Assimp, which reads on a thread whose stack grows with the file.
-// Pure functions of the bytes: no Assimp here.
+// overflow the stack) and trusts lengths in headers (it allocates what a GLB chunk claims). Each check returns the problem, or ""
+// when it finds none; what a check cannot see is left to Assimp, which reads on a thread whose stack grows with the file. Pure
+// functions of the bytes: no Assimp here.
 #pragma once
 
 #include <cstddef>

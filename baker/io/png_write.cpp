@@ -1,80 +1,163 @@
+// PNG in bands on every core (png_write.h).
 #include "io/png_write.h"
 
-#include <png.h>
+#include <zlib.h>
 
-#include <cstdio>
+#include <algorithm>
+#include <cstdint>
+#include <cstdlib>
 #include <cstring>
+#include <new>
 
+#include "core/parallel.h"
 #include "io/image_write.h"
-#include "io/png_parallel.h"
 
 namespace nmbake {
 namespace {
 
-// Where the encoder's bytes go, and libpng's first error message.
-struct Sink {
-  std::vector<unsigned char>* bytes;
-  char message[256];
-};
+// Bands of rows compressed apart: fixed, so the file's bytes do not depend on the threads. Eight
+// keep both cores of a small machine busy to the end (bands of unequal cost), and cost a few bytes
+// each (a sync flush, and RLE's first run of a band).
+constexpr int kBands = 8;
+constexpr std::size_t kIdatBytes = std::size_t(1) << 18;  // IDAT chunks of 256 KiB
 
-extern "C" void on_png_error(png_structp png, png_const_charp message) {
-  Sink* sink = static_cast<Sink*>(png_get_error_ptr(png));
-  std::snprintf(sink->message, sizeof sink->message, "%s", message ? message : "unknown libpng error");
-  png_longjmp(png, 1);
-}
-
-extern "C" void on_png_warning(png_structp, png_const_charp) {}  // nothing libpng warns of here is ours to show
-
-extern "C" void on_png_write(png_structp png, png_bytep data, png_size_t size) {
-  Sink* sink = static_cast<Sink*>(png_get_io_ptr(png));
-  bool ok = true;
-  try {
-    sink->bytes->insert(sink->bytes->end(), data, data + size);
-  } catch (...) {
-    ok = false;
+// The PNG filter type byte of a single-filter mask, or -1.
+int filter_type(int mask) {
+  switch (mask) {
+    case 0x08: return 0;
+    case 0x10: return 1;
+    case 0x20: return 2;
+    case 0x40: return 3;
+    case 0x80: return 4;
+    default: return -1;
   }
-  if (!ok) png_error(png, "insufficient memory");
 }
 
-extern "C" void on_png_flush(png_structp) {}
+int paeth(int a, int b, int c) {
+  const int p = a + b - c, pa = std::abs(p - a), pb = std::abs(p - b), pc = std::abs(p - c);
+  if (pa <= pb && pa <= pc) return a;
+  return pb <= pc ? b : c;
+}
 
-// What one encode writes, prepared before libpng runs.
-struct Encode {
-  const unsigned char* rows;
-  std::size_t row_bytes;
-  int width, height, bits, color_type;
-  png_text* text;
-  int text_count;
-  bool has_time;
-  png_time time;
-  PngSettings settings;
+// One row's bytes as PNG stores them (16-bit samples big-endian).
+void raw_row(const unsigned char* rows, std::size_t row_bytes, int bits, int y, unsigned char* out) {
+  const unsigned char* in = rows + std::size_t(y) * row_bytes;
+  if (bits == 8) {
+    std::memcpy(out, in, row_bytes);
+    return;
+  }
+  for (std::size_t i = 0; i < row_bytes; i += 2) {
+    std::uint16_t v;
+    std::memcpy(&v, in + i, 2);
+    out[i] = static_cast<unsigned char>(v >> 8);
+    out[i + 1] = static_cast<unsigned char>(v & 0xffu);
+  }
+}
+
+// Row `cur` filtered against `prior` (zeros above the first row): type byte, then the bytes.
+void filter_row(int type, const unsigned char* cur, const unsigned char* prior, std::size_t n, std::size_t bpp,
+                unsigned char* out) {
+  out[0] = static_cast<unsigned char>(type);
+  unsigned char* o = out + 1;
+  const auto u8 = [](int v) { return static_cast<unsigned char>(v); };
+  const std::size_t first = std::min(bpp, n);  // the first pixel: a = c = 0
+  switch (type) {
+    case 0: std::memcpy(o, cur, n); break;
+    case 1:
+      std::memcpy(o, cur, first);
+      for (std::size_t i = first; i < n; ++i) o[i] = u8(cur[i] - cur[i - bpp]);
+      break;
+    case 2:
+      for (std::size_t i = 0; i < n; ++i) o[i] = u8(cur[i] - prior[i]);
+      break;
+    case 3:
+      for (std::size_t i = 0; i < first; ++i) o[i] = u8(cur[i] - prior[i] / 2);
+      for (std::size_t i = first; i < n; ++i) o[i] = u8(cur[i] - (cur[i - bpp] + prior[i]) / 2);
+      break;
+    default:                                                                 // 4, Paeth
+      for (std::size_t i = 0; i < first; ++i) o[i] = u8(cur[i] - prior[i]);  // paeth(0, b, 0) = b
+      for (std::size_t i = first; i < n; ++i) o[i] = u8(cur[i] - paeth(cur[i - bpp], prior[i], prior[i - bpp]));
+      break;
+  }
+}
+
+// One band's raw deflate stream (ended by a sync flush, or finished for the last band) and the
+// Adler-32 of what it compresses. Returns null, or zlib's reason it failed.
+struct Band {
+  std::vector<unsigned char> bytes;
+  uLong adler = 1;
+  std::size_t length = 0;  // bytes compressed
 };
 
-// libpng reports errors by longjmp back to the setjmp here: no object with a destructor lives in
-// this frame, and nothing it sets after setjmp is read after the jump.
-bool run_encoder(png_structp png, png_infop info, Sink* sink, const Encode& e) {
-  if (setjmp(png_jmpbuf(png))) return false;
-  png_set_write_fn(png, sink, on_png_write, on_png_flush);
-  png_set_IHDR(png, info, png_uint_32(e.width), png_uint_32(e.height), e.bits, e.color_type, PNG_INTERLACE_NONE,
-               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  png_set_compression_level(png, e.settings.level);
-  png_set_compression_strategy(png, e.settings.strategy);
-  png_set_filter(png, PNG_FILTER_TYPE_BASE, e.settings.filters);
-  png_set_compression_buffer_size(png, 1u << 18);  // IDAT chunks of 256 KiB, not 8 KiB
-  if (e.text_count) png_set_text(png, info, e.text, e.text_count);
-  if (e.has_time) png_set_tIME(png, info, &e.time);
-  png_write_info(png, info);
-  if (e.bits == 16) png_set_swap(png);  // the rows are native (little-endian) uint16
-  for (int y = 0; y < e.height; ++y) png_write_row(png, e.rows + std::size_t(y) * e.row_bytes);
-  png_write_end(png, info);
+const char* deflate_band(const unsigned char* rows, std::size_t row_bytes, int bits, std::size_t bpp, int type, int y0, int y1,
+                         bool last, const PngSettings& settings, Band& band) {
+  z_stream zs{};
+  const int init = deflateInit2(&zs, settings.level, Z_DEFLATED, -15, 8, settings.strategy);
+  if (init == Z_MEM_ERROR) return "insufficient memory";
+  if (init != Z_OK) return "invalid compression settings";
+  std::vector<unsigned char> prior(row_bytes, 0), cur(row_bytes), filtered(row_bytes + 1);
+  if (y0 > 0) raw_row(rows, row_bytes, bits, y0 - 1, prior.data());
+  band.bytes.resize(deflateBound(&zs, uLong(std::size_t(y1 - y0) * (row_bytes + 1))) + 64);
+  zs.next_out = band.bytes.data();
+  zs.avail_out = uInt(band.bytes.size());
+  bool ok = true;
+  for (int y = y0; y < y1 && ok; ++y) {
+    raw_row(rows, row_bytes, bits, y, cur.data());
+    filter_row(type, cur.data(), prior.data(), row_bytes, bpp, filtered.data());
+    band.adler = adler32(band.adler, filtered.data(), uInt(filtered.size()));
+    band.length += filtered.size();
+    zs.next_in = filtered.data();
+    zs.avail_in = uInt(filtered.size());
+    const int flush = y + 1 < y1 ? Z_NO_FLUSH : last ? Z_FINISH : Z_SYNC_FLUSH;
+    while (ok) {
+      if (zs.avail_out == 0) {  // deflateBound's room used up (it should not be): grow
+        const std::size_t used = band.bytes.size();
+        band.bytes.resize(2 * used);
+        zs.next_out = band.bytes.data() + used;
+        zs.avail_out = uInt(band.bytes.size() - used);
+      }
+      const int r = deflate(&zs, flush);
+      ok = r == Z_OK || r == Z_STREAM_END || r == Z_BUF_ERROR;
+      if (flush == Z_FINISH ? r == Z_STREAM_END : (zs.avail_in == 0 && zs.avail_out > 0)) break;
+    }
+    std::swap(prior, cur);
+  }
+  band.bytes.resize(band.bytes.size() - zs.avail_out);
+  deflateEnd(&zs);
+  return ok ? nullptr : "insufficient memory";  // deflate fails only for want of memory here
+}
+
+void put32(std::vector<unsigned char>& out, std::uint32_t v) {
+  const unsigned char b[4] = {static_cast<unsigned char>(v >> 24), static_cast<unsigned char>(v >> 16),
+                              static_cast<unsigned char>(v >> 8), static_cast<unsigned char>(v)};
+  out.insert(out.end(), b, b + 4);
+}
+
+void chunk(std::vector<unsigned char>& out, const char type[5], const unsigned char* data, std::size_t n) {
+  put32(out, std::uint32_t(n));
+  const std::size_t at = out.size();
+  out.insert(out.end(), type, type + 4);
+  if (n) out.insert(out.end(), data, data + n);
+  put32(out, std::uint32_t(crc32(0, out.data() + at, uInt(4 + n))));
+}
+
+// A tEXt keyword PNG allows: 1 to 79 printable Latin-1 characters, no leading, trailing or double
+// space (libpng refuses the others too).
+bool valid_keyword(const std::string& key) {
+  if (key.empty() || key.size() > 79 || key.front() == ' ' || key.back() == ' ') return false;
+  for (std::size_t i = 0; i < key.size(); ++i) {
+    const auto c = static_cast<unsigned char>(key[i]);
+    if (c < 32 || (c > 126 && c < 161) || (c == ' ' && key[i + 1] == ' ')) return false;
+  }
   return true;
 }
 
-// "YYYY:MM:DD HH:MM:SS" as a tIME; false when it is not that.
-bool parse_date_time(const std::string& text, png_time* t) {
+// "YYYY:MM:DD HH:MM:SS" as a tIME chunk's 7 bytes; false when it is not that.
+bool time_bytes(const std::string& text, unsigned char t[7]) {
   int f[6];
   if (!image_write::date_time_fields(text, f)) return false;
-  *t = {png_uint_16(f[0]), png_byte(f[1]), png_byte(f[2]), png_byte(f[3]), png_byte(f[4]), png_byte(f[5])};
+  const int v[7] = {f[0] >> 8, f[0] & 0xff, f[1], f[2], f[3], f[4], f[5]};
+  for (int k = 0; k < 7; ++k) t[k] = static_cast<unsigned char>(v[k]);
   return true;
 }
 
@@ -82,47 +165,76 @@ bool parse_date_time(const std::string& text, png_time* t) {
 
 std::vector<unsigned char> encode_png(const void* rows, int width, int height, int channels, int bits,
                                       const std::vector<std::pair<std::string, std::string>>& metadata,
-                                      const PngSettings& settings, std::string* error) {
-  static constexpr int kColorTypes[] = {PNG_COLOR_TYPE_GRAY, PNG_COLOR_TYPE_GRAY_ALPHA, PNG_COLOR_TYPE_RGB,
-                                        PNG_COLOR_TYPE_RGB_ALPHA};
-  std::vector<unsigned char> bytes;
-  Encode e{};
-  e.rows = static_cast<const unsigned char*>(rows);
-  e.row_bytes = std::size_t(width) * std::size_t(channels) * std::size_t(bits / 8);
-  e.width = width;
-  e.height = height;
-  e.bits = bits;
-  e.color_type = kColorTypes[channels - 1];
-  e.settings = settings;
-  std::vector<std::string> keys;  // png_text points into these
-  std::vector<png_text> text;
-  keys.reserve(metadata.size());
-  for (const auto& [key, value] : metadata) {
-    if (key == "DateTime") {
-      e.has_time = parse_date_time(value, &e.time);
-      continue;
-    }
-    keys.push_back(key == "ImageDescription" ? "Description" : key);
-    png_text t{};
-    t.compression = PNG_TEXT_COMPRESSION_NONE;
-    t.key = const_cast<char*>(keys.back().c_str());
-    t.text = const_cast<char*>(value.c_str());
-    t.text_length = value.size();
-    text.push_back(t);
-  }
-  e.text = text.data();
-  e.text_count = int(text.size());
-  Sink sink{&bytes, {}};
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &sink, on_png_error, on_png_warning);
-  png_infop info = png ? png_create_info_struct(png) : nullptr;
-  const bool created = info != nullptr;
-  const bool ok = created && run_encoder(png, info, &sink, e);
-  png_destroy_write_struct(png ? &png : nullptr, info ? &info : nullptr);  // sets both to null
-  if (!ok) {
-    *error = created ? sink.message : "insufficient memory";
+                                      const PngSettings& settings, int threads, std::string* error) {
+  const int type = filter_type(settings.filters);
+  if (type < 0) {
+    *error = "filters: one of 0x08, 0x10, 0x20, 0x40, 0x80 expected, not " + std::to_string(settings.filters);
     return {};
   }
-  return bytes;
+  if (width <= 0 || height <= 0 || width > 0x7fffffff / 8 || channels < 1 || channels > 4 || (bits != 8 && bits != 16)) {
+    *error = "invalid IHDR data (size, channels or bit depth)";
+    return {};
+  }
+  for (const auto& item : metadata)
+    if (item.first != "DateTime" && !valid_keyword(item.first)) {
+      *error = "tEXt: invalid keyword \"" + item.first + "\"";
+      return {};
+    }
+  static constexpr unsigned char kColorTypes[] = {0, 4, 2, 6};
+  const std::size_t bpp = std::size_t(channels) * std::size_t(bits / 8);
+  const std::size_t row_bytes = std::size_t(width) * bpp;
+  const auto* in = static_cast<const unsigned char*>(rows);
+  try {
+    const int bands = std::max(1, std::min(kBands, height));
+    std::vector<Band> band(static_cast<std::size_t>(bands));
+    std::vector<const char*> failed(band.size(), nullptr);
+    parallel_chunks(threads, band.size(), 1, [&](std::size_t b, std::size_t) {
+      const int y0 = int(std::int64_t(height) * std::int64_t(b) / bands),
+                y1 = int(std::int64_t(height) * std::int64_t(b + 1) / bands);
+      failed[b] = deflate_band(in, row_bytes, bits, bpp, type, y0, y1, b + 1 == band.size(), settings, band[b]);
+    });
+    for (const char* f : failed)
+      if (f) {
+        *error = f;
+        return {};
+      }
+    // The zlib stream: header (deflate, 32K window, no preset dictionary; check bits), the bands'
+    // streams joined, the Adler-32 of everything they compress.
+    std::vector<unsigned char> z = {0x78, 0x01};
+    uLong adler = 1;
+    for (const Band& b : band) {
+      z.insert(z.end(), b.bytes.begin(), b.bytes.end());
+      adler = adler32_combine(adler, b.adler, z_off_t(b.length));
+    }
+    put32(z, std::uint32_t(adler));
+
+    std::vector<unsigned char> out = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    std::vector<unsigned char> ihdr;
+    put32(ihdr, std::uint32_t(width));
+    put32(ihdr, std::uint32_t(height));
+    ihdr.insert(ihdr.end(), {static_cast<unsigned char>(bits), kColorTypes[channels - 1], 0, 0, 0});
+    chunk(out, "IHDR", ihdr.data(), ihdr.size());
+    unsigned char when[7];
+    bool has_time = false;
+    for (const auto& [key, value] : metadata) {
+      if (key == "DateTime") {
+        has_time = time_bytes(value, when);
+        continue;
+      }
+      std::string text = key == "ImageDescription" ? "Description" : key;
+      text.push_back('\0');
+      text += value;
+      chunk(out, "tEXt", reinterpret_cast<const unsigned char*>(text.data()), text.size());
+    }
+    if (has_time) chunk(out, "tIME", when, 7);
+    for (std::size_t at = 0; at < z.size(); at += kIdatBytes)
+      chunk(out, "IDAT", z.data() + at, std::min(kIdatBytes, z.size() - at));
+    chunk(out, "IEND", nullptr, 0);
+    return out;
+  } catch (const std::bad_alloc&) {
+    *error = "insufficient memory";
+    return {};
+  }
 }
 
 void write_png_image(const std::string& path, const Image& image, const WriteOptions& options) {
@@ -137,12 +249,12 @@ void write_png_image(const std::string& path, const Image& image, const WriteOpt
   std::vector<unsigned char> bytes;
   if (bits == 8) {
     const auto rows = image_write::quantize8(image.pixels, options.dither, options.threads);
-    bytes = encode_png_parallel(rows.data(), image.width, image.height, image.channels, 8, metadata, PngSettings{},
-                                options.threads, &error);
+    bytes =
+        encode_png(rows.data(), image.width, image.height, image.channels, 8, metadata, PngSettings{}, options.threads, &error);
   } else {
     const auto rows = image_write::quantize16(image.pixels, options.threads);
-    bytes = encode_png_parallel(rows.data(), image.width, image.height, image.channels, 16, metadata, PngSettings{},
-                                options.threads, &error);
+    bytes =
+        encode_png(rows.data(), image.width, image.height, image.channels, 16, metadata, PngSettings{}, options.threads, &error);
   }
   if (bytes.empty()) image_write::fail_write(path, error);
   image_write::write_file_bytes(path, bytes, options);

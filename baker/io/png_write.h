@@ -1,8 +1,9 @@
-// PNG maps and masks written with libpng directly, not through OpenImageIO: the nmbake command
-// writes its default output without loading the image library's ~260 libraries (0.2 s of CPU,
-// and threads that waited on the loader's lock meanwhile). Chunks as OpenImageIO wrote them: one
-// tEXt per metadata item ("ImageDescription" as "Description", which OpenImageIO reads back under
-// its own name), "DateTime" as tIME; 16-bit samples big-endian as PNG stores them.
+// PNG maps and masks, written without OpenImageIO. The rows are cut into a fixed number of bands;
+// each band is filtered and deflated on its own, on every core (zlib, raw deflate ended by a sync
+// flush, so the bands' streams join into one), and the file is assembled around the joined stream:
+// IHDR, one tEXt per metadata item ("ImageDescription" as "Description", which OpenImageIO reads
+// back under its own name), "DateTime" as tIME, the IDAT chunks, IEND. The bands do not depend on
+// the thread count, so neither do the bytes.
 #pragma once
 
 #include <string>
@@ -22,20 +23,21 @@ namespace nmbake {
 // one before: what RLE codes, and it searches for nothing else.
 struct PngSettings {
   int level = 1;       // zlib level 0-9 (with the RLE strategy any level from 1 codes the same)
-  int filters = 0x80;  // libpng's PNG_FILTER_* mask (0x08 none, 0x10 sub, 0x20 up, 0x40 avg, 0x80 paeth, 0xF8 all)
+  int filters = 0x80;  // one PNG filter: 0x08 none, 0x10 sub, 0x20 up, 0x40 average, 0x80 Paeth (libpng's PNG_FILTER_*)
   int strategy = 3;    // zlib strategy: 0 default, 1 filtered, 2 Huffman only, 3 RLE
 };
 
 // The PNG file's bytes for `rows` (height rows of width * channels samples, 1 byte each for
-// bits 8, native-endian uint16 for bits 16; channels 1 to 4: grey, grey + alpha, RGB, RGBA).
-// Empty, with *error set (libpng's message; "insufficient memory" when memory ran out), on failure.
+// bits 8, native-endian uint16 for bits 16; channels 1 to 4: grey, grey + alpha, RGB, RGBA), on
+// `threads` threads (0: all cores). Empty, with *error set ("insufficient memory" when memory ran
+// out), on failure: a size, channel count, bit depth, filter or keyword PNG does not take.
 std::vector<unsigned char> encode_png(const void* rows, int width, int height, int channels, int bits,
                                       const std::vector<std::pair<std::string, std::string>>& metadata,
-                                      const PngSettings& settings, std::string* error);
+                                      const PngSettings& settings, int threads, std::string* error);
 
 // write_image (image_io.h) for a .png path: quantized as every writer does, encoded with the
-// default PngSettings on options.threads threads (png_parallel.h), written to the temporary file
-// and renamed as write_image documents.
+// default PngSettings on options.threads threads, written to the temporary file and renamed as
+// write_image documents.
 void write_png_image(const std::string& path, const Image& image, const WriteOptions& options);
 
 }  // namespace nmbake

@@ -19,8 +19,6 @@ fi
 shim=$(realpath "$shim")
 low=$repo/data/sample/torus_low.obj high=$repo/data/sample/torus_high.ply
 max_runs=${NMBAKE_FAULT_MAX_RUNS:-25}  # per kind of call; ~0.5 s each
-# (Allocations are counted in an order that varies a little from run to run: the image module loads
-# on its own thread beside the meshes. Each run is checked all the same.)
 rm -rf "$work" && mkdir -p "$work/scene" "$work/old" && cd "$work/scene" || exit 1
 log=$work
 outputs="m.png miss.png cage.obj r.json"

@@ -16,10 +16,9 @@
 //           (default 65536): the buffers a bake sizes by its input, where memory really runs out
 //           (operator new and std containers allocate through malloc). Smaller ones are not
 //           counted: failing one inside a library's static constructor or the dynamic loader tests
-//           those libraries, not nmbake. Nor is any allocation made inside dlopen (the image
-//           module's ~260 libraries' constructors): an exception from one (libcharls throws
-//           std::bad_alloc) cannot cross the loader and ends in std::terminate, whatever the
-//           program does; nmbake checks the address space left before it loads them instead.
+//           those libraries, not nmbake. Nor is any allocation made inside dlopen (a loaded
+//           library's constructors): an exception from one (libcharls throws std::bad_alloc)
+//           cannot cross the loader and ends in std::terminate, whatever the program does.
 // ERRNO is ENOSPC, EIO, EDQUOT, EROFS, EACCES or ENOMEM. Reads, and writes to terminals and pipes
 // (stdout, stderr), are never counted: the tests need the command's messages.
 // glibc's stdio writes through internal calls that no shim sees, so fwrite and fclose are covered

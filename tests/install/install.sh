@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
-# install.sh CMAKE BUILD WORK SAMPLE_DIR BINDIR MODULEDIR MODULE VIEWER(0|1)
+# install.sh CMAKE BUILD WORK SAMPLE_DIR BINDIR VIEWER(0|1)
 # Installs BUILD into a prefix under WORK, checks the layout, bakes the bundled sample with the
 # installed nmbake from another folder (by PATH), moves the prefix and bakes again, and runs the
-# installed nmdiff on that map (it loads the module too) and nmview --help. Leaves nothing behind: WORK's scratch folder is removed and
+# installed nmdiff on that map and nmview --help. Leaves nothing behind: WORK's scratch folder is removed and
 # BUILD's install_manifest.txt, which `cmake --install` rewrites, is put back as it was.
 set -euo pipefail
-cmake=$1 build=$2 work=$3 sample=$4 bindir=$5 moduledir=$6 module=$7 viewer=$8
+cmake=$1 build=$2 work=$3 sample=$4 bindir=$5 viewer=$6
 scratch=$(mktemp -d "$work/install-test.XXXXXX")
 manifest=$build/install_manifest.txt
 had_manifest=0
@@ -20,11 +20,10 @@ fail() { echo "install test: $*" >&2; exit 1; }
 prefix=$scratch/prefix
 "$cmake" --install "$build" --prefix "$prefix" >"$scratch/install.log" || { cat "$scratch/install.log"; fail "cmake --install failed"; }
 
-# The layout: the commands in BINDIR, nmbake's image module in MODULEDIR and not beside the commands.
+# The layout: the commands in BINDIR.
 expected="nmbake nmdiff"
 [ "$viewer" = 1 ] && expected="nmbake nmdiff nmview"
 [ "$(ls "$prefix/$bindir" | sort | tr '\n' ' ')" = "$expected " ] || fail "$bindir holds: $(ls "$prefix/$bindir" | tr '\n' ' ')"
-[ -f "$prefix/$moduledir/$module" ] || fail "no $moduledir/$module"
 
 bake() {  # bake PREFIX FOLDER: the installed nmbake, found by PATH, run in FOLDER
   mkdir -p "$2"
@@ -37,7 +36,6 @@ mv "$prefix" "$scratch/moved"
 bake "$scratch/moved" "$scratch/elsewhere2"
 
 "$scratch/moved/$bindir/nmdiff" --help >/dev/null || fail "installed nmdiff --help failed"
-# nmdiff and nmview load the image module too, from the moved tree.
 (cd "$scratch/elsewhere2" && "$scratch/moved/$bindir/nmdiff" map.png map.png >/dev/null) || fail "installed nmdiff could not compare maps"
 if [ "$viewer" = 1 ]; then "$scratch/moved/$bindir/nmview" --help >/dev/null || fail "installed nmview --help failed"; fi
 echo "install test: passed"
