@@ -68,7 +68,10 @@ ErrorEstimate estimate_bake_error(const Mesh& low, const TraceInputs& traced, co
   fixed.samples = e.samples;
   fixed.adaptive = false;
   fixed.progress = nullptr;
-  const TileBins bins = bin_triangles(low, fixed.width, fixed.height, trace_tile_side(fixed), eo.tile);
+  // Tiles whose samples take no more room in the tracer than a 64-sample bake's (kTileSide).
+  int side = kTileSide;
+  while (side > 4 && side * side * e.samples > kTileSide * kTileSide * 64) side /= 2;
+  const TileBins bins = bin_triangles(low, fixed.width, fixed.height, side, eo.tile);
   const std::vector<glm::dvec3> reference =
       trace_texels(traced.s, traced.scene, bins, traced.rays, fixed, worker_threads(fixed.threads), result.stats, texels);
   std::vector<double> err;
