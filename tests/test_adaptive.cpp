@@ -140,10 +140,11 @@ TEST(Adaptive, TheErrorEstimateMeasuresIt) {
   const Bumps s;
   BakeOptions o = adaptive(64, 1.0);
   o.front = o.rear = 0.1f;
+  o.keep_trace = true;
   const BakeResult r = bake_normal_map(s.low, s.high, nullptr, o);
   ErrorEstimateOptions eo;
   eo.bits = 32;
-  const ErrorEstimate e = estimate_bake_error(s.low, s.high, nullptr, o, r, eo);
+  const ErrorEstimate e = estimate_bake_error(s.low, o, r, eo);
   EXPECT_EQ(e.samples, 256);  // 4x the deepest level's 64
   EXPECT_GT(e.texels, 0u);
   EXPECT_TRUE(std::isfinite(e.mean_deg));

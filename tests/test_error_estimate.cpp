@@ -1,7 +1,10 @@
-// The --estimate-error machinery: bake_texel_values reproduces the bake texel for texel, and the
-// estimate is ~0 where there is nothing to estimate and close to the true error where there is.
+// The --estimate-error machinery: the bake's own tracer, over the trace inputs the bake kept, gives
+// the bake's texels again bit for bit, and the estimate is ~0 where there is nothing to estimate
+// and close to the true error where there is.
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -22,6 +25,7 @@ BakeOptions options(int size, int samples) {
   o.width = o.height = size;
   o.samples = samples;
   o.padding = 0;
+  o.keep_trace = true;
   return o;
 }
 
@@ -39,26 +43,56 @@ Mesh aliasing_height_field() {
 
 }  // namespace
 
-TEST(ErrorEstimate, RebakedTexelsMatchTheBake) {
+// What the estimate's re-bake gives a texel at the bake's own samples is the bake's texel, bit for
+// bit: one tracer, one BVH. With a fixed distance, two rays per sample, --green down, the automatic
+// cage, object space.
+TEST(ErrorEstimate, TheBakesTracerGivesItsTexelsAgain) {
   const Mesh low = test::make_torus(24, 12);
   const Mesh high = test::make_torus(96, 48, 1.0f, 0.37f);
-  for (int variant = 0; variant < 3; ++variant) {
-    BakeOptions o = options(96, variant == 1 ? 1 : 4);
-    o.front = o.rear = 0.1f;
+  for (int variant = 0; variant < 5; ++variant) {
+    BakeOptions o = options(96, variant == 1 || variant == 3 ? 1 : 4);
+    if (variant != 3) o.front = o.rear = 0.1f;
     if (variant == 1) o.policy = RayPolicy::closest;
     if (variant == 2) o.green_down = true;
+    if (variant == 4) o.space = NormalSpace::object;
     const BakeResult r = bake_normal_map(low, high, nullptr, o);
-    std::vector<std::uint32_t> texels;
-    for (std::uint32_t i = 0; i < r.coverage.size(); ++i)
-      if (r.coverage[i]) texels.push_back(i);
-    const std::vector<glm::dvec3> v = bake_texel_values(low, high, nullptr, o, r, texels, o.samples);
-    double worst = 0.0;
-    for (std::size_t i = 0; i < texels.size(); ++i) {
-      ASSERT_NE(v[i], glm::dvec3(0.0)) << "texel " << texels[i];
-      worst = std::max(worst, angle_deg(decode_rgb(&r.map.pixels[3 * std::size_t(texels[i])]), v[i]));
-    }
-    EXPECT_LT(worst, 1e-3) << "variant " << variant;  // float encoding only
+    ASSERT_TRUE(r.trace_inputs);
+    EXPECT_EQ(r.stats.cage == BakeStats::CageSource::automatic, variant == 3);
+    std::size_t covered = 0;
+    EXPECT_EQ(test::texels_traced_otherwise(low, *r.trace_inputs, o, r, &covered), 0u) << "variant " << variant;
+    EXPECT_GT(covered, 4000u);
   }
+}
+
+// The kept inputs read the high-poly (its triangles' objects, and with no triangle culled its
+// index buffer): one moved to the low-poly's origin for the bake is kept with them.
+TEST(ErrorEstimate, AHighPolyMovedForTheBakeIsKeptWithItsTrace) {
+  const Mesh low = test::make_torus(24, 12);
+  Mesh high = with_origin(test::make_torus(96, 48, 1.0f, 0.37f), glm::dvec3(0.5, 0.25, 0.0));
+  high.objects = {{"inner", ""}, {"outer", ""}};
+  for (std::size_t t = 0; t < high.triangle_count(); ++t) high.triangle_object.push_back(std::uint32_t(t % 2));
+  BakeOptions o = options(64, 1);
+  o.front = o.rear = 0.1f;
+  o.cull_far = false;
+  const BakeResult r = bake_normal_map(low, high, nullptr, o);
+  // The memory the bake freed taken again and overwritten.
+  std::vector<std::vector<std::uint32_t>> clobber;
+  for (std::size_t n : {high.triangle_count(), 3 * high.triangle_count()})
+    for (int k = 0; k < 32; ++k) clobber.emplace_back(n, 0xffffffffu);
+  std::size_t covered = 0;
+  EXPECT_EQ(test::texels_traced_otherwise(low, *r.trace_inputs, o, r, &covered), 0u);
+  EXPECT_GT(covered, 2000u);
+  EXPECT_EQ(r.stats.misses, 0u);
+  EXPECT_EQ(clobber.back().back(), 0xffffffffu);
+}
+
+TEST(ErrorEstimate, OnlyABakeThatKeptItsTraceIsEstimated) {
+  const Mesh m = test::make_torus(32, 16);
+  BakeOptions o = options(32, 1);
+  o.keep_trace = false;
+  const BakeResult r = bake_normal_map(m, m, nullptr, o);
+  EXPECT_FALSE(r.trace_inputs);
+  EXPECT_THROW(estimate_bake_error(m, o, r), std::invalid_argument);
 }
 
 TEST(ErrorEstimate, SelfBakeEstimatesZero) {
@@ -68,7 +102,7 @@ TEST(ErrorEstimate, SelfBakeEstimatesZero) {
   const BakeResult r = bake_normal_map(m, m, nullptr, o);
   ErrorEstimateOptions eo;
   eo.bits = 8;
-  const ErrorEstimate e = estimate_bake_error(m, m, nullptr, o, r, eo);
+  const ErrorEstimate e = estimate_bake_error(m, o, r, eo);
   EXPECT_EQ(e.texels, 4096u);
   EXPECT_EQ(e.samples, 64);
   EXPECT_LT(e.max_deg, 1e-3);
@@ -87,6 +121,7 @@ TEST(ErrorEstimate, AliasedBakeEstimateIsCloseToTheTrueError) {
   // True error: every texel against a full 64-sample bake.
   BakeOptions ref_o = o;
   ref_o.samples = 64;
+  ref_o.keep_trace = false;
   const BakeResult ref = bake_normal_map(low, high, nullptr, ref_o);
   std::vector<double> err;
   for (std::size_t i = 0; i < r.coverage.size(); ++i)
@@ -96,7 +131,7 @@ TEST(ErrorEstimate, AliasedBakeEstimateIsCloseToTheTrueError) {
   std::sort(err.begin(), err.end());
   const double p95 = err[std::size_t(0.95 * double(err.size() - 1) + 0.5)];
 
-  const ErrorEstimate e = estimate_bake_error(low, high, nullptr, o, r);
+  const ErrorEstimate e = estimate_bake_error(low, o, r);
   std::printf(
       "aliased 128^2, 1 sample: true mean %.3f p95 %.3f max %.3f deg; estimate mean %.3f p95 %.3f max %.3f deg on %zu texels, "
       "%.3f s\n",

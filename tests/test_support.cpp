@@ -15,6 +15,8 @@
 #include "core/rasterize.h"
 #include "core/tangent_frames.h"
 #include "io/mesh_io.h"
+#include "pipeline/bake_stages.h"
+#include "pipeline/trace.h"
 
 namespace nmbake::test {
 
@@ -170,6 +172,26 @@ void for_each_decoded_texel(
       const glm::dvec3 world = decode_tangent_normal(interpolate_frame(frames, std::size_t(t), b), decode_rgb(map.at(x, y)));
       fn(x, y, world, p, std::size_t(t));
     }
+}
+
+std::size_t texels_traced_otherwise(const Mesh& low, const TraceInputs& traced, const BakeOptions& o, const BakeResult& r,
+                                    std::size_t* covered, const UvTileFilter* tile) {
+  std::vector<std::uint32_t> texels;
+  for (std::uint32_t i = 0; i < r.coverage.size(); ++i)
+    if (r.coverage[i]) texels.push_back(i);
+  if (covered) *covered = texels.size();
+  const TileBins bins = bin_triangles(low, o.width, o.height, trace_tile_side(o), tile);
+  const std::vector<glm::dvec3> v = trace_texels(traced.s, traced.scene, bins, traced.rays, o, 2, r.stats, texels);
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < texels.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      const double n = std::fabs(v[i][c]) < 1e-6 ? 0.0 : v[i][c];  // the trace's snap to 0 (trace.cpp)
+      if (float(n * 0.5 + 0.5) != r.map.pixels[3 * std::size_t(texels[i]) + std::size_t(c)]) {
+        ++differ;
+        break;
+      }
+    }
+  return differ;
 }
 
 }  // namespace nmbake::test

@@ -13,6 +13,13 @@
 
 #include "core/mesh.h"
 
+namespace nmbake {
+struct BakeOptions;
+struct BakeResult;
+struct TraceInputs;
+struct UvTileFilter;
+}  // namespace nmbake
+
 namespace nmbake::test {
 
 std::string data_path(const std::string& relative);         // <repo>/data/<relative>
@@ -88,5 +95,13 @@ glm::dvec3 decode_rgb(const float* c);
 void for_each_decoded_texel(
     const Mesh& low, const Image& map,
     const std::function<void(int x, int y, const glm::dvec3& world, const glm::dvec3& point, std::size_t triangle)>& fn);
+
+// The covered texels of `r` (a bake from `low` with options `o`, or a UDIM tile's with `tile`) whose
+// map bits the bake's tracer, given the same samples, does not give again over `traced` (the bake's
+// kept trace inputs): trace_texels, as the error estimate calls it, snapped and encoded as the map
+// (write_texel_row). 0 when the estimate's re-bake is the bake, bit for bit; `covered` receives how
+// many texels were compared.
+std::size_t texels_traced_otherwise(const Mesh& low, const TraceInputs& traced, const BakeOptions& o, const BakeResult& r,
+                                    std::size_t* covered = nullptr, const UvTileFilter* tile = nullptr);
 
 }  // namespace nmbake::test

@@ -43,13 +43,13 @@ void print_distances(const BakeStats& s) {
 }
 
 // With <UDIM>, each tile's estimate goes into the report's udim tiles and the line gives them combined.
-ErrorEstimate estimate_error(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& o, const BakeResult& r,
-                             UdimBake* udim, RunInfo& run, int bits, Progress& progress) {
+ErrorEstimate estimate_error(const Mesh& low, const BakeOptions& o, const BakeResult& r, const UdimBake* udim, RunInfo& run,
+                             int bits, Progress& progress) {
   ErrorEstimateOptions eo;
   eo.bits = bits;
   ErrorEstimate estimate;
   if (udim) {
-    const std::vector<ErrorEstimate> tiles = estimate_udim_errors(low, high, cage, o, *udim, eo);
+    const std::vector<ErrorEstimate> tiles = estimate_udim_errors(low, o, *udim, eo);
     for (std::size_t k = 0; k < tiles.size() && k < run.udim["tiles"].size(); ++k)
       run.udim["tiles"][k]["error_estimate"] = {{"mean_deg", tiles[k].mean_deg},
                                                 {"p95_deg", tiles[k].p95_deg},
@@ -57,7 +57,7 @@ ErrorEstimate estimate_error(const Mesh& low, const Mesh& high, const Mesh* cage
                                                 {"texels", tiles[k].texels}};
     estimate = combine_estimates(tiles);
   } else {
-    estimate = estimate_bake_error(low, high, cage, o, r, eo);
+    estimate = estimate_bake_error(low, o, r, eo);
   }
   // The estimate compares float values; say what the output's bit depth adds on top.
   char quant[128] = "float output adds no quantisation";
@@ -332,21 +332,19 @@ void bake_job(const Args& a, const JobEnv& env) {
   if (env.cache) o.bvh_cache = &loaded->bvh;  // a batch: the next job from this high-poly may trace its BVH
   o.progress = [&](double f) { return env.progress.fraction(f); };
   o.on_stage = [&](const char* stage) { env.progress.stage(stage); };
+  o.keep_trace = a.estimate_error;  // the estimate traces the bake's scene again
   *env.doing = "baking";
   BakeResult r;
   std::optional<UdimBake> udim;
   if (has_udim(a.output)) {
     udim = bake_udim_tiles(low, high, cage_mesh, o);
     r.stats = udim->stats;
-    r.cage_positions = udim->cage_positions;  // --save-cage; the estimate reads the tiles' copy
+    r.cage_positions = udim->cage_positions;  // --save-cage
     run.udim = udim_report(*udim, a.output);
   } else {
     r = bake_normal_map(low, high, cage_mesh, o);
   }
   const BakeStats& s = r.stats;
-  // Topology checks are only reported: they run beside the image write, after the bake has freed
-  // its BVH, so that they take neither the bake's threads nor its peak memory.
-  auto topology = std::async(std::launch::async, [&high, threads = o.threads] { return inspect_topology(high, threads); });
   if (!a.quiet) env.progress.above([&] { print_distances(s); });
   o.on_stage = nullptr;  // the estimate's re-bake is one stage
   if (env.interrupted()) throw Cancelled();
@@ -354,8 +352,13 @@ void bake_job(const Args& a, const JobEnv& env) {
   *env.doing = "estimating the error";
   if (a.estimate_error) {
     env.progress.stage("estimating the error");
-    estimate = estimate_error(low, high, cage_mesh, o, r, udim ? &*udim : nullptr, run, bits, env.progress);
+    estimate = estimate_error(low, o, r, udim ? &*udim : nullptr, run, bits, env.progress);
+    r.trace_inputs.reset();
+    if (udim) udim->trace_inputs.reset();
   }
+  // Topology checks are only reported: they run beside the image write, after the bake (and the
+  // estimate) have freed the BVH, so that they take neither the bake's threads nor its peak memory.
+  auto topology = std::async(std::launch::async, [&high, threads = o.threads] { return inspect_topology(high, threads); });
 
   // Every output to its temporary file, then all renamed into place together.
   OutputSet outputs;

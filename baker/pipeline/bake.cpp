@@ -217,6 +217,13 @@ void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const Ba
   in.rays.diagonal = s.diagonal;
 }
 
+std::shared_ptr<const TraceInputs> holding(std::shared_ptr<const TraceInputs> inputs, std::shared_ptr<const Mesh> high) {
+  if (!inputs) return inputs;
+  const auto both = std::make_shared<std::pair<std::shared_ptr<const TraceInputs>, std::shared_ptr<const Mesh>>>(
+      std::move(inputs), std::move(high));
+  return {both, both->first.get()};  // owns both, points to the inputs
+}
+
 // Tiles of 32 x 32 texels up to 4 samples, else 16 x 16: a triangle's rows within a tile are
 // longer with the larger ones (less set-up per texel), and a tile's samples stay within the cache
 // with the smaller.
@@ -254,7 +261,10 @@ void validate_options(const BakeOptions& o) {
 BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt) {
   if (!share_origin(low, high, cage)) {  // loaded each on its own (nmbake loads them on one origin)
     const std::optional<Mesh> moved_cage = cage ? std::optional<Mesh>(with_origin(*cage, low.origin)) : std::nullopt;
-    return bake_normal_map(low, with_origin(high, low.origin), moved_cage ? &*moved_cage : nullptr, opt);
+    const auto moved_high = std::make_shared<const Mesh>(with_origin(high, low.origin));
+    BakeResult result = bake_normal_map(low, *moved_high, moved_cage ? &*moved_cage : nullptr, opt);
+    result.trace_inputs = holding(std::move(result.trace_inputs), moved_high);
+    return result;
   }
   check_bake_inputs(low, high, cage, opt);
   const int threads = worker_threads(opt.threads);
@@ -266,7 +276,8 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     BakeStats& st = result.stats;
     std::vector<std::uint8_t> disagree;  // per texel: its samples disagree (suspect), with several samples
     OutputAllocation outputs([&opt, &result, &disagree] { allocate_outputs(opt, result, disagree); });
-    TraceInputs in;
+    const auto kept = std::make_shared<TraceInputs>();
+    TraceInputs& in = *kept;
     prepare_trace(low, high, cage, opt, threads, in, result, stage);
 
     announce_stage(opt, "tracing");
@@ -284,6 +295,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     t0 = Clock::now();
     pad_map(opt, disagree, threads, result);
     st.seconds_padding = seconds_since(t0);
+    if (opt.keep_trace) result.trace_inputs = kept;
     return result;
   } catch (const std::bad_alloc&) {
     throw ResourceError("out of memory while " + stage);

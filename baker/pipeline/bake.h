@@ -126,6 +126,8 @@ struct BakeOptions {
   std::vector<std::uint32_t> low_object_group, high_object_group;
   // A BVH to reuse or to keep for later bakes from the same high-poly (BvhCache); null: none.
   BvhCache* bvh_cache = nullptr;
+  // Keep what the trace read in BakeResult::trace_inputs (UdimBake's), for the error estimate.
+  bool keep_trace = false;
   // Called from the calling thread with the fraction done in [0,1]; return false to cancel
   // (bake_normal_map then throws Cancelled).
   std::function<bool(double)> progress;
@@ -215,6 +217,8 @@ struct BakeStats {
   std::uint64_t samples_unmatched = 0;
 };
 
+struct TraceInputs;  // bake_stages.h: the prepared scene, its BVH and the rays' set-up
+
 struct BakeResult {
   Image map;                           // RGB, encoded c = n * 0.5 + 0.5
   Image miss_mask;                     // 1 channel, share of missed samples (only with options.miss_mask)
@@ -230,6 +234,9 @@ struct BakeResult {
   // Per low-poly position, how far out rays search beyond a cage that a neighbouring part limits
   // (LocalDistances::search); empty where vertex_rear is.
   std::vector<float> vertex_search;
+  // With BakeOptions::keep_trace, what the trace read (for estimate_bake_error, error_estimate.h);
+  // it reads the low-poly and the high-poly given, which must outlive it unchanged. Else null.
+  std::shared_ptr<const TraceInputs> trace_inputs;
 };
 
 struct Cancelled : Error {
@@ -270,17 +277,5 @@ std::vector<glm::vec3> low_ray_normals(const Mesh& low);
 // The sample offsets inside a texel for `samples` samples, in [0,1)^2: the centre for 1, a
 // regular grid for square counts, otherwise a stratified (Hammersley) set.
 std::vector<glm::dvec2> sample_offsets(int samples);
-
-// ---- Re-baking chosen texels (for the error estimate, error_estimate.h) ----
-struct UvTileFilter;  // tiles.h: one UDIM tile's triangles, their UVs moved into 0-1
-// The unit values bake_normal_map gives texels `texels` (indices y * width + x) with `samples`
-// sample points each (sample_offsets), using the ray distances, cage and centre of a finished bake
-// (`baked`) and otherwise the same rays, shading and averaging as the bake (tangent space with
-// --green down applied, or object space), as n in [-1,1]^3 (not encoded, not snapped to 0).
-// A texel none of whose samples falls in the UV layout gets (0,0,0). Builds its own BVH.
-std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& options,
-                                          const BakeResult& baked, const std::vector<std::uint32_t>& texels, int samples,
-                                          const UvTileFilter* tile = nullptr);
-// ---- end of re-baking chosen texels ----
 
 }  // namespace nmbake

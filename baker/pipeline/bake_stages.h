@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <exception>
 #include <functional>
+#include <memory>
 #include <string>
 #include <thread>
 #include <vector>
@@ -42,6 +43,10 @@ struct TraceInputs {
 // `stage` says what runs, for an out-of-memory message.
 void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt, int threads, TraceInputs& in,
                    BakeResult& result, std::string& stage);
+
+// `inputs` made to hold `high` too: a high-poly moved to the low-poly's origin for the bake, which
+// they read (BakeResult::trace_inputs). Null stays null.
+std::shared_ptr<const TraceInputs> holding(std::shared_ptr<const TraceInputs> inputs, std::shared_ptr<const Mesh> high);
 
 // Texels per side of the trace's bins for these options (TileBins::side).
 int trace_tile_side(const BakeOptions& opt);

@@ -1,12 +1,15 @@
 #include "pipeline/error_estimate.h"
 
 #include "core/codec.h"
+#include "core/parallel.h"
+#include "pipeline/bake_stages.h"
+#include "pipeline/trace.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <optional>
 #include <random>
+#include <stdexcept>
 
 namespace nmbake {
 
@@ -32,12 +35,14 @@ float quantize(float c, int bits) {
 
 }  // namespace
 
-ErrorEstimate estimate_bake_error(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& options,
+ErrorEstimate estimate_bake_error(const Mesh& low, const BakeOptions& options, const BakeResult& result,
+                                  const ErrorEstimateOptions& eo) {
+  if (!result.trace_inputs) throw std::invalid_argument("estimate_bake_error: the bake kept no trace (BakeOptions::keep_trace)");
+  return estimate_bake_error(low, *result.trace_inputs, options, result, eo);
+}
+
+ErrorEstimate estimate_bake_error(const Mesh& low, const TraceInputs& traced, const BakeOptions& options,
                                   const BakeResult& result, const ErrorEstimateOptions& eo) {
-  if (!share_origin(low, high, cage)) {  // as bake_normal_map does
-    const std::optional<Mesh> moved_cage = cage ? std::optional<Mesh>(with_origin(*cage, low.origin)) : std::nullopt;
-    return estimate_bake_error(low, with_origin(high, low.origin), moved_cage ? &*moved_cage : nullptr, options, result, eo);
-  }
   const auto t0 = std::chrono::steady_clock::now();
   ErrorEstimate e;
   // 4x the most samples a texel of the bake has (with --samples auto, its deepest level's).
@@ -59,7 +64,16 @@ ErrorEstimate estimate_bake_error(const Mesh& low, const Mesh& high, const Mesh*
   }
   std::sort(texels.begin(), texels.end());
 
-  const std::vector<glm::dvec3> reference = bake_texel_values(low, high, cage, options, result, texels, e.samples, eo.tile);
+  BakeOptions fixed = options;  // the re-bake's samples, each texel all of them
+  fixed.samples = e.samples;
+  fixed.adaptive = false;
+  fixed.progress = nullptr;
+  // Tiles whose samples take no more room in the tracer than a 64-sample bake's (kTileSide).
+  int side = kTileSide;
+  while (side > 4 && side * side * e.samples > kTileSide * kTileSide * 64) side /= 2;
+  const TileBins bins = bin_triangles(low, fixed.width, fixed.height, side, eo.tile);
+  const std::vector<glm::dvec3> reference =
+      trace_texels(traced.s, traced.scene, bins, traced.rays, fixed, worker_threads(fixed.threads), result.stats, texels);
   std::vector<double> err;
   err.reserve(texels.size());
   double sum = 0.0, qsum = 0.0;

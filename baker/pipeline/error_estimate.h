@@ -1,12 +1,12 @@
 // Error estimate of a finished bake: a random subset of its covered texels re-baked with many
 // samples, and the angle between the bake's values and those.
 //
-// The re-bake uses the same rays and shading as the bake (bake_texel_values), so what it measures
-// is the sampling error of the bake's --samples at its --size (aliasing of detail finer than a
-// texel), not the high-poly's own tessellation. Angles are between the tangent-space (or
-// object-space) unit vectors of the float map (BakeResult::map, before any quantisation), in
-// degrees. The output's bit depth adds quantisation on top; `quantization_*` measures it on the
-// same texels.
+// The re-bake traces the chosen texels through the bake's own tracer (trace_texels, trace.h) over
+// the scene, BVH and rays the bake kept (BakeOptions::keep_trace), so what it measures is the
+// sampling error of the bake's --samples at its --size (aliasing of detail finer than a texel), not
+// the high-poly's own tessellation. Angles are between the tangent-space (or object-space) unit
+// vectors of the float map (BakeResult::map, before any quantisation), in degrees. The output's bit
+// depth adds quantisation on top; `quantization_*` measures it on the same texels.
 #pragma once
 
 #include <cstddef>
@@ -17,6 +17,7 @@
 namespace nmbake {
 
 struct UvTileFilter;  // tiles.h
+struct TraceInputs;   // bake_stages.h
 
 struct ErrorEstimateOptions {
   std::size_t texels = 4096;   // covered texels re-baked (all of them when fewer are covered)
@@ -37,8 +38,13 @@ struct ErrorEstimate {
   double quantization_mean_deg = 0, quantization_max_deg = 0;
 };
 
-// `result` must come from bake_normal_map(low, high, cage, options).
-ErrorEstimate estimate_bake_error(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& options,
+// `result` must come from bake_normal_map(low, high, cage, options) with options.keep_trace (its
+// trace_inputs; std::invalid_argument otherwise).
+ErrorEstimate estimate_bake_error(const Mesh& low, const BakeOptions& options, const BakeResult& result,
+                                  const ErrorEstimateOptions& estimate = {});
+
+// The same over the given trace inputs (a UDIM tile's map: UdimBake::trace_inputs, udim.h).
+ErrorEstimate estimate_bake_error(const Mesh& low, const TraceInputs& traced, const BakeOptions& options,
                                   const BakeResult& result, const ErrorEstimateOptions& estimate = {});
 
 }  // namespace nmbake

@@ -1,5 +1,5 @@
-// The bake's rays and the shading of one sample, shared by the trace stage (trace.h) and the
-// re-baking of chosen texels (rebake.cpp, for the error estimate): one definition of each.
+// The bake's rays and the shading of one sample, for the trace stage (trace.h): the definitions
+// its vector kernels (trace/) give the bits of, and the cases they leave to one at a time.
 #pragma once
 
 #include <cmath>

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <numeric>
 
 #include "pipeline/adaptive_levels.h"
 #include "pipeline/trace_stats.h"
@@ -137,6 +138,34 @@ class TileTracer {
       const std::uint32_t* order = cast_order(sh_.offsets, sample_count);
       for (std::size_t r = 0; r < sample_count * std::size_t(sh_.rays_per_sample); ++r)
         out.push_back(rays_.ray(order ? order[r] : r));
+    }
+  }
+
+  // trace_texels: texels[order[i]] for first[k] <= i < first[k + 1] lie in one tile, traced alone
+  // (as a refining pass traces its marked ones) for each k taken from the shared counter.
+  void run_texels(const std::vector<std::uint32_t>& texels, const std::vector<std::size_t>& order,
+                  const std::vector<std::size_t>& first, std::vector<glm::dvec3>& out) {
+    std::vector<std::uint8_t> only(tile_texels_, 0);
+    const std::uint32_t w = std::uint32_t(sh_.opt.width);
+    for (std::size_t k; !sh_.cancel.load(std::memory_order_relaxed) && (k = sh_.next_tile.fetch_add(1)) + 1 < first.size();) {
+      const std::uint32_t one = texels[order[first[k]]];
+      const std::size_t tile = sh_.bins.tile_of(int(one % w), int(one / w));
+      const TileRect rect = rect_of(tile);
+      const auto at = [&](std::size_t i) {  // in the tile
+        return std::size_t(int(texels[order[i]] / w) - rect.y0) * std::size_t(side_) +
+               std::size_t(int(texels[order[i]] % w) - rect.x0);
+      };
+      for (std::size_t i = first[k]; i < first[k + 1]; ++i) only[at(i)] = 1;
+      trace_pass(tile, rect, sh_.offsets, only.data());
+      for (std::size_t i = first[k]; i < first[k + 1]; ++i) {
+        const std::size_t j = at(i);
+        only[j] = 0;
+        glm::dvec3 v(sums_.sum[0][j], sums_.sum[1][j], sums_.sum[2][j]);
+        const double len = glm::length(v);
+        v = len > 0.0 ? v * (1.0 / len) : glm::dvec3(0, 0, 1);
+        if (sh_.opt.space == NormalSpace::tangent && sh_.opt.green_down) v.y = -v.y;
+        if (sums_.count[j] > 0.0) out[order[i]] = v;
+      }
     }
   }
 
@@ -556,6 +585,29 @@ std::vector<raycast::Ray> trace_rays(const Prepared& s, const HighScene& scene, 
   std::vector<raycast::Ray> all;
   TileTracer(sh, 0).collect_rays(all);
   return all;
+}
+
+std::vector<glm::dvec3> trace_texels(const Prepared& s, const HighScene& scene, const TileBins& bins, const RaySetup& rays,
+                                     const BakeOptions& opt, int threads, const BakeStats& st,
+                                     const std::vector<std::uint32_t>& texels) {
+  const std::uint32_t w = std::uint32_t(opt.width);
+  const auto tile_of = [&](std::size_t i) { return bins.tile_of(int(texels[i] % w), int(texels[i] / w)); };
+  std::vector<std::size_t> order(texels.size()), first;  // the texels tile by tile, and where each tile's begin
+  std::iota(order.begin(), order.end(), std::size_t(0));
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return tile_of(a) < tile_of(b); });
+  for (std::size_t i = 0; i <= order.size(); ++i)
+    if (i == 0 || i == order.size() || tile_of(order[i]) != tile_of(order[i - 1])) first.push_back(i);
+  std::vector<glm::dvec3> out(texels.size(), glm::dvec3(0.0));
+  Image map;
+  std::vector<std::uint8_t> coverage, disagree;
+  const TraceTargets none{map, coverage, map, disagree};
+  Shared sh(s, scene, bins, rays, opt, none, threads);
+  raycast::HitRule rule;
+  set_rule(sh, st, rule);
+  run_workers(
+      std::min(threads, int(first.size() - 1)), [&](int i) { TileTracer(sh, i).run_texels(texels, order, first, out); },
+      sh.cancel, nullptr, [] { return 1.0; });
+  return out;
 }
 
 void trace_and_shade(const Prepared& s, const HighScene& scene, const TileBins& bins, const RaySetup& rays,

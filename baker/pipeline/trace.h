@@ -38,4 +38,13 @@ std::vector<raycast::Ray> trace_rays(const Prepared& s, const HighScene& scene, 
 void trace_and_shade(const Prepared& s, const HighScene& scene, const TileBins& bins, const RaySetup& rays,
                      const BakeOptions& opt, int threads, const TraceTargets& out, BakeStats& st);
 
+// The texels `texels` (indices y * width + x, each once) of `bins` traced as trace_and_shade traces
+// them, by the same tracer, with the samples of opt.samples (sample_offsets; opt.adaptive false);
+// `st` as for trace_rays. Per texel, the renormalized mean of its samples (tangent space with
+// --green down applied, or object space) as n in [-1,1]^3, not encoded and not snapped to 0, or
+// (0,0,0) when the layout covers none of its samples. No progress is reported.
+std::vector<glm::dvec3> trace_texels(const Prepared& s, const HighScene& scene, const TileBins& bins, const RaySetup& rays,
+                                     const BakeOptions& opt, int threads, const BakeStats& st,
+                                     const std::vector<std::uint32_t>& texels);
+
 }  // namespace nmbake

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <new>
 #include <optional>
 #include <stdexcept>
@@ -175,7 +176,10 @@ UdimLayout find_udim_tiles(const Mesh& low, int width, int height) {
 UdimBake bake_udim_tiles(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt) {
   if (!share_origin(low, high, cage)) {  // loaded each on its own (nmbake loads them on one origin)
     const std::optional<Mesh> moved_cage = cage ? std::optional<Mesh>(with_origin(*cage, low.origin)) : std::nullopt;
-    return bake_udim_tiles(low, with_origin(high, low.origin), moved_cage ? &*moved_cage : nullptr, opt);
+    const auto moved_high = std::make_shared<const Mesh>(with_origin(high, low.origin));
+    UdimBake out = bake_udim_tiles(low, *moved_high, moved_cage ? &*moved_cage : nullptr, opt);
+    out.trace_inputs = holding(std::move(out.trace_inputs), moved_high);
+    return out;
   }
   const UdimLayout layout = low.has_uvs() ? find_udim_tiles(low) : UdimLayout{};  // no UVs: check_bake_inputs says so
   const std::size_t n = layout.tiles.size();
@@ -197,7 +201,8 @@ UdimBake bake_udim_tiles(const Mesh& low, const Mesh& high, const Mesh* cage, co
       for (std::size_t i = 0; i < out.tiles.size(); ++i) allocate_outputs(opt, out.tiles[i].result, disagree[i]);
     });
     BakeResult shared;
-    TraceInputs in;
+    const auto kept = std::make_shared<TraceInputs>();
+    TraceInputs& in = *kept;
     prepare_trace(low, high, cage, opt, threads, in, shared, stage);
 
     // Trace: every tile with the shared scene, its own bins. Progress runs over all tiles.
@@ -247,37 +252,26 @@ UdimBake bake_udim_tiles(const Mesh& low, const Mesh& high, const Mesh* cage, co
     out.cage_positions = std::move(shared.cage_positions);
     out.vertex_rear = std::move(shared.vertex_rear);
     out.vertex_search = std::move(shared.vertex_search);
+    if (opt.keep_trace) out.trace_inputs = kept;
     return out;
   } catch (const std::bad_alloc&) {
     throw ResourceError("out of memory while " + stage);
   }
 }
 
-std::vector<ErrorEstimate> estimate_udim_errors(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt,
-                                                UdimBake& bake, const ErrorEstimateOptions& eo) {
+std::vector<ErrorEstimate> estimate_udim_errors(const Mesh& low, const BakeOptions& opt, const UdimBake& bake,
+                                                const ErrorEstimateOptions& eo) {
+  if (!bake.trace_inputs) throw std::invalid_argument("estimate_udim_errors: the bake kept no trace (BakeOptions::keep_trace)");
   const UdimLayout layout = find_udim_tiles(low);  // the bake's, tile for tile
   std::vector<ErrorEstimate> out;
-  for (TileBake& t : bake.tiles) {
+  for (const TileBake& t : bake.tiles) {
     std::size_t k = 0;
     while (k < layout.tiles.size() && layout.tiles[k].number != t.tile.number) ++k;
     if (k == layout.tiles.size()) throw std::logic_error("estimate_udim_errors: the bake's tiles are not the mesh's");
     const UvTileFilter filter{&layout.tile_of, std::int32_t(k), layout.tiles[k].u, layout.tiles[k].v};
     ErrorEstimateOptions tile_options = eo;
     tile_options.tile = &filter;
-    // The re-bake reads the automatic cage and the distances, which the bake keeps once for all tiles.
-    std::swap(t.result.cage_positions, bake.cage_positions);
-    std::swap(t.result.vertex_rear, bake.vertex_rear);
-    std::swap(t.result.vertex_search, bake.vertex_search);
-    struct SwapBack {
-      TileBake& t;
-      UdimBake& b;
-      ~SwapBack() {
-        std::swap(t.result.cage_positions, b.cage_positions);
-        std::swap(t.result.vertex_rear, b.vertex_rear);
-        std::swap(t.result.vertex_search, b.vertex_search);
-      }
-    } swap_back{t, bake};
-    out.push_back(estimate_bake_error(low, high, cage, opt, t.result, tile_options));
+    out.push_back(estimate_bake_error(low, *bake.trace_inputs, opt, t.result, tile_options));
   }
   return out;
 }

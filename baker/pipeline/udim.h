@@ -19,6 +19,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "core/mesh.h"
@@ -87,6 +88,7 @@ struct UdimBake {
   std::size_t straddling_triangles = 0;   // cut at their tile's edge
   std::vector<glm::vec3> cage_positions;  // as BakeResult's
   std::vector<float> vertex_rear, vertex_search;
+  std::shared_ptr<const TraceInputs> trace_inputs;  // as BakeResult's, for all tiles (the tiles' are null)
 };
 
 // Bakes every occupied tile: prepare, select, BVH and distances once, then per tile its bins, the
@@ -96,11 +98,11 @@ struct UdimBake {
 // bake_normal_map throws, and InputError when no triangle lies in a tile.
 UdimBake bake_udim_tiles(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& options);
 
-// The error estimate (error_estimate.h) of each tile of `bake` (made by bake_udim_tiles with these
-// meshes and options): the tile's map against a re-bake of its texels from its own triangles. In
-// the order of bake.tiles; `estimate` as for one map (its `tile` is set here).
-std::vector<ErrorEstimate> estimate_udim_errors(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& options,
-                                                UdimBake& bake, const ErrorEstimateOptions& estimate = {});
+// The error estimate (error_estimate.h) of each tile of `bake` (made by bake_udim_tiles from `low`
+// with these options and keep_trace): the tile's map against a re-bake of its texels from its own
+// triangles. In the order of bake.tiles; `estimate` as for one map (its `tile` is set here).
+std::vector<ErrorEstimate> estimate_udim_errors(const Mesh& low, const BakeOptions& options, const UdimBake& bake,
+                                                const ErrorEstimateOptions& estimate = {});
 
 // The tiles' estimates as one: the mean weighted by the texels compared, and the largest p95, max
 // and quantisation max (an upper bound of the whole's p95); the texels and seconds summed.
