@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "bench_bake.h"
+#include "bench_stages.h"
 #include "bench_support.h"
 #include "io/mesh_io.h"
 
@@ -69,10 +70,9 @@ TraceRounds measure_trace_rounds(const Mesh& low, const Mesh& high, const Record
     t.trace.keep_min(r.stats.seconds_trace, r.stats.cpu_seconds_trace);
     BakeOptions plain = rec.options;
     plain.keep_backfaces = true;
-    plain.cast_by_texel = true;  // the same packets as the bake under the rule
-    const BakeResult nr = bake_normal_map(low, high, nullptr, plain);
-    t.no_rule.keep_min(nr.stats.seconds_trace, nr.stats.cpu_seconds_trace);
-    t.same_rays = t.same_rays && nr.stats.rays == r.stats.rays;
+    const BakeStats nr = trace_by_texel(low, high, plain);  // the same packets as the bake under the rule
+    t.no_rule.keep_min(nr.seconds_trace, nr.cpu_seconds_trace);
+    t.same_rays = t.same_rays && nr.rays == r.stats.rays;
     const std::string h = hex(pixel_hash(r.map.pixels));
     t.hash = round == 0 ? h : (h == t.hash ? t.hash : t.hash + " VARIES between rounds");
     const Timing b1 = bare_loop(scene, rec.rays, threads, Bare::single);
@@ -140,7 +140,7 @@ Recorded record(const Mesh& low, const Mesh& high, int size, int samples) {
   const BakeResult first = bake_normal_map(low, high, nullptr, r.options);
   r.options.front = first.stats.front;
   r.options.rear = first.stats.rear;
-  BakeRays pinned = bake_rays(low, high, nullptr, r.options);
+  BakeRays pinned = bake_rays(low, high, r.options);
   r.rays = std::move(pinned.rays);
   r.positions = recentred(high, pinned.stats.centre);
   r.culled = pinned.stats.high_triangles_culled;

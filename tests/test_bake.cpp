@@ -284,26 +284,3 @@ TEST(Bake, MirroredUVHalvesDecodeToMirroredNormals) {
   EXPECT_GT(compared, 128u * 128u * 9 / 10);
   EXPECT_LT(worst, 0.5);  // the bound; measured 0.0000 deg (the frames mirror exactly)
 }
-
-TEST(Bake, BakeRaysAreTheRaysTheBakeCasts) {
-  // bake_rays (for the bench's bare loop) runs the bake's own stages up to the trace: as many rays
-  // as the bake casts, with its distances, for the automatic cage, fixed distances and closest.
-  const Mesh low = test::make_torus(24, 12);
-  const Mesh high = test::make_torus(96, 48, 1.0f, 0.37f);
-  for (int mode = 0; mode < 3; ++mode) {
-    BakeOptions o = options(96, mode == 2 ? 4 : 1);
-    if (mode >= 1) o.front = o.rear = 0.1f;
-    if (mode == 2) o.policy = RayPolicy::closest;
-    const BakeResult r = bake_normal_map(low, high, nullptr, o);
-    const BakeRays rays = bake_rays(low, high, nullptr, o);
-    ASSERT_GT(r.stats.rays, 0u);
-    EXPECT_EQ(rays.rays.size(), r.stats.rays) << "mode " << mode;
-    EXPECT_EQ(rays.stats.front, r.stats.front);
-    EXPECT_EQ(rays.stats.rear, r.stats.rear);
-    EXPECT_EQ(rays.stats.centre, r.stats.centre);
-    for (const raycast::Ray& ray : rays.rays) {
-      ASSERT_NEAR(glm::length(ray.direction), 1.0f, 1e-5f);
-      ASSERT_GT(ray.tfar, ray.tnear);
-    }
-  }
-}

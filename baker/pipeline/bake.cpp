@@ -290,18 +290,4 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
   }
 }
 
-BakeRays bake_rays(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt) {
-  if (!share_origin(low, high, cage)) {
-    const std::optional<Mesh> moved_cage = cage ? std::optional<Mesh>(with_origin(*cage, low.origin)) : std::nullopt;
-    return bake_rays(low, with_origin(high, low.origin), moved_cage ? &*moved_cage : nullptr, opt);
-  }
-  check_bake_inputs(low, high, cage, opt);
-  BakeResult result;
-  TraceInputs in;
-  std::string stage;
-  prepare_trace(low, high, cage, opt, worker_threads(opt.threads), in, result, stage);
-  const TileBins bins = bin_triangles(low, opt.width, opt.height, trace_tile_side(opt));
-  return {trace_rays(in.s, in.scene, bins, in.rays, opt, result.stats), result.stats};
-}
-
 }  // namespace nmbake

@@ -111,11 +111,6 @@ struct BakeOptions {
   // normal points to) is passed over for the next one, and a hit whose normal points away from the
   // low-poly's outside is taken only when the ray finds no other (raycast::HitRule).
   bool keep_backfaces = false;
-  // Several samples per texel are cast texel by texel under the hit rule; without it, in the order
-  // they were covered, as Embree's pick between two triangles at one distance depends on the
-  // packet's other rays. True: texel by texel either way (the bench's "no rule" timing, so that it
-  // casts the same packets as the bake under the rule; a map may then differ in such ties).
-  bool cast_by_texel = false;
   // Bytes the bake's buffers may take (estimate_bake_bytes); 0 = what the machine has
   // (memory_budget_bytes: MemAvailable, cgroup limit, ulimit -v). Larger bakes are refused.
   std::uint64_t memory_limit = 0;
@@ -243,15 +238,6 @@ void validate_options(const BakeOptions& options);
 // Throws UsageError for absurd options (validate_options), InputError for meshes that cannot be baked (no UVs, cage
 // topology mismatch), ResourceError when the buffers would not fit in memory, Cancelled.
 BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& options);
-
-// The rays bake_normal_map would cast with these options, in coordinates re-centred on
-// stats.centre, tile by tile, and the stats of the stages before the trace (distances, culling,
-// BVH quality). The bench traces them with a bare Embree loop.
-struct BakeRays {
-  std::vector<raycast::Ray> rays;
-  BakeStats stats;
-};
-BakeRays bake_rays(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& options);
 
 // The BVH build quality a bake with these options picks for `triangles` high-poly triangles (after
 // culling), by measurement (bench, issue 6): with few rays per triangle the quick Morton build wins
