@@ -52,20 +52,16 @@ constexpr double kMixedShare = 0.2;
 // BakeOptions::low_object_group: a low-poly object matched to no high-poly object.
 constexpr std::uint32_t kNoMatch = 0xffffffffu;
 
-// A high-poly's BVH kept for the next bakes from the same high-poly mesh (nmbake --batch). The
-// first bake given an empty cache builds its BVH over every triangle (none culled: the map is the
-// same) and keeps it; a later bake from the same mesh whose scene has the same centre and diagonal
-// (its low-poly lies within the high-poly's bounds, or is the same) traces that BVH instead of
-// building one. The maps are the same either way.
+struct KeptBvh;  // pipeline/bvh.h
+
+// A high-poly's BVH kept for the next bakes from the same high-poly (nmbake --batch). The first
+// bake given an empty cache builds its BVH over every triangle (none culled: the map is the same)
+// and keeps it; a later bake whose high-poly has the same content (positions and faces) and whose
+// scene has the same centre and diagonal (its low-poly lies within the high-poly's bounds, or is
+// the same) traces that BVH instead of building one. The maps are the same either way.
 struct BvhCache {
-  std::shared_ptr<const raycast::Scene> scene;
-  const Mesh* high = nullptr;
-  glm::dvec3 centre{0.0};
-  double diagonal = 0.0;
-  std::vector<std::uint32_t> kept;  // the triangles in it (increasing; empty: all)
-  std::size_t duplicates_skipped = 0;
-  raycast::BuildQuality quality = raycast::BuildQuality::medium;
-  std::size_t reused = 0;  // bakes that took it
+  std::shared_ptr<const KeptBvh> kept;  // null until a bake keeps its BVH
+  std::size_t reused = 0;               // bakes that took it
 };
 
 // --max-error's default (BakeOptions::max_error_deg) and the third level's factor, chosen on the
