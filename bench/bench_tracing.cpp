@@ -9,6 +9,7 @@
 #include "bench_stages.h"
 #include "bench_support.h"
 #include "io/mesh_io.h"
+#include "pipeline/bvh.h"
 
 namespace nmbake::bench {
 
@@ -19,15 +20,6 @@ std::vector<glm::vec3> recentred(const Mesh& high, const glm::dvec3& centre) {
   std::vector<glm::vec3> pos(high.positions.size());
   for (std::size_t i = 0; i < pos.size(); ++i) pos[i] = glm::vec3(glm::dvec3(high.positions[i]) - centre);
   return pos;
-}
-
-// The BVH build quality the bake picks (pipeline/bake.h), so the bare loop traces the same kind of tree.
-raycast::BuildQuality bake_quality(const BakeOptions& o, std::size_t kept_triangles) {
-  return bvh_quality_for(o, kept_triangles);
-}
-
-const char* quality_name(raycast::BuildQuality q) {
-  return q == raycast::BuildQuality::low ? "low" : q == raycast::BuildQuality::medium ? "medium" : "high";
 }
 
 // BVH build time and 8-packet trace time per build quality, on the same recorded rays.
@@ -92,7 +84,7 @@ void run_trace_row(BenchRun& run, const std::string& name, const Mesh& low, cons
                    std::vector<QualityRow>& quality_rows) {
   const Args& args = run.args;
   const Recorded rec = record(low, high, 2048, samples);
-  const raycast::BuildQuality quality = bake_quality(rec.options, high.triangle_count() - rec.culled);
+  const raycast::BuildQuality quality = bvh_quality_for(rec.options, high.triangle_count() - rec.culled);
   raycast::Scene scene(&rec.positions[0].x, rec.positions.size(), high.position_index.data(), high.triangle_count(), quality);
   const TraceRounds t = measure_trace_rounds(low, high, rec, scene, run.threads, samples <= 4 ? args.trace_rounds : args.rounds);
   const double paired_median = median(t.paired);
@@ -155,7 +147,7 @@ std::vector<QualityRow> run_tracing(BenchRun& run) {
   std::printf(
       "Each round runs the bake, then the bare loops, back to back on the rays the bake recorded; CPU = process CPU\n"
       "seconds (all threads), less disturbed by other load than wall time. The bare loops trace a BVH of the build quality\n"
-      "the bake picks (bvh_quality_for in pipeline/bake.h: low below 16 rays per triangle, else high; column \"BVH\").\n"
+      "the bake picks (bvh_quality_for in pipeline/bvh.h: low below 16 rays per triangle, else high; column \"BVH\").\n"
       "Targets (wall, trace / best bare): issue 2 <= 1.3x for 1 and 4 samples, issue 6 <= 1.15x for 1 and 16 samples.\n"
       "Bare loops: one rtcIntersect1 per ray; 8-wide packets (rtcIntersect8) filled from Ray structs; 8-wide packets from\n"
       "arrays already in Embree's packet layout (filled before the clock starts; the bake writes its rays this way). The\n"
@@ -227,7 +219,7 @@ void run_bvh_quality(const BenchRun& run, const Scenes& scenes, std::vector<Qual
                 quality_rows[i].samples > 1 ? "s" : "", quality_name(quality_rows[best].quality));
     BakeOptions o;  // 2048^2, as the sweep
     o.samples = quality_rows[i].samples;
-    std::printf(" (the bake picks %s)", quality_name(bake_quality(o, quality_rows[i].triangles)));
+    std::printf(" (the bake picks %s)", quality_name(bvh_quality_for(o, quality_rows[i].triangles)));
   }
   std::printf(".\n\n");
   flush();

@@ -192,9 +192,7 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
   report["started"] = r.started;
   report["warnings"] = r.warnings;
   report["bvh_reused"] = s.bvh_reused;
-  report["bvh_quality"] = s.bvh_quality == raycast::BuildQuality::low      ? "low"
-                          : s.bvh_quality == raycast::BuildQuality::medium ? "medium"
-                                                                           : "high";
+  report["bvh_quality"] = s.bvh_quality;
   return report;
 }
 

@@ -130,11 +130,6 @@ std::vector<glm::dvec2> sample_offsets(int samples) {
   return out;
 }
 
-raycast::BuildQuality bvh_quality_for(const BakeOptions& o, std::size_t triangles) {
-  const double rays = double(o.width) * double(o.height) * double(o.samples);
-  return rays < 16.0 * double(triangles) ? raycast::BuildQuality::low : raycast::BuildQuality::high;
-}
-
 std::uint64_t estimate_bake_bytes(const BakeOptions& o) {
   const std::uint64_t texels = std::uint64_t(std::max(o.width, 0)) * std::uint64_t(std::max(o.height, 0));
   // map (3 floats) + coverage (1 byte) + padding transform (one int) + optional miss mask.
@@ -210,7 +205,7 @@ void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const Ba
     narrow_and_rebuild(high, mode, opt, threads, result, in);
     st.seconds_bvh += seconds_since(t0);
   }
-  st.bvh_quality = in.scene.quality;
+  st.bvh_quality = quality_name(in.scene.quality);
   st.high_triangles_culled = high.triangle_count() - in.scene.triangles;
   in.rays.front = st.front;
   in.rays.rear = st.rear;

@@ -18,7 +18,6 @@
 #include "core/errors.h"
 #include "core/image.h"
 #include "core/mesh.h"
-#include "raycast.h"
 #include "core/tangent_frames.h"
 
 namespace nmbake {
@@ -145,8 +144,8 @@ struct BakeStats {
   std::size_t low_triangles = 0, high_triangles = 0;
   std::size_t high_triangles_culled = 0;    // left out of the BVH: out of every ray's reach
   std::size_t high_duplicates_skipped = 0;  // of those, repeats in a stack of identical triangles (select.h)
-  raycast::BuildQuality bvh_quality = raycast::BuildQuality::medium;  // of the BVH traced (bvh_quality_for)
-  bool bvh_reused = false;  // the BVH of an earlier bake from the same high-poly (BakeOptions::bvh_cache)
+  const char* bvh_quality = "medium";       // of the BVH traced: "low", "medium" or "high" (bvh_quality_for, bvh.h)
+  bool bvh_reused = false;                  // the BVH of an earlier bake from the same high-poly (BakeOptions::bvh_cache)
   std::size_t degenerate_uv_triangles = 0, degenerate_3d_triangles = 0, corners_without_tangent = 0;
   std::size_t uv_outside_triangles = 0;           // low-poly triangles with a UV outside [0,1]
   std::size_t uv_outside_entirely_triangles = 0;  // of those, UV bounding box outside [0,1]^2: not baked
@@ -234,12 +233,6 @@ void validate_options(const BakeOptions& options);
 // Throws UsageError for absurd options (validate_options), InputError for meshes that cannot be baked (no UVs, cage
 // topology mismatch), ResourceError when the buffers would not fit in memory, Cancelled.
 BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& options);
-
-// The BVH build quality a bake with these options picks for `triangles` high-poly triangles (after
-// culling), by measurement (bench, issue 6): with few rays per triangle the quick Morton build wins
-// end to end (1M triangles at 2048^2, 1 sample: 0.15 s build instead of 0.64 s, trace 20% slower);
-// with 16 or more, the high-quality build's faster trace wins (8-9% faster than medium).
-raycast::BuildQuality bvh_quality_for(const BakeOptions& options, std::size_t triangles);
 
 // Bytes the bake will allocate for its images at this size (for the memory check and reports).
 std::uint64_t estimate_bake_bytes(const BakeOptions& options);

@@ -28,6 +28,15 @@ std::uint64_t hash_words(const void* data, std::size_t bytes, std::uint64_t h) {
 
 }  // namespace
 
+raycast::BuildQuality bvh_quality_for(const BakeOptions& o, std::size_t triangles) {
+  const double rays = double(o.width) * double(o.height) * double(o.samples);
+  return rays < 16.0 * double(triangles) ? raycast::BuildQuality::low : raycast::BuildQuality::high;
+}
+
+const char* quality_name(raycast::BuildQuality q) {
+  return q == raycast::BuildQuality::low ? "low" : q == raycast::BuildQuality::medium ? "medium" : "high";
+}
+
 std::uint64_t bvh_content(const Prepared& s, const Mesh& high) {
   const std::uint64_t h = hash_words(s.high_pos.data(), s.high_pos.size() * sizeof(glm::vec3), s.high_pos.size());
   return hash_words(high.position_index.data(), high.position_index.size() * sizeof(std::uint32_t), h);
