@@ -63,7 +63,7 @@ BakeRays bake_rays(const Mesh& low, const Mesh& high, const BakeOptions& o) {
   prepare_trace(low, high, nullptr, o, worker_threads(o.threads), in, result, stage);
   const TileBins bins = bin_triangles(low, o.width, o.height, trace_tile_side(o));
   // Under a hit rule (back faces skipped, or match groups) the trace casts texel by texel.
-  const bool rule = result.stats.backfaces_skipped || !o.low_object_group.empty();
+  const bool rule = result.stats.distances.backfaces_skipped || !o.low_object_group.empty();
   return {tile_rays(in.s, bins, in.rays, sample_offsets(o.samples), o.width, o.height, rule), result.stats};
 }
 
@@ -81,8 +81,8 @@ BakeStats trace_by_texel(const Mesh& low, const Mesh& high, const BakeOptions& o
   const double cpu0 = process_cpu_seconds();
   const TileBins bins = bin_triangles(low, o.width, o.height, trace_tile_side(o));
   trace_and_shade(in.s, in.scene, bins, in.rays, o, threads, {result.map, result.coverage, result.miss_mask, disagree}, st, true);
-  st.seconds_trace = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  st.cpu_seconds_trace = process_cpu_seconds() - cpu0;
+  st.trace.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  st.trace.cpu_seconds = process_cpu_seconds() - cpu0;
   return st;
 }
 

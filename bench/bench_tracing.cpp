@@ -56,15 +56,15 @@ TraceRounds measure_trace_rounds(const Mesh& low, const Mesh& high, const Record
   TraceRounds t;
   for (int round = 0; round < rounds; ++round) {
     const BakeResult r = bake_normal_map(low, high, nullptr, rec.options);
-    if (r.stats.seconds_trace < t.trace.wall) {
-      t.bvh = r.stats.seconds_bvh, t.pad = r.stats.seconds_padding;
+    if (r.stats.trace.seconds < t.trace.wall) {
+      t.bvh = r.stats.bvh.seconds, t.pad = r.stats.pad.seconds;
     }
-    t.trace.keep_min(r.stats.seconds_trace, r.stats.cpu_seconds_trace);
+    t.trace.keep_min(r.stats.trace.seconds, r.stats.trace.cpu_seconds);
     BakeOptions plain = rec.options;
     plain.keep_backfaces = true;
     const BakeStats nr = trace_by_texel(low, high, plain);  // the same packets as the bake under the rule
-    t.no_rule.keep_min(nr.seconds_trace, nr.cpu_seconds_trace);
-    t.same_rays = t.same_rays && nr.rays == r.stats.rays;
+    t.no_rule.keep_min(nr.trace.seconds, nr.trace.cpu_seconds);
+    t.same_rays = t.same_rays && nr.trace.rays == r.stats.trace.rays;
     const std::string h = hex(pixel_hash(r.map.pixels));
     t.hash = round == 0 ? h : (h == t.hash ? t.hash : t.hash + " VARIES between rounds");
     const Timing b1 = bare_loop(scene, rec.rays, threads, Bare::single);
@@ -73,7 +73,7 @@ TraceRounds measure_trace_rounds(const Mesh& low, const Mesh& high, const Record
     t.bare1.keep_min(b1);
     t.bare8.keep_min(b8);
     t.bare_arrays.keep_min(ba);
-    t.paired.push_back(r.stats.seconds_trace / std::min({b1.wall, b8.wall, ba.wall}));
+    t.paired.push_back(r.stats.trace.seconds / std::min({b1.wall, b8.wall, ba.wall}));
   }
   return t;
 }
@@ -130,12 +130,12 @@ Recorded record(const Mesh& low, const Mesh& high, int size, int samples) {
   r.options.width = r.options.height = size;
   r.options.samples = samples;
   const BakeResult first = bake_normal_map(low, high, nullptr, r.options);
-  r.options.front = first.stats.front;
-  r.options.rear = first.stats.rear;
+  r.options.front = first.stats.distances.front;
+  r.options.rear = first.stats.distances.rear;
   BakeRays pinned = bake_rays(low, high, r.options);
   r.rays = std::move(pinned.rays);
-  r.positions = recentred(high, pinned.stats.centre);
-  r.culled = pinned.stats.high_triangles_culled;
+  r.positions = recentred(high, pinned.stats.prepare.centre);
+  r.culled = pinned.stats.select.high_triangles_culled;
   return r;
 }
 

@@ -31,11 +31,11 @@ TEST(BenchStages, BakeRaysAreTheRaysTheBakeCasts) {
     if (mode == 3) o.keep_backfaces = true;
     const BakeResult r = bake_normal_map(low, high, nullptr, o);
     const BakeRays rays = bake_rays(low, high, o);
-    ASSERT_GT(r.stats.rays, 0u);
-    EXPECT_EQ(rays.rays.size(), r.stats.rays) << "mode " << mode;
-    EXPECT_EQ(rays.stats.front, r.stats.front);
-    EXPECT_EQ(rays.stats.rear, r.stats.rear);
-    EXPECT_EQ(rays.stats.centre, r.stats.centre);
+    ASSERT_GT(r.stats.trace.rays, 0u);
+    EXPECT_EQ(rays.rays.size(), r.stats.trace.rays) << "mode " << mode;
+    EXPECT_EQ(rays.stats.distances.front, r.stats.distances.front);
+    EXPECT_EQ(rays.stats.distances.rear, r.stats.distances.rear);
+    EXPECT_EQ(rays.stats.prepare.centre, r.stats.prepare.centre);
     for (const raycast::Ray& ray : rays.rays) {
       ASSERT_NEAR(glm::length(ray.direction), 1.0f, 1e-5f);
       ASSERT_GT(ray.tfar, ray.tnear);
@@ -54,7 +54,7 @@ TEST(BenchStages, BakeRaysHitWhereTheBakesHit) {
   const BakeResult r = bake_normal_map(low, high, nullptr, o);
   const BakeRays rays = bake_rays(low, high, o);
   std::vector<glm::vec3> pos;
-  for (const glm::vec3& p : high.positions) pos.push_back(glm::vec3(glm::dvec3(p) - rays.stats.centre));
+  for (const glm::vec3& p : high.positions) pos.push_back(glm::vec3(glm::dvec3(p) - rays.stats.prepare.centre));
   const raycast::Scene scene(&pos[0].x, pos.size(), high.position_index.data(), high.triangle_count());
   std::vector<raycast::Hit> hits(rays.rays.size());
   scene.intersect(rays.rays.data(), hits.data(), hits.size());
@@ -62,9 +62,9 @@ TEST(BenchStages, BakeRaysHitWhereTheBakesHit) {
   double sum = 0.0;
   for (const raycast::Hit& h : hits)
     if (h.triangle != raycast::no_hit) ++hit_count, sum += double(o.front) - double(h.t);
-  ASSERT_GT(r.stats.misses, 0u);  // the distances leave some samples without a hit
-  EXPECT_EQ(hit_count, r.stats.hits);
-  EXPECT_NEAR(sum / double(hit_count), r.stats.hit_distance_mean, 1e-9);
+  ASSERT_GT(r.stats.trace.misses, 0u);  // the distances leave some samples without a hit
+  EXPECT_EQ(hit_count, r.stats.trace.hits);
+  EXPECT_NEAR(sum / double(hit_count), r.stats.trace.hit_distance_mean, 1e-9);
 }
 
 TEST(BenchStages, TraceByTexelIsTheBakesTrace) {
@@ -77,13 +77,13 @@ TEST(BenchStages, TraceByTexelIsTheBakesTrace) {
     o.keep_backfaces = keep;
     const BakeResult r = bake_normal_map(low, high, nullptr, o);
     const BakeStats st = trace_by_texel(low, high, o);
-    EXPECT_EQ(st.rays, r.stats.rays);
-    EXPECT_EQ(st.hits, r.stats.hits);
-    EXPECT_EQ(st.texels_covered, r.stats.texels_covered);
+    EXPECT_EQ(st.trace.rays, r.stats.trace.rays);
+    EXPECT_EQ(st.trace.hits, r.stats.trace.hits);
+    EXPECT_EQ(st.trace.texels_covered, r.stats.trace.texels_covered);
     if (!keep) {
-      EXPECT_EQ(st.hit_distance_mean, r.stats.hit_distance_mean);
+      EXPECT_EQ(st.trace.hit_distance_mean, r.stats.trace.hit_distance_mean);
     }
-    EXPECT_GT(st.seconds_trace, 0.0);
+    EXPECT_GT(st.trace.seconds, 0.0);
   }
 }
 

@@ -157,8 +157,8 @@ BvhSource select_and_build(const Mesh& high, const ReachMode& mode, const BakeOp
   stage = "building the BVH of " + std::to_string(count) + " high-poly triangles";
   build_high_scene(in.scene, s, high, in.selection.kept, reuse ? reuse->quality : bvh_quality_for(opt, count), opt.threads,
                    reuse ? reuse->scene : nullptr, !keep);
-  st.high_duplicates_skipped = in.selection.duplicates_skipped;
-  st.bvh_reused = reuse != nullptr;
+  st.select.high_duplicates_skipped = in.selection.duplicates_skipped;
+  st.bvh.reused = reuse != nullptr;
   if (reuse) ++cache->reused;
   if (keep)
     cache->kept =
@@ -170,7 +170,7 @@ BvhSource select_and_build(const Mesh& high, const ReachMode& mode, const BakeOp
 void narrow_and_rebuild(const Mesh& high, const ReachMode& mode, const BakeOptions& opt, int threads, const BakeResult& result,
                         TraceInputs& in) {
   const BakeStats& st = result.stats;
-  if (narrow_high(in.s, high, mode.any_cage, st.front, st.rear, result.vertex_search, in.selection, threads))
+  if (narrow_high(in.s, high, mode.any_cage, st.distances.front, st.distances.rear, result.vertex_search, in.selection, threads))
     build_high_scene(in.scene, in.s, high, in.selection.kept, bvh_quality_for(opt, in.selection.kept.size()), opt.threads,
                      nullptr, true);
 }
@@ -182,33 +182,33 @@ void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const Ba
   announce_stage(opt, "preparing");
   stage = "preparing " + std::to_string(low.triangle_count()) + " low-poly and " + std::to_string(high.triangle_count()) +
           " high-poly triangles";
-  st.low_triangles = low.triangle_count();
-  st.high_triangles = high.triangle_count();
+  st.prepare.low_triangles = low.triangle_count();
+  st.prepare.high_triangles = high.triangle_count();
   auto t0 = Clock::now();
   in.s = prepare(low, high, cage, st);
   const ReachMode mode = ReachMode::of(opt, cage, in.s);
-  st.seconds_prepare = seconds_since(t0);
+  st.prepare.seconds = seconds_since(t0);
 
   t0 = Clock::now();
   const BvhSource source = select_and_build(high, mode, opt, threads, in, st, stage);
-  st.seconds_bvh = seconds_since(t0);
+  st.bvh.seconds = seconds_since(t0);
 
   t0 = Clock::now();
   announce_stage(opt, "measuring distances");
   stage = "measuring the ray distances";
   measure_reach(mode, low, opt, threads, in.s, in.scene, result);
-  st.seconds_distances = seconds_since(t0);
+  st.distances.seconds = seconds_since(t0);
 
   if (opt.cull_far && mode.probing && source == BvhSource::built) {
     t0 = Clock::now();
     stage = "building the BVH of the reachable high-poly triangles";
     narrow_and_rebuild(high, mode, opt, threads, result, in);
-    st.seconds_bvh += seconds_since(t0);
+    st.bvh.seconds += seconds_since(t0);
   }
-  st.bvh_quality = quality_name(in.scene.quality);
-  st.high_triangles_culled = high.triangle_count() - in.scene.triangles;
-  in.rays.front = st.front;
-  in.rays.rear = st.rear;
+  st.bvh.quality = quality_name(in.scene.quality);
+  st.select.high_triangles_culled = high.triangle_count() - in.scene.triangles;
+  in.rays.front = st.distances.front;
+  in.rays.rear = st.distances.rear;
   in.rays.cage = mode.any_cage;
   in.rays.closest = opt.policy == RayPolicy::closest;
   in.rays.diagonal = in.s.diagonal;
@@ -273,14 +273,14 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     const TileBins bins = bin_triangles(low, opt.width, opt.height, trace_tile_side(opt));
     outputs.wait();
     trace_and_shade(in.s, in.scene, bins, in.rays, opt, threads, {result.map, result.coverage, result.miss_mask, disagree}, st);
-    st.seconds_trace = seconds_since(t0);
-    st.cpu_seconds_trace = process_cpu_seconds() - cpu0;
+    st.trace.seconds = seconds_since(t0);
+    st.trace.cpu_seconds = process_cpu_seconds() - cpu0;
 
     announce_stage(opt, "padding");
     stage = "padding (" + texels + ")";
     t0 = Clock::now();
     pad_map(opt, disagree, threads, result);
-    st.seconds_padding = seconds_since(t0);
+    st.pad.seconds = seconds_since(t0);
     return result;
   } catch (const std::bad_alloc&) {
     throw ResourceError("out of memory while " + stage);

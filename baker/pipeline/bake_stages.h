@@ -20,7 +20,7 @@
 
 namespace nmbake {
 
-// Process CPU time in seconds (all threads), for BakeStats::cpu_seconds_trace.
+// Process CPU time in seconds (all threads), for BakeStats::Trace::cpu_seconds.
 double process_cpu_seconds();
 
 // Calls options.on_stage when set.
@@ -56,7 +56,7 @@ enum class BvhSource { built, kept, reused };
 // ray can reach before the distances are known (within the probes' reach `mode.reach`, or the
 // distances given; all of them without cull_far or for a BVH to keep), less duplicate floods
 // (select_high), in a BVH of the quality bvh_quality_for picks, kept by an empty cache. Sets
-// st.high_duplicates_skipped and bvh_reused; `stage` names the build.
+// st.select.high_duplicates_skipped and st.bvh.reused; `stage` names the build.
 BvhSource select_and_build(const Mesh& high, const ReachMode& mode, const BakeOptions& opt, int threads, TraceInputs& in,
                            BakeStats& st, std::string& stage);
 

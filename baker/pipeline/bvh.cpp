@@ -1,32 +1,11 @@
 #include "pipeline/bvh.h"
 
-#include <cstring>
+#include <functional>
+#include <string_view>
 
 #include "core/parallel.h"
 
 namespace nmbake {
-
-namespace {
-
-// Words of `bytes` bytes hashed on four lanes (their multiplies overlap), then the tail, into `h`.
-std::uint64_t hash_words(const void* data, std::size_t bytes, std::uint64_t h) {
-  constexpr std::uint64_t kMul = 0x9e3779b97f4a7c15ull;
-  const unsigned char* p = static_cast<const unsigned char*>(data);
-  std::uint64_t lane[4] = {h, h + 1, h + 2, h + 3};
-  std::size_t i = 0;
-  for (; i + 32 <= bytes; i += 32)
-    for (int k = 0; k < 4; ++k) {
-      std::uint64_t w;
-      std::memcpy(&w, p + i + 8 * std::size_t(k), 8);
-      lane[k] = (lane[k] ^ w) * kMul;
-      lane[k] ^= lane[k] >> 32;
-    }
-  for (; i < bytes; ++i) lane[0] = (lane[0] ^ p[i]) * kMul;
-  for (int k = 1; k < 4; ++k) lane[0] = (lane[0] ^ lane[k]) * kMul;
-  return lane[0] ^ (lane[0] >> 29);
-}
-
-}  // namespace
 
 raycast::BuildQuality bvh_quality_for(const BakeOptions& o, std::size_t triangles) {
   const double rays = double(o.width) * double(o.height) * double(o.samples);
@@ -38,8 +17,10 @@ const char* quality_name(raycast::BuildQuality q) {
 }
 
 std::uint64_t bvh_content(const Prepared& s, const Mesh& high) {
-  const std::uint64_t h = hash_words(s.high_pos.data(), s.high_pos.size() * sizeof(glm::vec3), s.high_pos.size());
-  return hash_words(high.position_index.data(), high.position_index.size() * sizeof(std::uint32_t), h);
+  const auto bytes = [](const auto& v) {
+    return std::hash<std::string_view>{}({reinterpret_cast<const char*>(v.data()), v.size() * sizeof(v[0])});
+  };
+  return bytes(s.high_pos) * 0x9e3779b97f4a7c15ull ^ bytes(high.position_index);
 }
 
 const KeptBvh* find_kept_bvh(const BvhCache* cache, const Prepared& s, std::uint64_t content) {

@@ -51,7 +51,7 @@ struct RayGroups {
 RayGroups ray_groups(const Prepared& s, const HighScene& h, const BakeOptions& opt);
 
 // The rule the trace casts under, or null for none: h.hit_rule() when back faces are skipped
-// (BakeStats::backfaces_skipped); with match groups, the groups too (alone when back faces are
+// (BakeStats::Distances::backfaces_skipped); with match groups, the groups too (alone when back faces are
 // kept). `rule` holds it.
 const raycast::HitRule* trace_rule(const HighScene& h, bool backfaces_skipped, const RayGroups& groups, raycast::HitRule& rule);
 
@@ -69,7 +69,7 @@ void build_high_scene(HighScene& h, const Prepared& s, const Mesh& high, const s
 // with 16 or more, the high-quality build's faster trace wins (8-9% faster than medium).
 raycast::BuildQuality bvh_quality_for(const BakeOptions& options, std::size_t triangles);
 
-// "low", "medium" or "high" (BakeStats::bvh_quality).
+// "low", "medium" or "high" (BakeStats::Bvh::quality).
 const char* quality_name(raycast::BuildQuality quality);
 
 // A BVH a BvhCache keeps (bake.h) and what it was built from. Keyed by content, not by address: a

@@ -29,18 +29,19 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
   if (!cage && !baked.cage_positions.empty())
     attach_cage(s, baked.cage_positions, low.position_index);  // the bake's automatic cage
   const bool any_cage = !s.cage_tris.empty();
-  if (any_cage) set_cage_reach(s, low, st.rear, baked.vertex_rear, baked.vertex_search);
+  if (any_cage) set_cage_reach(s, low, st.distances.rear, baked.vertex_rear, baked.vertex_search);
   // Few rays: a quick BVH build pays off more than a fast one to trace. All triangles: culling
   // leaves the hits unchanged.
   HighScene scene;
   build_high_scene(scene, s, high, {}, raycast::BuildQuality::low, opt.threads, nullptr, true);
-  if (st.high_facing == BakeStats::HighFacing::inverted) turn_inverted_high(s, scene, scratch.high_normals_computed);
+  if (st.distances.high_facing == BakeStats::HighFacing::inverted)
+    turn_inverted_high(s, scene, scratch.prepare.high_normals_computed);
   const RayGroups groups = ray_groups(s, scene, opt);
   raycast::HitRule rule;
-  const raycast::HitRule* const hit_rule = trace_rule(scene, st.backfaces_skipped, groups, rule);
+  const raycast::HitRule* const hit_rule = trace_rule(scene, st.distances.backfaces_skipped, groups, rule);
   RaySetup ray_setup;
-  ray_setup.front = st.front;
-  ray_setup.rear = st.rear;
+  ray_setup.front = st.distances.front;
+  ray_setup.rear = st.distances.rear;
   ray_setup.cage = any_cage;
   ray_setup.closest = opt.policy == RayPolicy::closest;
   ray_setup.diagonal = s.diagonal;
@@ -69,7 +70,7 @@ std::vector<glm::dvec3> bake_texel_values(const Mesh& low, const Mesh& high, con
     ray_batch.outward = outward.empty() ? nullptr : outward.data();
     ray_batch.coherent = true;  // a texel's samples one after another
     std::vector<float> prefer_lo(arrays.size()), prefer_hi(arrays.size());
-    if (st.backfaces_skipped) {
+    if (st.distances.backfaces_skipped) {
       ray_batch.prefer_lo = prefer_lo.data();
       ray_batch.prefer_hi = prefer_hi.data();
     }

@@ -528,8 +528,8 @@ class TileTracer {
 // `rule` holds it.
 void set_rule(Shared& sh, const BakeStats& st, raycast::HitRule& rule) {
   sh.groups = ray_groups(sh.s, sh.scene, sh.opt);
-  sh.hit_rule = trace_rule(sh.scene, st.backfaces_skipped, sh.groups, rule);
-  sh.prefer = st.backfaces_skipped;
+  sh.hit_rule = trace_rule(sh.scene, st.distances.backfaces_skipped, sh.groups, rule);
+  sh.prefer = st.distances.backfaces_skipped;
 }
 
 }  // namespace
@@ -547,9 +547,9 @@ void trace_and_shade(const Prepared& s, const HighScene& scene, const TileBins& 
       [&sh] { return double(sh.tiles_done.load()) / double(sh.bins.count()); });
 
   sum_thread_stats(sh.stats, sh.per_object, s.low_objects, s.high_objects, sh.tile_dsum, st);
-  st.texels_total = std::size_t(opt.width) * std::size_t(opt.height);
-  for (std::uint8_t c : out.coverage) st.texels_covered += c;
-  st.coverage = double(st.texels_covered) / double(st.texels_total);
+  st.trace.texels_total = std::size_t(opt.width) * std::size_t(opt.height);
+  for (std::uint8_t c : out.coverage) st.trace.texels_covered += c;
+  st.trace.coverage = double(st.trace.texels_covered) / double(st.trace.texels_total);
 }
 
 }  // namespace nmbake

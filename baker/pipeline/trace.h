@@ -26,14 +26,12 @@ struct TraceTargets {
   std::vector<std::uint8_t>& disagree;
 };
 
-// Traces every tile of `bins`, applying the hit rule of `scene` unless stats.backfaces_skipped is
-// false. Fills in `st`: rays, hits, misses, samples_covered, overlapping_samples, backface_skips,
+// Traces every tile of `bins`, applying the hit rule of `scene` unless st.distances.backfaces_skipped is
+// false. Fills in `st.trace`: rays, hits, misses, samples_covered, overlapping_samples, backface_skips,
 // hits_facing_away, hit_distance_*, texels_total, texels_covered, coverage.
 // Calls options.progress from the calling thread; throws Cancelled when it returns false.
-// Several samples per texel are cast texel by texel under the hit rule; without it in the order
-// they were covered (Embree's pick between two triangles at one distance depends on the packet's
-// other rays), unless `by_texel` (the bench's timing without the rule casts the same packets as
-// the bake under it; a map may then differ in such ties).
+// `by_texel`: several samples per texel cast texel by texel even without the hit rule, as under it
+// (cast_order in trace.cpp; a map may then differ in ties between triangles at one distance).
 void trace_and_shade(const Prepared& s, const HighScene& scene, const TileBins& bins, const RaySetup& rays,
                      const BakeOptions& opt, int threads, const TraceTargets& out, BakeStats& st, bool by_texel = false);
 
