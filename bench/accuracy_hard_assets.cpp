@@ -62,15 +62,16 @@ std::vector<HardAssetRow> run_hard_assets(const std::vector<int>& sizes, std::ve
         row.setting = setting;
         row.size = size;
         row.texels = e.texels;
-        row.facing_away = r.stats.texels_covered ? double(r.stats.texels_facing_away) / double(r.stats.texels_covered) : 0.0;
+        row.facing_away =
+            r.stats.trace.texels_covered ? double(r.stats.pad.texels_facing_away) / double(r.stats.trace.texels_covered) : 0.0;
         row.mean_deg = e.mean_deg;
         row.over1 = e.over1;
         row.over60 = e.over60;
         row.worst_deg = e.worst_deg;
-        row.misses = r.stats.misses;
-        row.backface_skips = r.stats.backface_skips;
-        row.front = cage ? push : r.stats.front;  // BakeStats::front is 0 with a cage
-        row.rear = r.stats.rear;
+        row.misses = r.stats.trace.misses;
+        row.backface_skips = r.stats.trace.backface_skips;
+        row.front = cage ? push : r.stats.distances.front;  // BakeStats::Distances::front is 0 with a cage
+        row.rear = r.stats.distances.rear;
         row.seconds = seconds;
         rows.push_back(row);
         std::fprintf(
@@ -90,7 +91,7 @@ std::vector<HardAssetRow> run_hard_assets(const std::vector<int>& sizes, std::ve
       closest.policy = RayPolicy::closest;
       run("closest", closest, nullptr);
 
-      const double push = 1.25 * def.vertex_front.max;
+      const double push = 1.25 * def.distances.vertex_front.max;
       const Mesh cage = push_cage(a.low, push);
       run("cage", o, &cage, push);
 
@@ -100,12 +101,12 @@ std::vector<HardAssetRow> run_hard_assets(const std::vector<int>& sizes, std::ve
       measure_old.width = measure_old.height = 64;
       measure_old.padding = 0;
       measure_old.keep_backfaces = true;
-      measure_old.rear = float(def.vertex_rear.max);
+      measure_old.rear = float(def.distances.vertex_rear.max);
       const BakeStats old_distances = bake_normal_map(a.low, a.high, nullptr, measure_old).stats;
       BakeOptions old = o;
       old.keep_backfaces = true;
-      old.front = old_distances.front;
-      old.rear = old_distances.rear;
+      old.front = old_distances.distances.front;
+      old.rear = old_distances.distances.rear;
       run("old-rule", old, nullptr);
     }
   }
@@ -137,7 +138,8 @@ std::string hard_assets_markdown(const std::vector<HardAssetRow>& rows, const st
        "kept, first hit, front and rear pinned to the scene-wide distances measured with back faces kept and the rear "
        "given as the default bake's largest per-vertex rear: the baker before the automatic cage and the back-face "
        "filter). Facing away: covered texels whose normal points into the low-poly (`texels_facing_away` / "
-       "`texels_covered`). Front, rear: the largest distances the bake used (`BakeStats::front`, `rear`); for `cage` the push. "
+       "`texels_covered`). Front, rear: the largest distances the bake used (`BakeStats::Distances::front`, `rear`); for `cage` "
+       "the push. "
        "Seconds: `bake_normal_map` in-process; for `cage` and `old-rule` without the bakes that "
        "measured their distances. The section took " +
        fmt("%.0f", seconds) + " s.\n\n";

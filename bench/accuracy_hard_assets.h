@@ -15,12 +15,12 @@ struct HardAssetRow {
   std::string asset, setting;        // setting: default, closest, cage, old-rule
   int size = 0;                      // map side in texels (1 sample per texel)
   std::size_t texels = 0;            // covered texel centres measured
-  double facing_away = 0.0;          // BakeStats::texels_facing_away / texels_covered
+  double facing_away = 0.0;          // BakeStats::Pad::texels_facing_away / texels_covered
   double mean_deg = 0.0;             // mean angular error against the analytic normal, degrees
   double over1 = 0.0, over60 = 0.0;  // share of the texels more than 1 (60) degrees off
   double worst_deg = 0.0;
   std::uint64_t misses = 0, backface_skips = 0;
-  double front = 0.0, rear = 0.0;  // BakeStats::front / rear: largest distances used (cage: its push), scene units
+  double front = 0.0, rear = 0.0;  // BakeStats::Distances::front / rear: largest distances used (cage: its push), scene units
   double seconds = 0.0;            // bake_normal_map wall time (in-process; no files)
 };
 
@@ -28,7 +28,7 @@ struct HardAssetRow {
 //  - default:  default BakeOptions (automatic cage, back faces skipped);
 //  - closest:  RayPolicy::closest, otherwise default;
 //  - cage:     an explicit cage: the low-poly moved along its per-position ray normals by
-//              1.25 x the default bake's BakeStats::vertex_front.max (an artist's uniform push);
+//              1.25 x the default bake's BakeStats::Distances::vertex_front.max (an artist's uniform push);
 //  - old-rule: keep_backfaces with front and rear pinned to the global distances a bake with
 //              back faces kept measures (rear given as the default bake's vertex_rear.max),
 //              i.e. the rule the baker had before the automatic cage and the back-face filter.

@@ -54,7 +54,7 @@ const char* verdict(bool met);  // "MET" or "NOT MET"
 void flush();                   // stdout, so a long run shows each row as it is measured
 
 // A bake's distances pinned (so the timed rounds skip the measurement), and the rays a bake with
-// them casts (bake_rays: the bake's own stages up to the trace).
+// them casts (bake_rays, bench_stages.h).
 struct Recorded {
   std::vector<raycast::Ray> rays;
   std::vector<glm::vec3> positions;  // high-poly, re-centred

@@ -64,7 +64,7 @@ void run_thread_scaling(BenchRun& run, const Scenes& scenes) {
       BakeOptions o = rec.options;
       o.threads = t;
       const BakeResult r = bake_normal_map(t3_low, t3_high, nullptr, o);
-      trace[t - 1].keep_min(r.stats.seconds_trace, r.stats.cpu_seconds_trace);
+      trace[t - 1].keep_min(r.stats.trace.seconds, r.stats.trace.cpu_seconds);
       bare[t - 1].keep_min(bare_loop(scene, rec.rays, t, Bare::arrays));
     }
   std::printf("| threads | trace s (CPU) | bare 8-packet from arrays s (CPU) |\n|---|---|---|\n");
@@ -129,14 +129,14 @@ void run_texel_scaling(const BenchRun& run, const Scenes& scenes) {
       const auto t0 = Clock::now();
       const BakeResult r = bake_normal_map(scenes.t3_low, scenes.t3_high, nullptr, o);
       const double total = since(t0);
-      trace.keep_min(r.stats.seconds_trace, r.stats.cpu_seconds_trace);
+      trace.keep_min(r.stats.trace.seconds, r.stats.trace.cpu_seconds);
       if (total < best_total) best_total = total, best = r.stats;
     }
     if (first_trace == 0) first_trace = trace.wall;
     std::printf("| %d^2 | %zu | %.2fM | %.3f | %.3f | %.3f | %.3f (%.3f) | %.3f | %.3f | %.0f | %.2fx |\n", size,
-                best.texels_covered, double(best.rays) / 1e6, best.seconds_prepare, best.seconds_bvh, best.seconds_distances,
-                trace.wall, trace.cpu, best.seconds_padding, best_total, 1e9 * trace.wall / double(best.rays),
-                trace.wall / first_trace);
+                best.trace.texels_covered, double(best.trace.rays) / 1e6, best.prepare.seconds, best.bvh.seconds,
+                best.distances.seconds, trace.wall, trace.cpu, best.pad.seconds, best_total,
+                1e9 * trace.wall / double(best.trace.rays), trace.wall / first_trace);
     flush();
   }
   std::printf("\n(stage columns from the fastest whole bake; trace = best of the rounds; x trace = against 1024^2.)\n\n");

@@ -6,8 +6,10 @@
 #include <vector>
 
 #include "bench_bake.h"
+#include "bench_stages.h"
 #include "bench_support.h"
 #include "io/mesh_io.h"
+#include "pipeline/bvh.h"
 
 namespace nmbake::bench {
 
@@ -18,15 +20,6 @@ std::vector<glm::vec3> recentred(const Mesh& high, const glm::dvec3& centre) {
   std::vector<glm::vec3> pos(high.positions.size());
   for (std::size_t i = 0; i < pos.size(); ++i) pos[i] = glm::vec3(glm::dvec3(high.positions[i]) - centre);
   return pos;
-}
-
-// The BVH build quality the bake picks (pipeline/bake.h), so the bare loop traces the same kind of tree.
-raycast::BuildQuality bake_quality(const BakeOptions& o, std::size_t kept_triangles) {
-  return bvh_quality_for(o, kept_triangles);
-}
-
-const char* quality_name(raycast::BuildQuality q) {
-  return q == raycast::BuildQuality::low ? "low" : q == raycast::BuildQuality::medium ? "medium" : "high";
 }
 
 // BVH build time and 8-packet trace time per build quality, on the same recorded rays.
@@ -63,16 +56,15 @@ TraceRounds measure_trace_rounds(const Mesh& low, const Mesh& high, const Record
   TraceRounds t;
   for (int round = 0; round < rounds; ++round) {
     const BakeResult r = bake_normal_map(low, high, nullptr, rec.options);
-    if (r.stats.seconds_trace < t.trace.wall) {
-      t.bvh = r.stats.seconds_bvh, t.pad = r.stats.seconds_padding;
+    if (r.stats.trace.seconds < t.trace.wall) {
+      t.bvh = r.stats.bvh.seconds, t.pad = r.stats.pad.seconds;
     }
-    t.trace.keep_min(r.stats.seconds_trace, r.stats.cpu_seconds_trace);
+    t.trace.keep_min(r.stats.trace.seconds, r.stats.trace.cpu_seconds);
     BakeOptions plain = rec.options;
     plain.keep_backfaces = true;
-    plain.cast_by_texel = true;  // the same packets as the bake under the rule
-    const BakeResult nr = bake_normal_map(low, high, nullptr, plain);
-    t.no_rule.keep_min(nr.stats.seconds_trace, nr.stats.cpu_seconds_trace);
-    t.same_rays = t.same_rays && nr.stats.rays == r.stats.rays;
+    const BakeStats nr = trace_by_texel(low, high, plain);  // the same packets as the bake under the rule
+    t.no_rule.keep_min(nr.trace.seconds, nr.trace.cpu_seconds);
+    t.same_rays = t.same_rays && nr.trace.rays == r.stats.trace.rays;
     const std::string h = hex(pixel_hash(r.map.pixels));
     t.hash = round == 0 ? h : (h == t.hash ? t.hash : t.hash + " VARIES between rounds");
     const Timing b1 = bare_loop(scene, rec.rays, threads, Bare::single);
@@ -81,7 +73,7 @@ TraceRounds measure_trace_rounds(const Mesh& low, const Mesh& high, const Record
     t.bare1.keep_min(b1);
     t.bare8.keep_min(b8);
     t.bare_arrays.keep_min(ba);
-    t.paired.push_back(r.stats.seconds_trace / std::min({b1.wall, b8.wall, ba.wall}));
+    t.paired.push_back(r.stats.trace.seconds / std::min({b1.wall, b8.wall, ba.wall}));
   }
   return t;
 }
@@ -92,7 +84,7 @@ void run_trace_row(BenchRun& run, const std::string& name, const Mesh& low, cons
                    std::vector<QualityRow>& quality_rows) {
   const Args& args = run.args;
   const Recorded rec = record(low, high, 2048, samples);
-  const raycast::BuildQuality quality = bake_quality(rec.options, high.triangle_count() - rec.culled);
+  const raycast::BuildQuality quality = bvh_quality_for(rec.options, high.triangle_count() - rec.culled);
   raycast::Scene scene(&rec.positions[0].x, rec.positions.size(), high.position_index.data(), high.triangle_count(), quality);
   const TraceRounds t = measure_trace_rounds(low, high, rec, scene, run.threads, samples <= 4 ? args.trace_rounds : args.rounds);
   const double paired_median = median(t.paired);
@@ -138,12 +130,12 @@ Recorded record(const Mesh& low, const Mesh& high, int size, int samples) {
   r.options.width = r.options.height = size;
   r.options.samples = samples;
   const BakeResult first = bake_normal_map(low, high, nullptr, r.options);
-  r.options.front = first.stats.front;
-  r.options.rear = first.stats.rear;
-  BakeRays pinned = bake_rays(low, high, nullptr, r.options);
+  r.options.front = first.stats.distances.front;
+  r.options.rear = first.stats.distances.rear;
+  BakeRays pinned = bake_rays(low, high, r.options);
   r.rays = std::move(pinned.rays);
-  r.positions = recentred(high, pinned.stats.centre);
-  r.culled = pinned.stats.high_triangles_culled;
+  r.positions = recentred(high, pinned.stats.prepare.centre);
+  r.culled = pinned.stats.select.high_triangles_culled;
   return r;
 }
 
@@ -155,7 +147,7 @@ std::vector<QualityRow> run_tracing(BenchRun& run) {
   std::printf(
       "Each round runs the bake, then the bare loops, back to back on the rays the bake recorded; CPU = process CPU\n"
       "seconds (all threads), less disturbed by other load than wall time. The bare loops trace a BVH of the build quality\n"
-      "the bake picks (bvh_quality_for in pipeline/bake.h: low below 16 rays per triangle, else high; column \"BVH\").\n"
+      "the bake picks (bvh_quality_for in pipeline/bvh.h: low below 16 rays per triangle, else high; column \"BVH\").\n"
       "Targets (wall, trace / best bare): issue 2 <= 1.3x for 1 and 4 samples, issue 6 <= 1.15x for 1 and 16 samples.\n"
       "Bare loops: one rtcIntersect1 per ray; 8-wide packets (rtcIntersect8) filled from Ray structs; 8-wide packets from\n"
       "arrays already in Embree's packet layout (filled before the clock starts; the bake writes its rays this way). The\n"
@@ -227,7 +219,7 @@ void run_bvh_quality(const BenchRun& run, const Scenes& scenes, std::vector<Qual
                 quality_rows[i].samples > 1 ? "s" : "", quality_name(quality_rows[best].quality));
     BakeOptions o;  // 2048^2, as the sweep
     o.samples = quality_rows[i].samples;
-    std::printf(" (the bake picks %s)", quality_name(bake_quality(o, quality_rows[i].triangles)));
+    std::printf(" (the bake picks %s)", quality_name(bvh_quality_for(o, quality_rows[i].triangles)));
   }
   std::printf(".\n\n");
   flush();

@@ -7,7 +7,6 @@ macro(nmbake_require _pkg _deb)
 endmacro()
 
 nmbake_require(embree libembree-dev 3.13)
-nmbake_require(OpenMesh libopenmesh-dev)
 nmbake_require(assimp libassimp-dev 5.2)
 # Debian's OpenImageIOConfig.cmake names /usr/include/opencv4 as an include folder even when
 # OpenCV is not installed, which breaks every target linking it; use its pkg-config file instead.

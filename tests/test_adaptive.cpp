@@ -58,15 +58,16 @@ TEST(Adaptive, EveryTexelIsItsBaseMeanOrTheFixedBakes) {
   const BakeResult t = bake_normal_map(s.low, s.high, nullptr, tight);
   const BakeResult l = bake_normal_map(s.low, s.high, nullptr, loose);
   // The quad covers every texel fully and every ray hits: nothing refines at 90 degrees.
-  EXPECT_EQ(l.stats.texels_refined, 0u);
-  EXPECT_EQ(l.stats.texels_base, 64u * 64u);
-  EXPECT_EQ(l.stats.rays, 4u * 64u * 64u);
+  EXPECT_EQ(l.stats.trace.texels_refined, 0u);
+  EXPECT_EQ(l.stats.trace.texels_base, 64u * 64u);
+  EXPECT_EQ(l.stats.trace.rays, 4u * 64u * 64u);
   // At 0.05 degrees nearly every texel of the curved field refines, most of them to 64 samples, and
   // then holds the fixed bake's value with as many.
-  EXPECT_GT(t.stats.texels_refined + t.stats.texels_deep, 64u * 64u * 9 / 10);
-  EXPECT_GT(t.stats.texels_deep, 64u * 64u / 2);
-  EXPECT_EQ(t.stats.texels_base + t.stats.texels_refined + t.stats.texels_deep, 64u * 64u);
-  EXPECT_EQ(t.stats.rays, 4u * 64u * 64u + 16u * (t.stats.texels_refined + t.stats.texels_deep) + 64u * t.stats.texels_deep);
+  EXPECT_GT(t.stats.trace.texels_refined + t.stats.trace.texels_deep, 64u * 64u * 9 / 10);
+  EXPECT_GT(t.stats.trace.texels_deep, 64u * 64u / 2);
+  EXPECT_EQ(t.stats.trace.texels_base + t.stats.trace.texels_refined + t.stats.trace.texels_deep, 64u * 64u);
+  EXPECT_EQ(t.stats.trace.rays,
+            4u * 64u * 64u + 16u * (t.stats.trace.texels_refined + t.stats.trace.texels_deep) + 64u * t.stats.trace.texels_deep);
   std::size_t as_fixed = 0, as_fixed64 = 0, as_base = 0;
   for (std::size_t i = 0; i < 64u * 64u; ++i) {
     const bool is_fixed = same_texel(t.map, f.map, i), is_fixed64 = same_texel(t.map, f64.map, i),
@@ -77,8 +78,8 @@ TEST(Adaptive, EveryTexelIsItsBaseMeanOrTheFixedBakes) {
     as_base += is_base && !is_fixed && !is_fixed64;
   }
   EXPECT_GE(as_fixed + as_fixed64, 64u * 64u * 8 / 10);
-  EXPECT_GE(as_fixed64, t.stats.texels_deep * 9 / 10);
-  EXPECT_LE(as_base, 64u * 64u - t.stats.texels_refined - t.stats.texels_deep);
+  EXPECT_GE(as_fixed64, t.stats.trace.texels_deep * 9 / 10);
+  EXPECT_LE(as_base, 64u * 64u - t.stats.trace.texels_refined - t.stats.trace.texels_deep);
   // The base pass alone (2x2 Gauss-Legendre) is not the fixed bake: the test can tell them apart.
   std::size_t base_differs = 0;
   for (std::size_t i = 0; i < 64u * 64u; ++i) base_differs += !same_texel(l.map, f.map, i);
@@ -90,7 +91,7 @@ TEST(Adaptive, ASurfaceBakedOntoItselfRefinesOnlyIslandEdges) {
   BakeOptions o = adaptive(128, 0.5);
   o.front = o.rear = 0.05f;
   const BakeResult r = bake_normal_map(m, m, nullptr, o);
-  EXPECT_EQ(r.stats.misses, 0u);
+  EXPECT_EQ(r.stats.trace.misses, 0u);
   // Interior texels' samples all hit the surface they start on: flat, no disagreement. The texels
   // an island's edge crosses have fewer than 4 base samples and refine.
   std::size_t interior = 0;
@@ -102,7 +103,7 @@ TEST(Adaptive, ASurfaceBakedOntoItselfRefinesOnlyIslandEdges) {
     ++interior;
   }
   EXPECT_GT(interior, 0u);
-  EXPECT_LT(r.stats.texels_refined, r.stats.texels_base / 10);
+  EXPECT_LT(r.stats.trace.texels_refined, r.stats.trace.texels_base / 10);
 }
 
 TEST(Adaptive, TheMapDoesNotDependOnTheThreadCount) {
@@ -118,9 +119,9 @@ TEST(Adaptive, TheMapDoesNotDependOnTheThreadCount) {
   const BakeResult three = bake_normal_map(s.low, s.high, nullptr, o);
   EXPECT_TRUE(one.map.pixels == two.map.pixels);
   EXPECT_TRUE(one.map.pixels == three.map.pixels);
-  EXPECT_EQ(one.stats.texels_refined, two.stats.texels_refined);
-  EXPECT_GT(one.stats.texels_refined, 0u);
-  EXPECT_GT(one.stats.texels_base, 0u);
+  EXPECT_EQ(one.stats.trace.texels_refined, two.stats.trace.texels_refined);
+  EXPECT_GT(one.stats.trace.texels_refined, 0u);
+  EXPECT_GT(one.stats.trace.texels_base, 0u);
 }
 
 TEST(Adaptive, OptionsAreChecked) {

@@ -37,8 +37,8 @@ TEST(Bake, MeshBakedOntoItselfIsExactlyFlat) {
     BakeOptions o = options(256, samples);
     o.front = o.rear = 0.05f;
     const BakeResult r = bake_normal_map(m, m, nullptr, o);
-    EXPECT_EQ(r.stats.misses, 0u);
-    EXPECT_GT(r.stats.texels_covered, 256u * 256u * 9 / 10);
+    EXPECT_EQ(r.stats.trace.misses, 0u);
+    EXPECT_GT(r.stats.trace.texels_covered, 256u * 256u * 9 / 10);
     for (std::size_t i = 0; i < r.coverage.size(); ++i) {
       if (!r.coverage[i]) continue;
       const float* c = &r.map.pixels[3 * i];
@@ -60,7 +60,7 @@ TEST(Bake, QuadAgainstTiltedPlaneGivesThePlaneNormal) {
   o.front = o.rear = 1.0f;
   const BakeResult r = bake_normal_map(low, high, nullptr, o);
   const glm::dvec3 expect = glm::normalize(glm::dvec3(-0.2, -0.1, 1.0));
-  ASSERT_EQ(r.stats.texels_covered, 64u * 64u);
+  ASSERT_EQ(r.stats.trace.texels_covered, 64u * 64u);
   for (std::size_t i = 0; i < r.coverage.size(); ++i) {
     const float* c = &r.map.pixels[3 * i];
     ASSERT_LT(angle_deg(decode_rgb(c), expect), 1e-4) << "texel " << i;
@@ -88,7 +88,7 @@ TEST(Bake, HeightFieldMatchesAnalyticNormal) {
   BakeOptions o = options(512);
   o.front = o.rear = 0.06f;
   const BakeResult r = bake_normal_map(low, high, nullptr, o);
-  ASSERT_EQ(r.stats.misses, 0u);
+  ASSERT_EQ(r.stats.trace.misses, 0u);
   double sum = 0.0, worst = 0.0;
   std::size_t count = 0;
   for (int y = 0; y < 512; ++y)
@@ -125,10 +125,10 @@ TEST(Bake, ResultsDoNotDependOnThreadCount) {
   EXPECT_TRUE(a.coverage == b.coverage);
   // The report's statistics too, to the last bit: the mean hit distance is summed per tile, then
   // over tiles in order, whichever thread took which tile.
-  EXPECT_EQ(a.stats.hits, b.stats.hits);
-  EXPECT_EQ(a.stats.hit_distance_mean, b.stats.hit_distance_mean);
-  EXPECT_EQ(a.stats.hit_distance_min, b.stats.hit_distance_min);
-  EXPECT_EQ(a.stats.hit_distance_max, b.stats.hit_distance_max);
+  EXPECT_EQ(a.stats.trace.hits, b.stats.trace.hits);
+  EXPECT_EQ(a.stats.trace.hit_distance_mean, b.stats.trace.hit_distance_mean);
+  EXPECT_EQ(a.stats.trace.hit_distance_min, b.stats.trace.hit_distance_min);
+  EXPECT_EQ(a.stats.trace.hit_distance_max, b.stats.trace.hit_distance_max);
 }
 
 TEST(Bake, MissesAreCountedFlatAndMasked) {
@@ -140,9 +140,9 @@ TEST(Bake, MissesAreCountedFlatAndMasked) {
   o.front = o.rear = 0.1f;
   o.miss_mask = true;
   const BakeResult r = bake_normal_map(low, high, nullptr, o);
-  EXPECT_GT(r.stats.misses, 0u);
-  EXPECT_GT(r.stats.hits, 0u);
-  EXPECT_EQ(r.stats.hits + r.stats.misses, r.stats.samples_covered);
+  EXPECT_GT(r.stats.trace.misses, 0u);
+  EXPECT_GT(r.stats.trace.hits, 0u);
+  EXPECT_EQ(r.stats.trace.hits + r.stats.trace.misses, r.stats.trace.samples_covered);
   for (int y = 0; y < 32; ++y)
     for (int x = 0; x < 32; ++x) {
       const float* c = r.map.at(x, y);
@@ -171,11 +171,11 @@ TEST(Bake, AutoDistancesCoverTheOffset) {
   for (glm::vec3& p : high.positions) p.z = 0.03f;
   BakeOptions o = options(32);
   const BakeResult r = bake_normal_map(low, high, nullptr, o);
-  EXPECT_TRUE(r.stats.auto_distances);
-  EXPECT_GE(r.stats.front, 0.03f);
-  EXPECT_LT(r.stats.front, 0.1f);
-  EXPECT_EQ(r.stats.misses, 0u);
-  EXPECT_NEAR(r.stats.hit_distance_mean, 0.03, 1e-5);
+  EXPECT_TRUE(r.stats.distances.auto_distances);
+  EXPECT_GE(r.stats.distances.front, 0.03f);
+  EXPECT_LT(r.stats.distances.front, 0.1f);
+  EXPECT_EQ(r.stats.trace.misses, 0u);
+  EXPECT_NEAR(r.stats.trace.hit_distance_mean, 0.03, 1e-5);
 }
 
 TEST(Bake, DisplacedSphereMatchesAnalyticNormal) {
@@ -193,7 +193,7 @@ TEST(Bake, DisplacedSphereMatchesAnalyticNormal) {
   o.height = 256;
   o.front = o.rear = 0.1f;
   const BakeResult r = bake_normal_map(low, high, nullptr, o);
-  ASSERT_EQ(r.stats.misses, 0u);
+  ASSERT_EQ(r.stats.trace.misses, 0u);
   // Reference: the analytic normal where the same ray meets the high-poly.
   std::vector<glm::vec3> pos = high.positions;
   raycast::Scene scene(&pos[0].x, pos.size(), high.position_index.data(), high.triangle_count());
@@ -256,7 +256,7 @@ TEST(Bake, MirroredUVHalvesDecodeToMirroredNormals) {
   BakeOptions o = options(128);
   o.front = o.rear = 0.1f;
   const BakeResult r = bake_normal_map(sorted, high, nullptr, o);
-  EXPECT_GT(r.stats.overlapping_samples, 128u * 128u / 2);  // the halves share the layout
+  EXPECT_GT(r.stats.trace.overlapping_samples, 128u * 128u / 2);  // the halves share the layout
   const TangentFrames frames = compute_tangent_frames(sorted);
   const std::size_t half = sorted.triangle_count() / 2;
   double worst = 0.0;
@@ -283,27 +283,4 @@ TEST(Bake, MirroredUVHalvesDecodeToMirroredNormals) {
   std::printf("mirrored UVs: %zu texels, worst left/right mismatch %.4f deg\n", compared, worst);
   EXPECT_GT(compared, 128u * 128u * 9 / 10);
   EXPECT_LT(worst, 0.5);  // the bound; measured 0.0000 deg (the frames mirror exactly)
-}
-
-TEST(Bake, BakeRaysAreTheRaysTheBakeCasts) {
-  // bake_rays (for the bench's bare loop) runs the bake's own stages up to the trace: as many rays
-  // as the bake casts, with its distances, for the automatic cage, fixed distances and closest.
-  const Mesh low = test::make_torus(24, 12);
-  const Mesh high = test::make_torus(96, 48, 1.0f, 0.37f);
-  for (int mode = 0; mode < 3; ++mode) {
-    BakeOptions o = options(96, mode == 2 ? 4 : 1);
-    if (mode >= 1) o.front = o.rear = 0.1f;
-    if (mode == 2) o.policy = RayPolicy::closest;
-    const BakeResult r = bake_normal_map(low, high, nullptr, o);
-    const BakeRays rays = bake_rays(low, high, nullptr, o);
-    ASSERT_GT(r.stats.rays, 0u);
-    EXPECT_EQ(rays.rays.size(), r.stats.rays) << "mode " << mode;
-    EXPECT_EQ(rays.stats.front, r.stats.front);
-    EXPECT_EQ(rays.stats.rear, r.stats.rear);
-    EXPECT_EQ(rays.stats.centre, r.stats.centre);
-    for (const raycast::Ray& ray : rays.rays) {
-      ASSERT_NEAR(glm::length(ray.direction), 1.0f, 1e-5f);
-      ASSERT_GT(ray.tfar, ray.tnear);
-    }
-  }
 }

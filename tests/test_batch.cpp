@@ -153,16 +153,16 @@ TEST(Batch, AKeptBvhGivesTheSameMaps) {
   BvhCache cache;
   o.bvh_cache = &cache;
   const BakeResult first = bake_normal_map(low, high, nullptr, o);
-  ASSERT_TRUE(cache.scene != nullptr);
-  EXPECT_FALSE(first.stats.bvh_reused);
-  EXPECT_EQ(first.stats.high_triangles_culled, 0u) << "a kept BVH holds every triangle";
+  ASSERT_TRUE(cache.kept != nullptr);
+  EXPECT_FALSE(first.stats.bvh.reused);
+  EXPECT_EQ(first.stats.select.high_triangles_culled, 0u) << "a kept BVH holds every triangle";
   for (const bool keep_backfaces : {false, true}) {
     o.keep_backfaces = keep_backfaces;
     o.samples = keep_backfaces ? 4 : 1;
     BakeOptions own = o;
     own.bvh_cache = nullptr;
     const BakeResult again = bake_normal_map(low, high, nullptr, o), alone = bake_normal_map(low, high, nullptr, own);
-    EXPECT_TRUE(again.stats.bvh_reused);
+    EXPECT_TRUE(again.stats.bvh.reused);
     EXPECT_TRUE(again.map.pixels == alone.map.pixels) << "keep_backfaces " << keep_backfaces;
   }
   EXPECT_TRUE(first.map.pixels == plain.map.pixels);
@@ -173,8 +173,31 @@ TEST(Batch, AKeptBvhGivesTheSameMaps) {
   o.keep_backfaces = false;
   o.samples = 1;
   const BakeResult other = bake_normal_map(moved, high, nullptr, o);
-  EXPECT_FALSE(other.stats.bvh_reused);
+  EXPECT_FALSE(other.stats.bvh.reused);
   EXPECT_EQ(cache.reused, 2u);
+}
+
+// The kept BVH is found by the high-poly's content, not by where the mesh lies in memory: a copy
+// takes it, the same mesh with a vertex moved (the same box) does not.
+TEST(Batch, AKeptBvhIsFoundByContent) {
+  const Mesh low = load_mesh(test::sample_low());
+  Mesh high = load_mesh(test::sample_high());
+  BakeOptions o;
+  o.width = o.height = 64;
+  BvhCache cache;
+  o.bvh_cache = &cache;
+  EXPECT_FALSE(bake_normal_map(low, high, nullptr, o).stats.bvh.reused);
+  const Mesh copy = high;
+  EXPECT_TRUE(bake_normal_map(low, copy, nullptr, o).stats.bvh.reused);
+  glm::vec3 lo = high.positions[0], hi = lo;
+  for (const glm::vec3& p : high.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  const auto inside = std::find_if(high.positions.begin(), high.positions.end(), [&](const glm::vec3& p) {
+    return glm::all(glm::greaterThan(p, lo)) && glm::all(glm::lessThan(p, hi));
+  });
+  ASSERT_NE(inside, high.positions.end());
+  *inside = glm::mix(*inside, 0.5f * (lo + hi), 0.01f);  // the box stays
+  EXPECT_FALSE(bake_normal_map(low, high, nullptr, o).stats.bvh.reused);
+  EXPECT_EQ(cache.reused, 1u);
 }
 
 }  // namespace

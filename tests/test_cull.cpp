@@ -105,11 +105,11 @@ TEST(Cull, FarCopyIsLeftOutAndTheMapIsUnchanged) {
   for (const bool given : {true, false}) {
     o.front = o.rear = given ? 0.1f : -1.0f;
     const BakeResult on = bake(low, high, nullptr, o, true), off = bake(low, high, nullptr, o, false);
-    EXPECT_EQ(on.stats.high_triangles_culled, near_high.triangle_count()) << "given distances: " << given;
-    EXPECT_EQ(off.stats.high_triangles_culled, 0u);
-    EXPECT_EQ(on.stats.front, off.stats.front);
+    EXPECT_EQ(on.stats.select.high_triangles_culled, near_high.triangle_count()) << "given distances: " << given;
+    EXPECT_EQ(off.stats.select.high_triangles_culled, 0u);
+    EXPECT_EQ(on.stats.distances.front, off.stats.distances.front);
     EXPECT_TRUE(on.map.pixels == off.map.pixels) << "given distances: " << given;
-    EXPECT_EQ(on.stats.hits, off.stats.hits);
+    EXPECT_EQ(on.stats.trace.hits, off.stats.trace.hits);
   }
   // The closest-hit policy reaches outward too: still the same map.
   o.policy = RayPolicy::closest;
@@ -125,7 +125,7 @@ TEST(Cull, GeometryWithinReachStaysIn) {
   o.width = o.height = 64;
   o.front = o.rear = 0.1f;
   const BakeResult on = bake(low, high, nullptr, o, true), off = bake(low, high, nullptr, o, false);
-  EXPECT_EQ(on.stats.high_triangles_culled, 0u);
+  EXPECT_EQ(on.stats.select.high_triangles_culled, 0u);
   EXPECT_TRUE(on.map.pixels == off.map.pixels);
 }
 
@@ -139,8 +139,8 @@ TEST(Cull, CageReachIsRespected) {
   o.width = o.height = 96;
   o.rear = 0.05f;
   const BakeResult on = bake(low, high, &cage, o, true), off = bake(low, high, &cage, o, false);
-  EXPECT_EQ(on.stats.high_triangles_culled, high.triangle_count() / 2);
-  EXPECT_GT(on.stats.hits, on.stats.samples_covered * 9 / 10);
+  EXPECT_EQ(on.stats.select.high_triangles_culled, high.triangle_count() / 2);
+  EXPECT_GT(on.stats.trace.hits, on.stats.trace.samples_covered * 9 / 10);
   EXPECT_TRUE(on.map.pixels == off.map.pixels);
 }
 

@@ -71,7 +71,7 @@ TEST(HostileGeometry, StacksOfIdenticalTrianglesEnterTheBvhOnce) {
   BakeOptions o;
   o.width = o.height = 64;
   const BakeResult single = bake_normal_map(low, high, nullptr, o);
-  EXPECT_EQ(single.stats.high_duplicates_skipped, 0u);
+  EXPECT_EQ(single.stats.select.high_duplicates_skipped, 0u);
   // Every triangle 40 times over (the copies' corners rotated: the same triangle, same winding),
   // and one triangle 8 times, which is left alone (kDuplicateFlood).
   Mesh stacked = high;
@@ -85,7 +85,7 @@ TEST(HostileGeometry, StacksOfIdenticalTrianglesEnterTheBvhOnce) {
       }
   stacked.source_face.resize(stacked.triangle_count(), 0);
   const BakeResult r = bake_normal_map(low, stacked, nullptr, o);
-  EXPECT_EQ(r.stats.high_duplicates_skipped, 39 * tris);
+  EXPECT_EQ(r.stats.select.high_duplicates_skipped, 39 * tris);
   EXPECT_TRUE(r.map.pixels == single.map.pixels);
   EXPECT_TRUE(r.coverage == single.coverage);
 }
@@ -144,7 +144,7 @@ TEST(HostileGeometry, SmallStacksAreLeftAlone) {
   high.source_face.resize(high.triangle_count(), 0);
   BakeOptions o;
   o.width = o.height = 16;
-  EXPECT_EQ(bake_normal_map(low, high, nullptr, o).stats.high_duplicates_skipped, 0u);
+  EXPECT_EQ(bake_normal_map(low, high, nullptr, o).stats.select.high_duplicates_skipped, 0u);
 }
 
 // A 1000-corner disc is cut in halving passes, not fanned: n - 2 triangles covering the disc, and

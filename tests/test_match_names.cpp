@@ -192,12 +192,12 @@ TEST(MatchNames, IntersectingPartsNeverImprintOnEachOther) {
   // The bolt's cross-section is 4% of the plate's top and bottom faces: about 2 x 29 texels.
   EXPECT_GT(imprinted, 40u) << "the unmatched bake should show the bolt on the plate";
   // Hits counted per object.
-  ASSERT_EQ(matched.stats.low_object_samples.size(), 2u);
-  EXPECT_EQ(matched.stats.low_object_samples[0], plate_texels);
-  EXPECT_EQ(matched.stats.low_object_hits[0], plate_texels);
-  EXPECT_EQ(matched.stats.high_object_hits[1], bolt_texels);
-  EXPECT_EQ(matched.stats.high_object_hits[0], plate_texels);
-  EXPECT_NE(together.stats.high_object_hits[0], plate_texels) << "unmatched, rays cross from one object to the other";
+  ASSERT_EQ(matched.stats.trace.low_object_samples.size(), 2u);
+  EXPECT_EQ(matched.stats.trace.low_object_samples[0], plate_texels);
+  EXPECT_EQ(matched.stats.trace.low_object_hits[0], plate_texels);
+  EXPECT_EQ(matched.stats.trace.high_object_hits[1], bolt_texels);
+  EXPECT_EQ(matched.stats.trace.high_object_hits[0], plate_texels);
+  EXPECT_NE(together.stats.trace.high_object_hits[0], plate_texels) << "unmatched, rays cross from one object to the other";
   // The error estimate re-bakes with the same matching: it sees no error the matching removed.
   EXPECT_EQ(test::texels_traced_otherwise(low, *matched.trace_inputs, o, matched), 0u);
 }
@@ -221,9 +221,9 @@ TEST(MatchNames, AnUnmatchedObjectIsLeftFlat) {
     if (n != glm::dvec3(0, 0, 1)) break;
   }
   EXPECT_GT(bolt_texels, 1000u);
-  EXPECT_EQ(r.stats.samples_unmatched, bolt_texels);
-  EXPECT_EQ(r.stats.misses, 0u);
-  EXPECT_EQ(r.stats.high_object_hits[1], 0u);
+  EXPECT_EQ(r.stats.trace.samples_unmatched, bolt_texels);
+  EXPECT_EQ(r.stats.trace.misses, 0u);
+  EXPECT_EQ(r.stats.trace.high_object_hits[1], 0u);
 }
 
 TEST(MatchNames, CommandLineReportAndWarnings) {
@@ -397,7 +397,7 @@ TEST(MatchNames, IntersectingBallsBakeAsIfAlone) {
   const Mesh high = load_obj("high.obj", balls_obj(true, true, true));
   ASSERT_EQ(low.objects.size(), 2u);
   const BakeResult both = bake_normal_map(low, high, nullptr, ball_options(low, high));
-  EXPECT_EQ(both.stats.misses, 0u) << "of " << both.stats.samples_covered;
+  EXPECT_EQ(both.stats.trace.misses, 0u) << "of " << both.stats.trace.samples_covered;
   for (const bool a : {true, false}) {
     const Mesh low1 = load_obj("low1.obj", balls_obj(false, a, !a)), high1 = load_obj("high1.obj", balls_obj(true, a, !a));
     const BakeResult alone = bake_normal_map(low1, high1, nullptr, ball_options(low1, high1));

@@ -126,7 +126,7 @@ TEST(Padding, PadMapCountsMatchAPlainCountOnAnyThreads) {
     in.coverage[i] = 1;
     for (int c = 0; c < 3; ++c) in.map.pixels[3 * i + c] = unit(rng);
     disagree[i] = unit(rng) < 0.05f;
-    in.stats.texels_covered++;
+    in.stats.trace.texels_covered++;
   }
   const float z_limit = float(0.5 + 0.5 * std::cos(kSuspectTiltDeg * 3.14159265358979323846 / 180.0));
   std::size_t facing = 0, suspect = 0, cell[8][8] = {};
@@ -146,9 +146,9 @@ TEST(Padding, PadMapCountsMatchAPlainCountOnAnyThreads) {
   for (int threads : {1, 2, 3}) {
     BakeResult r = in;
     pad_map(o, disagree, threads, r);
-    EXPECT_EQ(r.stats.texels_facing_away, facing);
-    EXPECT_EQ(r.stats.suspect_texels, suspect);
-    EXPECT_EQ(r.stats.suspect_region_share, double(best) / double(suspect));
+    EXPECT_EQ(r.stats.pad.texels_facing_away, facing);
+    EXPECT_EQ(r.stats.pad.suspect_texels, suspect);
+    EXPECT_EQ(r.stats.pad.suspect_region_share, double(best) / double(suspect));
     std::size_t marked = 0, flat = 0;  // flat: background texels that are not (0.5, 0.5, 1)
     for (std::size_t i = 0; i < n; ++i) {
       marked += r.suspect_mask.pixels[i] == 1.0f;
@@ -165,6 +165,6 @@ TEST(Padding, PadMapCountsMatchAPlainCountOnAnyThreads) {
       }
     }
     EXPECT_EQ(flat, 0u) << "a background texel is not (0.5, 0.5, 1)";
-    EXPECT_GT(r.stats.texels_padded, 0u);
+    EXPECT_GT(r.stats.pad.texels_padded, 0u);
   }
 }

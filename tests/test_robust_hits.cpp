@@ -39,9 +39,9 @@ void record(const std::string& name, const Errors& e, const BakeResult& r) {
   std::printf(
       "measured: %s mean %.4f deg, over 1 deg %.3f%%, over 60 deg %zu, worst %.2f deg, texels %zu, misses %llu, "
       "backface_skips %llu, front %.4g-%.4g, rear %.4g-%.4g\n",
-      name.c_str(), e.mean_deg, 100.0 * e.over1, e.over60_texels, e.worst_deg, e.texels, (unsigned long long)r.stats.misses,
-      (unsigned long long)r.stats.backface_skips, r.stats.vertex_front.min, r.stats.vertex_front.max, r.stats.vertex_rear.min,
-      r.stats.vertex_rear.max);
+      name.c_str(), e.mean_deg, 100.0 * e.over1, e.over60_texels, e.worst_deg, e.texels, (unsigned long long)r.stats.trace.misses,
+      (unsigned long long)r.stats.trace.backface_skips, r.stats.distances.vertex_front.min, r.stats.distances.vertex_front.max,
+      r.stats.distances.vertex_rear.min, r.stats.distances.vertex_rear.max);
 }
 
 }  // namespace
@@ -54,7 +54,7 @@ TEST(RobustHits, CloseTubesWithABulgeBakeCleanByDefault) {
     const BakeResult r = bake_normal_map(a.low, a.high, nullptr, options(512));
     const Errors e = measure(a, r);
     record(a.name, e, r);
-    EXPECT_EQ(r.stats.cage, BakeStats::CageSource::automatic);
+    EXPECT_EQ(r.stats.distances.cage, BakeStats::CageSource::automatic);
     EXPECT_GT(e.texels, 50000u);
     EXPECT_LE(e.mean_deg, 0.25) << a.name;
     EXPECT_LE(e.over1, 0.005) << a.name;
@@ -96,7 +96,7 @@ TEST(RobustHits, BevelledBoxFollowsTheBevels) {
   EXPECT_GT(e.texels, 50000u);
   EXPECT_EQ(e.over60_texels, 0u);
   EXPECT_LE(e.mean_deg, 0.25);
-  EXPECT_EQ(r.stats.misses, 0u);
+  EXPECT_EQ(r.stats.trace.misses, 0u);
 }
 
 TEST(RobustHits, FlippedWindingBakesLikeTheSoundMesh) {
@@ -109,8 +109,9 @@ TEST(RobustHits, FlippedWindingBakesLikeTheSoundMesh) {
     const BakeResult r = bake_normal_map(a.low, a.high, nullptr, options(256));
     const Errors e = measure(a, r, {0, 1});
     record(a.name, e, r);
-    EXPECT_EQ(r.stats.high_facing, keep_normals ? BakeStats::HighFacing::sound : BakeStats::HighFacing::inverted) << a.name;
-    EXPECT_TRUE(r.stats.backfaces_skipped);
+    EXPECT_EQ(r.stats.distances.high_facing, keep_normals ? BakeStats::HighFacing::sound : BakeStats::HighFacing::inverted)
+        << a.name;
+    EXPECT_TRUE(r.stats.distances.backfaces_skipped);
     EXPECT_EQ(e.other_surface, 0u) << a.name;
     EXPECT_LE(e.mean_deg, 0.3) << a.name;
     if (keep_normals) {
@@ -131,9 +132,9 @@ TEST(RobustHits, SuspectTexelsAreCountedAndMasked) {
   o.front = o.rear = 0.06f;
   const BakeResult bad = bake_normal_map(a.low, a.high, nullptr, o);
   std::printf("measured: suspect share default %.4f%%, back faces kept with --front/--rear 0.06 %.2f%%\n",
-              100.0 * r.stats.suspect_share, 100.0 * bad.stats.suspect_share);
-  EXPECT_LT(r.stats.suspect_share, kSuspectShareWarn);
-  EXPECT_GT(bad.stats.suspect_share, 0.05);
+              100.0 * r.stats.pad.suspect_share, 100.0 * bad.stats.pad.suspect_share);
+  EXPECT_LT(r.stats.pad.suspect_share, kSuspectShareWarn);
+  EXPECT_GT(bad.stats.pad.suspect_share, 0.05);
   for (const BakeResult* b : {&r, &bad}) {
     ASSERT_EQ(b->suspect_mask.width, 256);
     std::size_t ones = 0, outside = 0;
@@ -141,15 +142,15 @@ TEST(RobustHits, SuspectTexelsAreCountedAndMasked) {
       ones += b->suspect_mask.pixels[i] == 1.0f;
       outside += b->suspect_mask.pixels[i] != 0.0f && !b->coverage[i];
     }
-    EXPECT_EQ(ones, b->stats.suspect_texels);
+    EXPECT_EQ(ones, b->stats.pad.suspect_texels);
     EXPECT_EQ(outside, 0u);
-    EXPECT_EQ(b->stats.suspect_share, double(b->stats.suspect_texels) / double(b->stats.texels_covered));
+    EXPECT_EQ(b->stats.pad.suspect_share, double(b->stats.pad.suspect_texels) / double(b->stats.trace.texels_covered));
   }
   // Every texel facing away is suspect; the region holds the most of them of its 8 x 8 grid.
-  EXPECT_GE(bad.stats.suspect_texels, bad.stats.texels_facing_away);
-  EXPECT_GT(bad.stats.suspect_region_share, 1.0 / 64.0);
-  EXPECT_DOUBLE_EQ(bad.stats.suspect_region[2] - bad.stats.suspect_region[0], 0.125);
-  EXPECT_DOUBLE_EQ(bad.stats.suspect_region[3] - bad.stats.suspect_region[1], 0.125);
+  EXPECT_GE(bad.stats.pad.suspect_texels, bad.stats.pad.texels_facing_away);
+  EXPECT_GT(bad.stats.pad.suspect_region_share, 1.0 / 64.0);
+  EXPECT_DOUBLE_EQ(bad.stats.pad.suspect_region[2] - bad.stats.pad.suspect_region[0], 0.125);
+  EXPECT_DOUBLE_EQ(bad.stats.pad.suspect_region[3] - bad.stats.pad.suspect_region[1], 0.125);
 }
 
 TEST(RobustHits, SamplesThatDisagreeMakeATexelSuspect) {
@@ -174,13 +175,13 @@ TEST(RobustHits, SamplesThatDisagreeMakeATexelSuspect) {
   // Column 32 straddles the crease: half its samples on each side.
   std::size_t crease = 0;
   for (int y = 0; y < 64; ++y) crease += r.suspect_mask.at(32, y)[0] == 1.0f;
-  std::printf("measured: crease texels suspect %zu of 64, all suspect %zu\n", crease, r.stats.suspect_texels);
-  EXPECT_EQ(r.stats.texels_facing_away, 0u);
+  std::printf("measured: crease texels suspect %zu of 64, all suspect %zu\n", crease, r.stats.pad.suspect_texels);
+  EXPECT_EQ(r.stats.pad.texels_facing_away, 0u);
   EXPECT_EQ(crease, 64u);
-  EXPECT_EQ(r.stats.suspect_texels, crease);
+  EXPECT_EQ(r.stats.pad.suspect_texels, crease);
   // With one sample per texel nothing can disagree.
   o.samples = 1;
-  EXPECT_EQ(bake_normal_map(low, high, nullptr, o).stats.suspect_texels, 0u);
+  EXPECT_EQ(bake_normal_map(low, high, nullptr, o).stats.pad.suspect_texels, 0u);
 }
 
 TEST(RobustHits, SculptsHaveAlmostNoTexelFacingAway) {
@@ -195,12 +196,12 @@ TEST(RobustHits, SculptsHaveAlmostNoTexelFacingAway) {
     const Mesh low = load_mesh(dir + "/low.obj", lo), high = load_mesh(dir + "/high.ply");
     BakeOptions o = options(1024);
     const BakeResult r = bake_normal_map(low, high, nullptr, o);
-    const double share = double(r.stats.texels_facing_away) / double(r.stats.texels_covered);
+    const double share = double(r.stats.pad.texels_facing_away) / double(r.stats.trace.texels_covered);
     std::printf("measured: %s facing away %zu of %zu (%.4f%%), suspect %.4f%%, misses %llu of %llu samples\n", name,
-                r.stats.texels_facing_away, r.stats.texels_covered, 100.0 * share, 100.0 * r.stats.suspect_share,
-                (unsigned long long)r.stats.misses, (unsigned long long)r.stats.samples_covered);
+                r.stats.pad.texels_facing_away, r.stats.trace.texels_covered, 100.0 * share, 100.0 * r.stats.pad.suspect_share,
+                (unsigned long long)r.stats.trace.misses, (unsigned long long)r.stats.trace.samples_covered);
     EXPECT_LE(share, 0.001) << name;
-    EXPECT_LE(double(r.stats.misses), 0.001 * double(r.stats.samples_covered)) << name;
+    EXPECT_LE(double(r.stats.trace.misses), 0.001 * double(r.stats.trace.samples_covered)) << name;
     ++baked;
   }
   if (!baked) GTEST_SKIP() << "../shared/data/sculpts not found";
@@ -246,11 +247,11 @@ TEST(RobustHits, CullingLeavesTheAutomaticCagesMapUnchanged) {
   const BakeResult on = bake_normal_map(a.low, high, nullptr, o);
   o.cull_far = false;
   const BakeResult off = bake_normal_map(a.low, high, nullptr, o);
-  std::printf("measured: culled %zu of %zu\n", on.stats.high_triangles_culled, high.triangle_count());
-  EXPECT_GT(on.stats.high_triangles_culled, a.high.triangle_count() / 2);
+  std::printf("measured: culled %zu of %zu\n", on.stats.select.high_triangles_culled, high.triangle_count());
+  EXPECT_GT(on.stats.select.high_triangles_culled, a.high.triangle_count() / 2);
   EXPECT_TRUE(on.map.pixels == off.map.pixels);
-  EXPECT_EQ(on.stats.hits, off.stats.hits);
-  EXPECT_GT(on.stats.cage_front_limited, 0u);
+  EXPECT_EQ(on.stats.trace.hits, off.stats.trace.hits);
+  EXPECT_GT(on.stats.distances.cage_front_limited, 0u);
 }
 
 TEST(RobustHits, CageStopsBeforeANeighbouringPartsHighPoly) {
@@ -286,12 +287,12 @@ TEST(RobustHits, CageStopsBeforeANeighbouringPartsHighPoly) {
   const Mesh high = join(sheet(0.0f, false, 0.0f), sheet(0.03f, true, 0.55f));
   const BakeResult r = bake_normal_map(low, high, nullptr, options(64));
   ASSERT_EQ(r.cage_positions.size(), low.positions.size());
-  std::printf("measured: scene front %.4f, A's cage at z %.5f\n", r.stats.scene_front, double(r.cage_positions[0].z));
-  EXPECT_GT(r.stats.scene_front, 0.08);
+  std::printf("measured: scene front %.4f, A's cage at z %.5f\n", r.stats.distances.scene_front, double(r.cage_positions[0].z));
+  EXPECT_GT(r.stats.distances.scene_front, 0.08);
   for (std::size_t i = 0; i < 25; ++i) {  // A's vertices
     EXPECT_LE(r.cage_positions[i].z, 0.9f * 0.03f + 1e-5f) << "vertex " << i;
     EXPECT_GE(r.cage_positions[i].z, 0.02f) << "vertex " << i;
   }
-  EXPECT_EQ(r.stats.misses, 0u);
-  EXPECT_EQ(r.stats.texels_facing_away, 0u);
+  EXPECT_EQ(r.stats.trace.misses, 0u);
+  EXPECT_EQ(r.stats.pad.texels_facing_away, 0u);
 }

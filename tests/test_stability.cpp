@@ -25,8 +25,8 @@ TEST(Stability, DegenerateUvTrianglesChangeNothing) {
   const Mesh high = load("bumps_high.obj");
   const BakeResult ref = bake_normal_map(load_low("flat_grid_low.obj"), high, nullptr, options(128, 0.1f));
   const BakeResult r = bake_normal_map(load_low("degenerate_uv_low.obj"), high, nullptr, options(128, 0.1f));
-  EXPECT_EQ(r.stats.degenerate_uv_triangles, 3u);
-  EXPECT_EQ(ref.stats.degenerate_uv_triangles, 0u);
+  EXPECT_EQ(r.stats.prepare.degenerate_uv_triangles, 3u);
+  EXPECT_EQ(ref.stats.prepare.degenerate_uv_triangles, 0u);
   EXPECT_TRUE(all_finite(r.map));
   EXPECT_TRUE(r.coverage == ref.coverage);
   std::size_t differ = 0;
@@ -49,8 +49,8 @@ TEST(Stability, DegenerateUvTrianglesAreReportedByTheCli) {
 TEST(Stability, ZeroArea3dTrianglesDecodeToTheHighNormal) {
   const Mesh low = load_low("degenerate_3d_low.obj");
   const BakeResult r = bake_normal_map(low, load("tilted_plane_high.obj"), nullptr, options(128, 0.5f));
-  EXPECT_EQ(r.stats.degenerate_3d_triangles, 2u);
-  EXPECT_EQ(r.stats.misses, 0u);
+  EXPECT_EQ(r.stats.prepare.degenerate_3d_triangles, 2u);
+  EXPECT_EQ(r.stats.trace.misses, 0u);
   EXPECT_TRUE(all_finite(r.map));
   const glm::dvec3 expect = glm::normalize(glm::dvec3(-0.2, -0.1, 1.0));
   double worst = 0.0;
@@ -61,7 +61,7 @@ TEST(Stability, ZeroArea3dTrianglesDecodeToTheHighNormal) {
   });
   measured("zero_area_3d.texels_on_zero_area_triangles", double(on_degenerate));
   measured("zero_area_3d.worst_deg", worst);
-  measured("zero_area_3d.corners_without_tangent", double(r.stats.corners_without_tangent));
+  measured("zero_area_3d.corners_without_tangent", double(r.stats.prepare.corners_without_tangent));
   EXPECT_GT(on_degenerate, 200u);  // their UV triangles are baked too
   EXPECT_LT(worst, 1e-3);
 }
@@ -77,8 +77,8 @@ TEST(Stability, DuplicatedLowPolyVerticesAndFacesChangeNothing) {
   face1.normal_index.resize(3);
   std::size_t face1_texels = 0;
   for (std::int32_t t : rasterize_texel_triangles(face1, 128, 128)) face1_texels += t == 0;
-  measured("duplicates_low.overlapping_samples", double(r.stats.overlapping_samples));
-  EXPECT_EQ(r.stats.overlapping_samples, face1_texels);
+  measured("duplicates_low.overlapping_samples", double(r.stats.trace.overlapping_samples));
+  EXPECT_EQ(r.stats.trace.overlapping_samples, face1_texels);
   EXPECT_GT(face1_texels, 500u);
   EXPECT_TRUE(r.coverage == ref.coverage);
   EXPECT_TRUE(r.map.pixels == ref.map.pixels);
@@ -107,7 +107,9 @@ TEST(Stability, SliverInBothSpacesBakesLikeTheCleanSquare) {
   const Mesh low = load_low("sliver_both_low.obj");
   const BakeResult ref = bake_normal_map(load_low("flat_grid_low.obj"), high, nullptr, options(128, 0.1f));
   const BakeResult r = bake_normal_map(low, high, nullptr, options(128, 0.1f));
-  EXPECT_EQ(r.stats.degenerate_uv_triangles + r.stats.degenerate_3d_triangles + r.stats.corners_without_tangent, 0u);
+  EXPECT_EQ(
+      r.stats.prepare.degenerate_uv_triangles + r.stats.prepare.degenerate_3d_triangles + r.stats.prepare.corners_without_tangent,
+      0u);
   const TangentFrames f = compute_tangent_frames(low);
   double worst_t = 0.0;
   for (const glm::vec4& t : f.tangent) worst_t = std::max(worst_t, angle_deg(glm::dvec3(t), glm::dvec3(1, 0, 0)));
@@ -130,8 +132,8 @@ TEST(Stability, SliversInOneSpaceDecodeToTheHighNormal) {
     const Mesh low = load_low(name);
     const BakeResult r = bake_normal_map(low, high, nullptr, options(128, 0.1f));
     EXPECT_TRUE(all_finite(r.map)) << name;
-    EXPECT_EQ(r.stats.misses, 0u) << name;
-    EXPECT_EQ(r.stats.texels_covered, 128u * 128u) << name;
+    EXPECT_EQ(r.stats.trace.misses, 0u) << name;
+    EXPECT_EQ(r.stats.trace.texels_covered, 128u * 128u) << name;
     const TangentFrames f = compute_tangent_frames(low);
     for (std::size_t c = 0; c < f.tangent.size(); ++c) {
       EXPECT_NEAR(glm::length(glm::vec3(f.tangent[c])), 1.0f, 1e-5f) << name;

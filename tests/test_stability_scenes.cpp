@@ -33,7 +33,7 @@ TEST(Stability, TranslatedAndScaledScenesMatchTheOriginal) {
   // The base pair is 100 units across (z from the dome, bumps 1.5 units). Rays +-10 units, scaled.
   const Mesh low = load_low("far_base_low.obj"), high = load("far_base_high.obj");
   const BakeResult base = bake_normal_map(low, high, nullptr, options(128, 10.0f));
-  EXPECT_EQ(base.stats.misses, 0u);
+  EXPECT_EQ(base.stats.trace.misses, 0u);
   struct Case {
     std::string name;
     Mesh low, high;
@@ -56,12 +56,12 @@ TEST(Stability, TranslatedAndScaledScenesMatchTheOriginal) {
     const double worst = max_texel_angle(r, base, &mean);
     measured(c.name + ".max_deg", worst);
     measured(c.name + ".mean_deg", mean);
-    measured(c.name + ".coordinate_spacing", r.stats.coordinate_spacing);
+    measured(c.name + ".coordinate_spacing", r.stats.prepare.coordinate_spacing);
     EXPECT_TRUE(all_finite(r.map)) << c.name;
     EXPECT_TRUE(r.coverage == base.coverage) << c.name;
     // Within the range nmbake does not warn about, the map matches within 0.05 deg (a quarter of
     // an 8-bit step) or the case's tighter bound; beyond it the CLI warns (next test).
-    const bool warned = r.stats.coordinate_spacing > kCoordinateSpacingWarn;
+    const bool warned = r.stats.prepare.coordinate_spacing > kCoordinateSpacingWarn;
     if (!warned) {
       EXPECT_LT(worst, std::min(c.max_deg, 0.05)) << c.name;
     }
@@ -102,7 +102,7 @@ TEST(Stability, CoincidentMeshesBakeExactlyFlat) {
           o.policy = policy;
           o.samples = samples;
           const BakeResult r = bake_normal_map(m, m, nullptr, o);
-          EXPECT_EQ(r.stats.misses, 0u) << name;
+          EXPECT_EQ(r.stats.trace.misses, 0u) << name;
           std::size_t off = 0;
           for (std::size_t i = 0; i < r.coverage.size(); ++i) {
             if (!r.coverage[i]) continue;
@@ -110,7 +110,7 @@ TEST(Stability, CoincidentMeshesBakeExactlyFlat) {
             off += !(c[0] == 0.5f && c[1] == 0.5f && c[2] == 1.0f);
           }
           EXPECT_EQ(off, 0u) << name << " policy " << int(policy) << " distance " << distance << " samples " << samples;
-          EXPECT_GT(r.stats.texels_covered, 0u);
+          EXPECT_GT(r.stats.trace.texels_covered, 0u);
         }
   }
 }
@@ -137,7 +137,7 @@ TEST(Stability, GrazingRaysHitTheSteepFacesWithoutLeaks) {
   const glm::dvec3 rising = glm::normalize(glm::dvec3(-50, 0, 1)), falling = glm::normalize(glm::dvec3(50, 0, 1));
   BakeOptions o = options(128, 0.1f);
   const BakeResult r = bake_normal_map(low, high, nullptr, o);
-  EXPECT_EQ(r.stats.misses, 0u);
+  EXPECT_EQ(r.stats.trace.misses, 0u);
   EXPECT_TRUE(all_finite(r.map));
   double worst = 0.0;
   std::size_t n_rising = 0, n = 0;
@@ -153,8 +153,8 @@ TEST(Stability, GrazingRaysHitTheSteepFacesWithoutLeaks) {
   EXPECT_NEAR(double(n_rising) / double(n), 0.5, 0.1);
   o.samples = 16;  // 262144 grazing rays: none may slip between the faces
   const BakeResult r16 = bake_normal_map(low, high, nullptr, o);
-  measured("grazing.misses_16_samples", double(r16.stats.misses));
-  EXPECT_EQ(r16.stats.misses, 0u);
+  measured("grazing.misses_16_samples", double(r16.stats.trace.misses));
+  EXPECT_EQ(r16.stats.trace.misses, 0u);
   EXPECT_TRUE(all_finite(r16.map));
 }
 
@@ -180,9 +180,9 @@ TEST(Stability, HolesAreCountedFlatFilledAndMasked) {
         wrong += !(angle_deg(decode_rgb(c), expect) < 1e-3 && mask == 0.0f);
       }
     }
-  measured("holes.misses", double(r.stats.misses));
+  measured("holes.misses", double(r.stats.trace.misses));
   EXPECT_EQ(expected_misses, 120u);  // texel centres in the holes: 6 x 13 + 6 x 7
-  EXPECT_EQ(r.stats.misses, expected_misses);
+  EXPECT_EQ(r.stats.trace.misses, expected_misses);
   EXPECT_EQ(wrong, 0u);
 }
 
@@ -195,11 +195,11 @@ TEST(Stability, HighPolyInsideOrOutsideTheLowPoly) {
     // diagonal, 0.69, far: they find both, and every sample hits.)
     BakeOptions o = options(64, 0.1f);
     const BakeResult a = bake_normal_map(low, high, nullptr, options(64, -1.0f));
-    measured(std::string(name) + ".auto_misses", double(a.stats.misses));
-    EXPECT_EQ(a.stats.misses, 0u) << name;
+    measured(std::string(name) + ".auto_misses", double(a.stats.trace.misses));
+    EXPECT_EQ(a.stats.trace.misses, 0u) << name;
     const BakeResult r = bake_normal_map(low, high, nullptr, o);
-    EXPECT_EQ(r.stats.misses, r.stats.samples_covered) << name;
-    EXPECT_GT(r.stats.samples_covered, 0u);
+    EXPECT_EQ(r.stats.trace.misses, r.stats.trace.samples_covered) << name;
+    EXPECT_GT(r.stats.trace.samples_covered, 0u);
     for (std::size_t i = 0; i < r.coverage.size(); ++i) {
       if (r.coverage[i]) {
         ASSERT_EQ(r.map.pixels[3 * i + 2], 1.0f) << name;
@@ -211,7 +211,7 @@ TEST(Stability, HighPolyInsideOrOutsideTheLowPoly) {
     o.front = inside ? 0.01f : 0.7f;
     o.rear = inside ? 0.5f : 0.01f;
     const BakeResult h = bake_normal_map(low, high, nullptr, o);
-    EXPECT_EQ(h.stats.misses, 0u) << name;
+    EXPECT_EQ(h.stats.trace.misses, 0u) << name;
     const HighProbe probe(high);
     double worst = 0.0;
     test::for_each_decoded_texel(low, h.map, [&](int, int, const glm::dvec3& w, const glm::dvec3& p, std::size_t) {
@@ -246,7 +246,7 @@ TEST(Stability, TwoLayersFollowThePolicyDeterministically) {
       worst = std::max(worst, angle_deg(w, expect));
     });
     EXPECT_LT(worst, 1e-3) << what;
-    EXPECT_EQ(r.stats.misses, 0u) << what;
+    EXPECT_EQ(r.stats.trace.misses, 0u) << what;
   };
   BakeOptions o = options(64, 0.2f);
   const Mesh two = load("two_layers_high.obj"), tie = load("two_layers_tie_high.obj");
@@ -267,7 +267,7 @@ TEST(Stability, TwoLayersFollowThePolicyDeterministically) {
 TEST(Stability, UvTilesBakeOnlyTheMapRegionAndWarn) {
   const Mesh low = load_low("uv_tiles_low.obj");
   const BakeResult r = bake_normal_map(low, load("tilted_plane_high.obj"), nullptr, options(64, 0.5f));
-  EXPECT_EQ(r.stats.uv_outside_triangles, 4u);
+  EXPECT_EQ(r.stats.prepare.uv_outside_triangles, 4u);
   // Covered: island A's square and island C's part inside the map; island B (tile u in [1,2]) not at all.
   std::size_t wrong = 0, covered = 0;
   for (int y = 0; y < 64; ++y)
@@ -278,7 +278,7 @@ TEST(Stability, UvTilesBakeOnlyTheMapRegionAndWarn) {
       covered += a || c;
     }
   EXPECT_EQ(wrong, 0u);
-  EXPECT_EQ(r.stats.texels_covered, covered);
+  EXPECT_EQ(r.stats.trace.texels_covered, covered);
   const glm::dvec3 expect = glm::normalize(glm::dvec3(-0.2, -0.1, 1.0));
   double worst = 0.0;
   test::for_each_decoded_texel(low, r.map, [&](int, int, const glm::dvec3& w, const glm::dvec3&, std::size_t) {
@@ -297,8 +297,8 @@ TEST(Stability, OverlappingIslandsAreCountedAndTheFirstWins) {
   const Mesh low = load_low("uv_overlap_low.obj");
   const Mesh high = load("bumps_high.obj");
   const BakeResult r = bake_normal_map(low, high, nullptr, options(64, 0.1f));
-  EXPECT_EQ(r.stats.overlapping_samples, 144u);  // texel centres in (0.4,0.6)^2: 12 x 12
-  Mesh first = low;                              // island 1 alone
+  EXPECT_EQ(r.stats.trace.overlapping_samples, 144u);  // texel centres in (0.4,0.6)^2: 12 x 12
+  Mesh first = low;                                    // island 1 alone
   first.position_index.resize(6);
   first.uv_index.resize(6);
   first.normal_index.resize(6);
@@ -331,7 +331,7 @@ TEST(Stability, TinyAndOddMapSizes) {
       o.padding = padding;
       o.samples = 4;
       const BakeResult r = bake_normal_map(low, high, nullptr, o);
-      EXPECT_EQ(r.stats.texels_covered, std::size_t(w) * h);
+      EXPECT_EQ(r.stats.trace.texels_covered, std::size_t(w) * h);
       for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x)
           for (int k = 0; k < 3; ++k)

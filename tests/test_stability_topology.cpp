@@ -23,8 +23,8 @@ TEST(Stability, HardEdgesOpenNoGapsAndNoCracks) {
     BakeOptions o = options(128, 0.5f);
     o.height = 32;
     const BakeResult r = bake_normal_map(low, high, nullptr, o);
-    EXPECT_EQ(r.stats.misses, 0u) << name;
-    EXPECT_EQ(r.stats.texels_covered, 128u * 32u) << name;  // the strip covers the map: no cracks
+    EXPECT_EQ(r.stats.trace.misses, 0u) << name;
+    EXPECT_EQ(r.stats.trace.texels_covered, 128u * 32u) << name;  // the strip covers the map: no cracks
     EXPECT_TRUE(all_finite(r.map)) << name;
     // Along a row, the azimuth of the decoded normal (the cylinder's radial normal where the ray
     // hit) must rise steadily through 360 degrees: split rays at an edge would jump back ~23 deg.
@@ -85,7 +85,7 @@ TEST(Stability, NonManifoldFinsGiveTheFirstHit) {
     BakeOptions o = options(64, 0.6f);
     o.keep_backfaces = keep;
     const BakeResult r = bake_normal_map(low, load("nonmanifold_high.obj"), nullptr, o);
-    EXPECT_EQ(r.stats.misses, 0u);
+    EXPECT_EQ(r.stats.trace.misses, 0u);
     EXPECT_TRUE(all_finite(r.map));
     std::size_t wrong = 0, on_fin = 0;
     test::for_each_decoded_texel(low, r.map, [&](int, int, const glm::dvec3& w, const glm::dvec3& p, std::size_t) {
@@ -96,7 +96,7 @@ TEST(Stability, NonManifoldFinsGiveTheFirstHit) {
     });
     EXPECT_GT(on_fin, 100u);
     EXPECT_EQ(wrong, 0u) << "keep_backfaces " << keep;
-    EXPECT_EQ(r.stats.hits_facing_away, 0u);
+    EXPECT_EQ(r.stats.trace.hits_facing_away, 0u);
   }
 }
 
@@ -108,9 +108,9 @@ TEST(Stability, IsolatedVerticesChangeNothing) {
   double mean = 0.0;
   const double worst = max_texel_angle(r, ref, &mean);
   measured("isolated_vertices.max_deg_vs_clean", worst);
-  measured("isolated_vertices.front", r.stats.front);
-  EXPECT_EQ(r.stats.front, ref.stats.front);
-  EXPECT_EQ(r.stats.rear, ref.stats.rear);
+  measured("isolated_vertices.front", r.stats.distances.front);
+  EXPECT_EQ(r.stats.distances.front, ref.stats.distances.front);
+  EXPECT_EQ(r.stats.distances.rear, ref.stats.distances.rear);
   EXPECT_TRUE(r.map.pixels == ref.map.pixels);
 }
 
@@ -121,8 +121,8 @@ TEST(Stability, InconsistentWindingDoesNotFlipComputedNormals) {
   double mean = 0.0;
   const double worst = max_texel_angle(r, ref, &mean);
   measured("inconsistent_winding.max_deg_vs_clean", worst);
-  measured("inconsistent_winding.faces_reoriented", double(r.stats.high_faces_reoriented));
-  EXPECT_EQ(r.stats.high_faces_reoriented, 264u);
+  measured("inconsistent_winding.faces_reoriented", double(r.stats.prepare.high_faces_reoriented));
+  EXPECT_EQ(r.stats.prepare.high_faces_reoriented, 264u);
   EXPECT_LT(worst, 1e-3);
 }
 
@@ -135,28 +135,29 @@ TEST(Stability, InvertedNormalsAreBakedAsGivenAndReported) {
     BakeOptions o = options(64, 0.1f);
     o.keep_backfaces = keep;
     const BakeResult r = bake_normal_map(low, load("inverted_normals_high.obj"), nullptr, o);
-    measured(std::string("inverted_normals.texels_facing_away.keep") + (keep ? "1" : "0"), double(r.stats.texels_facing_away));
-    EXPECT_EQ(r.stats.texels_facing_away, r.stats.texels_covered);
-    EXPECT_EQ(r.stats.high_facing, keep ? BakeStats::HighFacing::sound : BakeStats::HighFacing::inverted);
+    measured(std::string("inverted_normals.texels_facing_away.keep") + (keep ? "1" : "0"),
+             double(r.stats.pad.texels_facing_away));
+    EXPECT_EQ(r.stats.pad.texels_facing_away, r.stats.trace.texels_covered);
+    EXPECT_EQ(r.stats.distances.high_facing, keep ? BakeStats::HighFacing::sound : BakeStats::HighFacing::inverted);
     EXPECT_TRUE(all_finite(r.map));
     const BakeResult w = bake_normal_map(low, load("inverted_winding_high.obj"), nullptr, o);
     EXPECT_TRUE(all_finite(w.map));
     if (keep) {
-      EXPECT_EQ(w.stats.texels_facing_away, w.stats.texels_covered);
+      EXPECT_EQ(w.stats.pad.texels_facing_away, w.stats.trace.texels_covered);
     } else {
-      EXPECT_EQ(w.stats.high_facing, BakeStats::HighFacing::inverted);
-      EXPECT_GT(w.stats.backface_probe_share, 0.99);
-      EXPECT_EQ(w.stats.texels_facing_away, 0u);
+      EXPECT_EQ(w.stats.distances.high_facing, BakeStats::HighFacing::inverted);
+      EXPECT_GT(w.stats.distances.backface_probe_share, 0.99);
+      EXPECT_EQ(w.stats.pad.texels_facing_away, 0u);
       // The same map as the correctly wound field's.
       const BakeResult ref = bake_normal_map(low, load("bumps_nonormals_high.obj"), nullptr, o);
       double mean = 0.0;
       EXPECT_LT(max_texel_angle(w, ref, &mean), 1e-3);
-      EXPECT_EQ(ref.stats.high_facing, BakeStats::HighFacing::sound);
+      EXPECT_EQ(ref.stats.distances.high_facing, BakeStats::HighFacing::sound);
     }
   }
   const BakeResult ok = bake_normal_map(low, load("bumps_high.obj"), nullptr, options(64, 0.1f));
-  EXPECT_EQ(ok.stats.texels_facing_away, 0u);
-  EXPECT_EQ(ok.stats.backface_probe_share, 0.0);
+  EXPECT_EQ(ok.stats.pad.texels_facing_away, 0u);
+  EXPECT_EQ(ok.stats.distances.backface_probe_share, 0.0);
 }
 
 TEST(Stability, TopologyAndInversionAreReportedByTheCli) {

@@ -39,7 +39,8 @@ Figures bake_figures(const Mesh& low, const Mesh& high, double front, double rea
   o.front = float(front);
   o.rear = float(rear);
   const BakeResult r = bake_normal_map(low, high, nullptr, o);
-  return {double(r.stats.misses) / double(std::max<std::uint64_t>(1, r.stats.hits + r.stats.misses)), r.stats.suspect_share};
+  return {double(r.stats.trace.misses) / double(std::max<std::uint64_t>(1, r.stats.trace.hits + r.stats.trace.misses)),
+          r.stats.pad.suspect_share};
 }
 
 TEST(ThinParts, FamilyIsCoarseOverFine) {
@@ -108,8 +109,8 @@ TEST(ThinParts, CoarsePrismUnderCloseTubesGetsTheAnalyticNormals) {
     const procedural::KnownErrors e =
         procedural::measure_against_known(a, r.cage_positions.empty() ? known : along_cage_rays(a, known, r.cage_positions), r);
     std::printf("measured: prism %s mean %.4f deg, over 1 deg %.3f%%, worst %.2f deg, texels %zu, misses %llu\n", label,
-                e.mean_deg, 100.0 * e.over1, e.worst_deg, e.texels, (unsigned long long)r.stats.misses);
-    return std::pair{e, r.stats.misses};
+                e.mean_deg, 100.0 * e.over1, e.worst_deg, e.texels, (unsigned long long)r.stats.trace.misses);
+    return std::pair{e, r.stats.trace.misses};
   };
   for (float d : {0.01f, 0.02f}) bake(("fixed " + std::to_string(d)).c_str(), d);
   const auto [e, misses] = bake("automatic", -1.0f);

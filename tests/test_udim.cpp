@@ -120,19 +120,19 @@ void expect_same_bake(const BakeResult& tile, const BakeResult& single, const st
   EXPECT_TRUE(same_bits(tile.miss_mask, single.miss_mask)) << what;
   EXPECT_TRUE(same_bits(tile.suspect_mask, single.suspect_mask)) << what;
   const BakeStats &a = tile.stats, &b = single.stats;
-  EXPECT_EQ(a.rays, b.rays) << what;
-  EXPECT_EQ(a.hits, b.hits) << what;
-  EXPECT_EQ(a.misses, b.misses) << what;
-  EXPECT_EQ(a.samples_covered, b.samples_covered) << what;
-  EXPECT_EQ(a.overlapping_samples, b.overlapping_samples) << what;
-  EXPECT_EQ(a.texels_covered, b.texels_covered) << what;
-  EXPECT_EQ(a.texels_padded, b.texels_padded) << what;
-  EXPECT_EQ(a.suspect_texels, b.suspect_texels) << what;
-  EXPECT_EQ(a.hit_distance_min, b.hit_distance_min) << what;
-  EXPECT_EQ(a.hit_distance_mean, b.hit_distance_mean) << what;
-  EXPECT_EQ(a.hit_distance_max, b.hit_distance_max) << what;
-  EXPECT_EQ(a.front, b.front) << what;
-  EXPECT_EQ(a.rear, b.rear) << what;
+  EXPECT_EQ(a.trace.rays, b.trace.rays) << what;
+  EXPECT_EQ(a.trace.hits, b.trace.hits) << what;
+  EXPECT_EQ(a.trace.misses, b.trace.misses) << what;
+  EXPECT_EQ(a.trace.samples_covered, b.trace.samples_covered) << what;
+  EXPECT_EQ(a.trace.overlapping_samples, b.trace.overlapping_samples) << what;
+  EXPECT_EQ(a.trace.texels_covered, b.trace.texels_covered) << what;
+  EXPECT_EQ(a.pad.texels_padded, b.pad.texels_padded) << what;
+  EXPECT_EQ(a.pad.suspect_texels, b.pad.suspect_texels) << what;
+  EXPECT_EQ(a.trace.hit_distance_min, b.trace.hit_distance_min) << what;
+  EXPECT_EQ(a.trace.hit_distance_mean, b.trace.hit_distance_mean) << what;
+  EXPECT_EQ(a.trace.hit_distance_max, b.trace.hit_distance_max) << what;
+  EXPECT_EQ(a.distances.front, b.distances.front) << what;
+  EXPECT_EQ(a.distances.rear, b.distances.rear) << what;
 }
 
 // Covered texels whose normal leans more than ~8 degrees from the flat (0, 0, 1): the map holds
@@ -185,9 +185,9 @@ TEST(Udim, ThreeTilesEqualThreeSingleTileBakes) {
       const std::string what = "tile " + std::to_string(tb.tile.number) + ", run " + std::to_string(run);
       expect_same_bake(tb.result, single, what);
       // Not a vacuous equality: the island covers most of its tile and carries the bumps.
-      EXPECT_GT(tb.result.stats.texels_covered, std::size_t(o.width * o.height) * 7 / 10) << what;
-      EXPECT_GT(bumpy_texels(tb.result), tb.result.stats.texels_covered / 4) << what;
-      EXPECT_EQ(tb.result.stats.overlapping_samples, 0u) << what;
+      EXPECT_GT(tb.result.stats.trace.texels_covered, std::size_t(o.width * o.height) * 7 / 10) << what;
+      EXPECT_GT(bumpy_texels(tb.result), tb.result.stats.trace.texels_covered / 4) << what;
+      EXPECT_EQ(tb.result.stats.trace.overlapping_samples, 0u) << what;
     }
     // Each strip lies under another part of the bumps: no two maps are the same.
     EXPECT_FALSE(same_bits(udim.tiles[0].result.map, udim.tiles[1].result.map));
@@ -195,10 +195,10 @@ TEST(Udim, ThreeTilesEqualThreeSingleTileBakes) {
     // The totals are the tiles' sums.
     std::uint64_t rays = 0;
     std::size_t covered = 0;
-    for (const TileBake& tb : udim.tiles) rays += tb.result.stats.rays, covered += tb.result.stats.texels_covered;
-    EXPECT_EQ(udim.stats.rays, rays);
-    EXPECT_EQ(udim.stats.texels_covered, covered);
-    EXPECT_EQ(udim.stats.texels_total, 3u * std::size_t(o.width * o.height));
+    for (const TileBake& tb : udim.tiles) rays += tb.result.stats.trace.rays, covered += tb.result.stats.trace.texels_covered;
+    EXPECT_EQ(udim.stats.trace.rays, rays);
+    EXPECT_EQ(udim.stats.trace.texels_covered, covered);
+    EXPECT_EQ(udim.stats.trace.texels_total, 3u * std::size_t(o.width * o.height));
     EXPECT_EQ(udim.outside_triangles, 0u);
   }
 }
@@ -256,19 +256,19 @@ TEST(Udim, OverlapIsCountedPerTile) {
   ASSERT_EQ(apart.tiles.size(), 2u);
   EXPECT_EQ(apart.tiles[1].tile.number, 1002);
   for (const TileBake& tb : apart.tiles) {
-    EXPECT_EQ(tb.result.stats.overlapping_samples, 0u) << tb.tile.number;
-    EXPECT_GT(tb.result.stats.texels_covered, 48u * 48u / 2) << tb.tile.number;
+    EXPECT_EQ(tb.result.stats.trace.overlapping_samples, 0u) << tb.tile.number;
+    EXPECT_GT(tb.result.stats.trace.texels_covered, 48u * 48u / 2) << tb.tile.number;
   }
-  EXPECT_EQ(apart.stats.overlapping_samples, 0u);
+  EXPECT_EQ(apart.stats.trace.overlapping_samples, 0u);
 
   const Mesh together = stacked(0);
   const UdimBake one = bake_udim_tiles(together, high, nullptr, o);
   ASSERT_EQ(one.tiles.size(), 1u);
   const BakeResult plain = bake_normal_map(together, high, nullptr, o);
-  EXPECT_GT(one.tiles[0].result.stats.overlapping_samples, 48u * 48u / 2);
-  EXPECT_EQ(one.tiles[0].result.stats.overlapping_samples, plain.stats.overlapping_samples);
-  EXPECT_EQ(one.stats.overlapping_samples, plain.stats.overlapping_samples);
-  EXPECT_EQ(one.tiles[0].result.stats.texels_covered, apart.tiles[0].result.stats.texels_covered);
+  EXPECT_GT(one.tiles[0].result.stats.trace.overlapping_samples, 48u * 48u / 2);
+  EXPECT_EQ(one.tiles[0].result.stats.trace.overlapping_samples, plain.stats.trace.overlapping_samples);
+  EXPECT_EQ(one.stats.trace.overlapping_samples, plain.stats.trace.overlapping_samples);
+  EXPECT_EQ(one.tiles[0].result.stats.trace.texels_covered, apart.tiles[0].result.stats.trace.texels_covered);
 }
 
 TEST(Udim, TrianglesInNoTileAreCountedAndLeftOut) {
@@ -299,7 +299,7 @@ TEST(Udim, TrianglesInNoTileAreCountedAndLeftOut) {
   const UdimBake udim = bake_udim_tiles(low, high, nullptr, o);
   ASSERT_EQ(udim.tiles.size(), 2u);
   EXPECT_EQ(udim.outside_triangles, expected_outside);
-  EXPECT_EQ(udim.stats.uv_outside_entirely_triangles, expected_outside);
+  EXPECT_EQ(udim.stats.prepare.uv_outside_entirely_triangles, expected_outside);
   // What lies outside moves no other tile's texel: 1002's map is its single-tile bake.
   const BakeResult single = bake_normal_map(single_tile_reference(low, layout, 1), high, nullptr, o);
   expect_same_bake(udim.tiles[1].result, single, "tile 1002");
@@ -333,10 +333,10 @@ TEST(Udim, LayoutCountsTrianglesAndTexelsPerTile) {
   BakeOptions o = options(64);
   o.front = o.rear = 0.1f;
   const UdimBake udim = bake_udim_tiles(low, high, nullptr, o);
-  for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(udim.tiles[i].result.stats.texels_covered, layout.tiles[i].texels);
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(udim.tiles[i].result.stats.trace.texels_covered, layout.tiles[i].texels);
   // A bake without <UDIM> covers 1001's texels only: the rest is what the warning names.
   const BakeResult plain = bake_normal_map(low, high, nullptr, o);
-  EXPECT_EQ(plain.stats.texels_covered, layout.tiles[0].texels);
+  EXPECT_EQ(plain.stats.trace.texels_covered, layout.tiles[0].texels);
 }
 
 TEST(Udim, StraddlingTriangleIsCutAtItsTilesEdge) {
@@ -362,8 +362,8 @@ TEST(Udim, StraddlingTriangleIsCutAtItsTilesEdge) {
   BakeOptions o = options(40);
   o.front = o.rear = 0.1f;
   const UdimBake udim = bake_udim_tiles(low, high, nullptr, o);
-  EXPECT_EQ(udim.stats.uv_outside_triangles, 1u);
-  EXPECT_EQ(udim.tiles[1].result.stats.uv_outside_triangles, 1u);
+  EXPECT_EQ(udim.stats.prepare.uv_outside_triangles, 1u);
+  EXPECT_EQ(udim.tiles[1].result.stats.prepare.uv_outside_triangles, 1u);
   // 1002 holds the straddler up to its left edge; 1001 holds none of it, where the plain bake
   // (the unit square) covers its part from u = 0.7 on.
   const BakeResult plain = bake_normal_map(low, high, nullptr, o);
@@ -401,18 +401,18 @@ TEST(Udim, MirroredAndZeroAreaUvsInATileStayFinite) {
   ASSERT_EQ(udim.tiles.size(), 2u);
   EXPECT_EQ(udim.tiles[0].tile.number, 1002);
   EXPECT_EQ(udim.tiles[1].tile.number, 1003);
-  EXPECT_EQ(udim.stats.degenerate_uv_triangles, 2u);
+  EXPECT_EQ(udim.stats.prepare.degenerate_uv_triangles, 2u);
   for (const TileBake& tb : udim.tiles)
     for (float c : tb.result.map.pixels) ASSERT_TRUE(std::isfinite(c)) << tb.tile.number;
   const BakeResult& mixed = udim.tiles[0].result;
-  EXPECT_GT(mixed.stats.texels_covered, 32u * 32u / 4);
+  EXPECT_GT(mixed.stats.trace.texels_covered, 32u * 32u / 4);
   for (std::size_t i = 0; i < mixed.coverage.size(); ++i)  // the bumps lean less than 20 degrees
     EXPECT_TRUE(!mixed.coverage[i] || mixed.map.pixels[3 * i + 2] > 0.9f) << "texel " << i;
   // Mirrored and degenerate UVs included, still the single-tile bake.
   const BakeResult single = bake_normal_map(single_tile_reference(low, find_udim_tiles(low), 0), high, nullptr, o);
   expect_same_bake(mixed, single, "tile 1002");
   const BakeResult& empty = udim.tiles[1].result;
-  EXPECT_EQ(empty.stats.texels_covered, 0u);
+  EXPECT_EQ(empty.stats.trace.texels_covered, 0u);
   for (std::size_t i = 0; i < empty.coverage.size(); ++i) {
     ASSERT_EQ(empty.map.pixels[3 * i], 0.5f);
     ASSERT_EQ(empty.map.pixels[3 * i + 1], 0.5f);

@@ -27,19 +27,19 @@ using Clock = std::chrono::steady_clock;
 
 // One line on how far rays reached, unless --quiet.
 void print_distances(const BakeStats& s) {
-  if (s.cage == BakeStats::CageSource::automatic)
+  if (s.distances.cage == BakeStats::CageSource::automatic)
     std::fprintf(
         stderr,
         "nmbake: automatic cage: front %.3g-%.3g (mean %.3g), rear %.3g-%.3g (mean %.3g) per vertex; limited by a neighbouring "
         "part at %zu and %zu vertices\n",
-        s.vertex_front.min, s.vertex_front.max, s.vertex_front.mean, s.vertex_rear.min, s.vertex_rear.max, s.vertex_rear.mean,
-        s.cage_front_limited, s.cage_rear_limited);
-  else if (s.cage == BakeStats::CageSource::file && s.auto_distances)
-    std::fprintf(stderr, "nmbake: rear distances measured per vertex: %.3g-%.3g (mean %.3g)\n", s.vertex_rear.min,
-                 s.vertex_rear.max, s.vertex_rear.mean);
-  else if (s.auto_distances)
-    std::fprintf(stderr, "nmbake: ray distances measured: --front %.6g --rear %.6g (%.2f%% of probes lie beyond)\n", s.front,
-                 s.rear, 100.0 * s.auto_probe_beyond);
+        s.distances.vertex_front.min, s.distances.vertex_front.max, s.distances.vertex_front.mean, s.distances.vertex_rear.min,
+        s.distances.vertex_rear.max, s.distances.vertex_rear.mean, s.distances.cage_front_limited, s.distances.cage_rear_limited);
+  else if (s.distances.cage == BakeStats::CageSource::file && s.distances.auto_distances)
+    std::fprintf(stderr, "nmbake: rear distances measured per vertex: %.3g-%.3g (mean %.3g)\n", s.distances.vertex_rear.min,
+                 s.distances.vertex_rear.max, s.distances.vertex_rear.mean);
+  else if (s.distances.auto_distances)
+    std::fprintf(stderr, "nmbake: ray distances measured: --front %.6g --rear %.6g (%.2f%% of probes lie beyond)\n",
+                 s.distances.front, s.distances.rear, 100.0 * s.distances.auto_probe_beyond);
 }
 
 // With <UDIM>, each tile's estimate goes into the report's udim tiles and the line gives them combined.
@@ -169,11 +169,11 @@ void report_job(const JobEnv& env, OutputSet& outputs, const Args& a, const Bake
 // "4", or with --samples auto "auto (16 at 3.2%, 64 at 0.4% of texels, 4 elsewhere)".
 std::string samples_text(const BakeOptions& o, const BakeStats& s) {
   if (!o.adaptive) return std::to_string(o.samples);
-  const double texels = double(s.texels_base + s.texels_refined + s.texels_deep);
+  const double texels = double(s.trace.texels_base + s.trace.texels_refined + s.trace.texels_deep);
   auto share = [texels](std::uint64_t n) { return texels > 0 ? 100.0 * double(n) / texels : 0.0; };
   char text[120];
-  std::snprintf(text, sizeof text, "auto (%d at %.1f%%, %d at %.1f%% of texels, 4 elsewhere)", o.samples, share(s.texels_refined),
-                4 * o.samples, share(s.texels_deep));
+  std::snprintf(text, sizeof text, "auto (%d at %.1f%%, %d at %.1f%% of texels, 4 elsewhere)", o.samples,
+                share(s.trace.texels_refined), 4 * o.samples, share(s.trace.texels_deep));
   return text;
 }
 
@@ -189,9 +189,9 @@ void print_summary(const Args& a, const BakeOptions& o, const RunInfo& run, cons
       "seconds: load %.2f prepare %.2f bvh %.2f distances %.2f trace %.2f padding %.2f write %.2f total %.2f\n",
       a.output.c_str(), tiles.c_str(), o.width, o.height, bits, to_string(o.space),
       o.space == NormalSpace::tangent ? (o.green_down ? ", green down" : ", green up") : "", samples_text(o, s).c_str(),
-      human(double(s.rays)).c_str(), (unsigned long long)s.misses,
-      s.samples_covered ? 100.0 * double(s.misses) / double(s.samples_covered) : 0.0, 100.0 * s.coverage, run.seconds_load,
-      s.seconds_prepare, s.seconds_bvh, s.seconds_distances, s.seconds_trace, s.seconds_padding, run.seconds_write,
+      human(double(s.trace.rays)).c_str(), (unsigned long long)s.trace.misses,
+      s.trace.samples_covered ? 100.0 * double(s.trace.misses) / double(s.trace.samples_covered) : 0.0, 100.0 * s.trace.coverage,
+      run.seconds_load, s.prepare.seconds, s.bvh.seconds, s.distances.seconds, s.trace.seconds, s.pad.seconds, run.seconds_write,
       run.seconds_total);
 }
 

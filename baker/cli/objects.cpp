@@ -79,14 +79,14 @@ void add_objects_report(nlohmann::json& report, const ObjectList& low, const Obj
     lows.push_back({{"name", low.objects[k].name},
                     {"file", low.objects[k].file},
                     {"triangles", low.triangles[k]},
-                    {"samples", at(s.low_object_samples, k)},
-                    {"hits", at(s.low_object_hits, k)},
+                    {"samples", at(s.trace.low_object_samples, k)},
+                    {"hits", at(s.trace.low_object_hits, k)},
                     {"match", group(m.match.low_group, k)}});
   for (std::size_t k = 0; k < high.objects.size(); ++k)
     highs.push_back({{"name", high.objects[k].name},
                      {"file", high.objects[k].file},
                      {"triangles", high.triangles[k]},
-                     {"hits", at(s.high_object_hits, k)},
+                     {"hits", at(s.trace.high_object_hits, k)},
                      {"match", group(m.match.high_group, k)}});
   report["objects"] = {{"low", lows}, {"high", highs}};
   json unmatched_low = json::array(), unmatched_high = json::array(), suffixes = json::array();
@@ -98,7 +98,7 @@ void add_objects_report(nlohmann::json& report, const ObjectList& low, const Obj
                      {"groups", m.match.bases},
                      {"unmatched_low", unmatched_low},
                      {"unmatched_high", unmatched_high}};
-  report["samples_unmatched"] = s.samples_unmatched;
+  report["samples_unmatched"] = s.trace.samples_unmatched;
 }
 
 }  // namespace nmbake

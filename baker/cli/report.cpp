@@ -54,8 +54,8 @@ void add_high_details(nlohmann::json& report, const BakeStats& s, const RunInfo&
   high["boundary_edges"] = t.boundary_edges;
   high["non_manifold_edges"] = t.non_manifold_edges;
   high["inconsistent_winding_faces"] = t.inconsistent_winding_faces;
-  high["triangles_culled"] = s.high_triangles_culled;
-  high["duplicates_skipped"] = s.high_duplicates_skipped;
+  high["triangles_culled"] = s.select.high_triangles_culled;
+  high["duplicates_skipped"] = s.select.high_duplicates_skipped;
   report["origin"] = r.origin;
   report["highs"] = r.high_paths;
   json files = json::array();
@@ -71,9 +71,10 @@ void add_high_details(nlohmann::json& report, const BakeStats& s, const RunInfo&
 // BakeOptions::samples and (when the bake has that level) 4x as many.
 nlohmann::json samples_histogram(const BakeOptions& o, const BakeStats& s) {
   using nlohmann::json;
-  if (!o.adaptive) return json::array({{{"samples", o.samples}, {"texels", s.texels_covered}}});
-  json rows = json::array({{{"samples", 4}, {"texels", s.texels_base}}, {{"samples", o.samples}, {"texels", s.texels_refined}}});
-  if (4 * o.samples <= kMaxSamples) rows.push_back({{"samples", 4 * o.samples}, {"texels", s.texels_deep}});
+  if (!o.adaptive) return json::array({{{"samples", o.samples}, {"texels", s.trace.texels_covered}}});
+  json rows = json::array(
+      {{{"samples", 4}, {"texels", s.trace.texels_base}}, {{"samples", o.samples}, {"texels", s.trace.texels_refined}}});
+  if (4 * o.samples <= kMaxSamples) rows.push_back({{"samples", 4 * o.samples}, {"texels", s.trace.texels_deep}});
   return rows;
 }
 
@@ -91,9 +92,9 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
       {"size", {o.width, o.height}},
       {"samples", o.adaptive ? json("auto") : json(o.samples)},
       {"max_error_deg", o.adaptive ? json(o.max_error_deg) : json(nullptr)},
-      {"front", s.front},
-      {"rear", s.rear},
-      {"front_rear_auto", s.auto_distances},
+      {"front", s.distances.front},
+      {"rear", s.distances.rear},
+      {"front_rear_auto", s.distances.auto_distances},
       {"policy", to_string(o.policy)},
       {"space", to_string(o.space)},
       {"green", o.green_down ? "down" : "up"},
@@ -126,61 +127,64 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
       {"options", options},
       {"seconds",
        {{"load", r.seconds_load},
-        {"prepare", s.seconds_prepare},
-        {"bvh", s.seconds_bvh},
-        {"distances", s.seconds_distances},
-        {"trace", s.seconds_trace},
-        {"padding", s.seconds_padding},
+        {"prepare", s.prepare.seconds},
+        {"bvh", s.bvh.seconds},
+        {"distances", s.distances.seconds},
+        {"trace", s.trace.seconds},
+        {"padding", s.pad.seconds},
         {"write", r.seconds_write},
         {"total", r.seconds_total}}},
-      {"rays", s.rays},
-      {"rays_per_second", s.seconds_trace > 0 ? double(s.rays) / s.seconds_trace : 0.0},
-      {"samples_covered", s.samples_covered},
+      {"rays", s.trace.rays},
+      {"rays_per_second", s.trace.seconds > 0 ? double(s.trace.rays) / s.trace.seconds : 0.0},
+      {"samples_covered", s.trace.samples_covered},
       {"samples_histogram", samples_histogram(o, s)},
-      {"hits", s.hits},
-      {"misses", s.misses},
-      {"texels", {{"total", s.texels_total}, {"covered", s.texels_covered}, {"padded", s.texels_padded}}},
-      {"coverage", s.coverage},
-      {"hit_distance", {{"min", s.hit_distance_min}, {"mean", s.hit_distance_mean}, {"max", s.hit_distance_max}}},
-      {"auto_distance_probes_beyond", s.auto_probe_beyond},
+      {"hits", s.trace.hits},
+      {"misses", s.trace.misses},
+      {"texels", {{"total", s.trace.texels_total}, {"covered", s.trace.texels_covered}, {"padded", s.pad.texels_padded}}},
+      {"coverage", s.trace.coverage},
+      {"hit_distance",
+       {{"min", s.trace.hit_distance_min}, {"mean", s.trace.hit_distance_mean}, {"max", s.trace.hit_distance_max}}},
+      {"auto_distance_probes_beyond", s.distances.auto_probe_beyond},
       {"degenerate",
-       {{"uv_triangles", s.degenerate_uv_triangles},
-        {"triangles_3d", s.degenerate_3d_triangles},
-        {"corners_without_tangent", s.corners_without_tangent}}},
-      {"uv_outside_triangles", s.uv_outside_triangles},
-      {"overlapping_samples", s.overlapping_samples},
-      {"low_mesh", mesh_json(r.low_info, s.low_triangles)},
-      {"high_mesh", mesh_json(r.high_info, s.high_triangles)},
-      {"high_normals_computed", s.high_normals_computed},
+       {{"uv_triangles", s.prepare.degenerate_uv_triangles},
+        {"triangles_3d", s.prepare.degenerate_3d_triangles},
+        {"corners_without_tangent", s.prepare.corners_without_tangent}}},
+      {"uv_outside_triangles", s.prepare.uv_outside_triangles},
+      {"overlapping_samples", s.trace.overlapping_samples},
+      {"low_mesh", mesh_json(r.low_info, s.prepare.low_triangles)},
+      {"high_mesh", mesh_json(r.high_info, s.prepare.high_triangles)},
+      {"high_normals_computed", s.prepare.high_normals_computed},
       {"peak_memory_bytes", r.peak_memory_bytes},
-      {"uv_outside_entirely_triangles", s.uv_outside_entirely_triangles},
-      {"high_faces_reoriented", s.high_faces_reoriented},
-      {"texels_facing_away", s.texels_facing_away},
-      {"backfaces_skipped", s.backfaces_skipped},
-      {"backface_skips", s.backface_skips},
-      {"backface_probe_share", s.backface_probe_share},
-      {"high_facing", s.high_facing == BakeStats::HighFacing::inverted ? "inverted"
-                      : s.high_facing == BakeStats::HighFacing::mixed  ? "mixed"
-                                                                       : "sound"},
-      {"hits_facing_away", s.hits_facing_away},
-      {"suspect_texels", s.suspect_texels},
-      {"suspect_share", s.suspect_share},
+      {"uv_outside_entirely_triangles", s.prepare.uv_outside_entirely_triangles},
+      {"high_faces_reoriented", s.prepare.high_faces_reoriented},
+      {"texels_facing_away", s.pad.texels_facing_away},
+      {"backfaces_skipped", s.distances.backfaces_skipped},
+      {"backface_skips", s.trace.backface_skips},
+      {"backface_probe_share", s.distances.backface_probe_share},
+      {"high_facing", s.distances.high_facing == BakeStats::HighFacing::inverted ? "inverted"
+                      : s.distances.high_facing == BakeStats::HighFacing::mixed  ? "mixed"
+                                                                                 : "sound"},
+      {"hits_facing_away", s.trace.hits_facing_away},
+      {"suspect_texels", s.pad.suspect_texels},
+      {"suspect_share", s.pad.suspect_share},
       {"suspect_region",
-       {{"u", {s.suspect_region[0], s.suspect_region[2]}},
-        {"v", {s.suspect_region[1], s.suspect_region[3]}},
-        {"share", s.suspect_region_share}}},
+       {{"u", {s.pad.suspect_region[0], s.pad.suspect_region[2]}},
+        {"v", {s.pad.suspect_region[1], s.pad.suspect_region[3]}},
+        {"share", s.pad.suspect_region_share}}},
       {"cage",
-       {{"source", s.cage == BakeStats::CageSource::automatic ? "automatic"
-                   : s.cage == BakeStats::CageSource::file    ? "file"
-                                                              : "none"},
-        {"front", {{"min", s.vertex_front.min}, {"mean", s.vertex_front.mean}, {"max", s.vertex_front.max}}},
-        {"rear", {{"min", s.vertex_rear.min}, {"mean", s.vertex_rear.mean}, {"max", s.vertex_rear.max}}},
-        {"scene_front", s.scene_front},
-        {"scene_rear", s.scene_rear},
-        {"front_limited_vertices", s.cage_front_limited},
-        {"rear_limited_vertices", s.cage_rear_limited}}},
-      {"coordinate_spacing", s.coordinate_spacing},
-      {"largest_coordinate", s.largest_coordinate},
+       {{"source", s.distances.cage == BakeStats::CageSource::automatic ? "automatic"
+                   : s.distances.cage == BakeStats::CageSource::file    ? "file"
+                                                                        : "none"},
+        {"front",
+         {{"min", s.distances.vertex_front.min}, {"mean", s.distances.vertex_front.mean}, {"max", s.distances.vertex_front.max}}},
+        {"rear",
+         {{"min", s.distances.vertex_rear.min}, {"mean", s.distances.vertex_rear.mean}, {"max", s.distances.vertex_rear.max}}},
+        {"scene_front", s.distances.scene_front},
+        {"scene_rear", s.distances.scene_rear},
+        {"front_limited_vertices", s.distances.cage_front_limited},
+        {"rear_limited_vertices", s.distances.cage_rear_limited}}},
+      {"coordinate_spacing", s.prepare.coordinate_spacing},
+      {"largest_coordinate", s.prepare.largest_coordinate},
   };
   add_high_details(report, s, r);
   add_objects_report(report, r.low_objects, r.high_objects, r.match, s);
@@ -191,10 +195,8 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
   report["command"] = r.command;
   report["started"] = r.started;
   report["warnings"] = r.warnings;
-  report["bvh_reused"] = s.bvh_reused;
-  report["bvh_quality"] = s.bvh_quality == raycast::BuildQuality::low      ? "low"
-                          : s.bvh_quality == raycast::BuildQuality::medium ? "medium"
-                                                                           : "high";
+  report["bvh_reused"] = s.bvh.reused;
+  report["bvh_quality"] = s.bvh.quality;
   return report;
 }
 

@@ -60,12 +60,12 @@ nlohmann::json udim_report(const UdimBake& bake, const std::string& pattern) {
                      {"file", udim_path(pattern, t.tile.number)},
                      {"triangles", t.tile.triangles},
                      {"straddling_triangles", t.tile.straddling},
-                     {"texels_covered", s.texels_covered},
-                     {"coverage", s.coverage},
-                     {"overlapping_samples", s.overlapping_samples},
-                     {"rays", s.rays},
-                     {"hits", s.hits},
-                     {"misses", s.misses}});
+                     {"texels_covered", s.trace.texels_covered},
+                     {"coverage", s.trace.coverage},
+                     {"overlapping_samples", s.trace.overlapping_samples},
+                     {"rays", s.trace.rays},
+                     {"hits", s.trace.hits},
+                     {"misses", s.trace.misses}});
   }
   return {{"tiles", tiles}, {"outside_triangles", bake.outside_triangles}, {"straddling_triangles", bake.straddling_triangles}};
 }

@@ -40,22 +40,22 @@ void WarningLog::check_strict() const {
 std::vector<std::string> bake_warnings(const BakeStats& s, const MeshTopology& t, const std::string& low, const std::string& high,
                                        const UvTilesNote& uv_tiles, const PairNote& pair) {
   std::vector<std::string> out;
-  if (s.degenerate_uv_triangles)
+  if (s.prepare.degenerate_uv_triangles)
     out.push_back(format_line("warning: %s: %zu triangles have zero UV area (they cover no texels and give no tangent)",
-                              low.c_str(), s.degenerate_uv_triangles));
-  if (s.degenerate_3d_triangles)
+                              low.c_str(), s.prepare.degenerate_uv_triangles));
+  if (s.prepare.degenerate_3d_triangles)
     out.push_back(
         format_line("warning: %s: %zu triangles have zero area (their texels take the normal found from a point or a line)",
-                    low.c_str(), s.degenerate_3d_triangles));
+                    low.c_str(), s.prepare.degenerate_3d_triangles));
   if (uv_tiles.udim) {  // udim.h: uv_outside_* count the triangles cut at their tile's edge and those in no tile
-    if (s.uv_outside_triangles)
+    if (s.prepare.uv_outside_triangles)
       out.push_back(
           format_line("warning: %s: %zu triangles reach beyond their UDIM tile (by their UV centroid) and are cut at its edge",
-                      low.c_str(), s.uv_outside_triangles));
-    if (s.uv_outside_entirely_triangles)
+                      low.c_str(), s.prepare.uv_outside_triangles));
+    if (s.prepare.uv_outside_entirely_triangles)
       out.push_back(format_line("warning: %s: %zu triangles lie in no UDIM tile (u below 0 or from 10 on, v below 0): not baked",
-                                low.c_str(), s.uv_outside_entirely_triangles));
-  } else if (s.uv_outside_triangles) {
+                                low.c_str(), s.prepare.uv_outside_entirely_triangles));
+  } else if (s.prepare.uv_outside_triangles) {
     std::string tiles;
     if (uv_tiles.beyond_triangles)
       tiles = format_line(
@@ -65,46 +65,46 @@ std::vector<std::string> bake_warnings(const BakeStats& s, const MeshTopology& t
     out.push_back(
         format_line("warning: %s: %zu triangles have UVs outside [0,1] (%zu entirely outside, not baked); only the part inside "
                     "the map is baked, UVs are not wrapped%s",
-                    low.c_str(), s.uv_outside_triangles, s.uv_outside_entirely_triangles, tiles.c_str()));
+                    low.c_str(), s.prepare.uv_outside_triangles, s.prepare.uv_outside_entirely_triangles, tiles.c_str()));
   }
   if (pair.overlap && pair.overlap->overlapped)
-    out.push_back("warning: " + overlap_text(*pair.overlap, s.overlapping_samples, low, true));
-  else if (s.overlapping_samples)  // too little to show on the overlap check's grid
+    out.push_back("warning: " + overlap_text(*pair.overlap, s.trace.overlapping_samples, low, true));
+  else if (s.trace.overlapping_samples)  // too little to show on the overlap check's grid
     out.push_back(format_line("warning: %s: UV islands overlap slightly (%llu samples covered twice; the lower face number wins)",
-                              low.c_str(), (unsigned long long)s.overlapping_samples));
-  if (s.samples_covered && double(s.misses) > kMissShareWarn * double(s.samples_covered))
+                              low.c_str(), (unsigned long long)s.trace.overlapping_samples));
+  if (s.trace.samples_covered && double(s.trace.misses) > kMissShareWarn * double(s.trace.samples_covered))
     out.push_back(format_line("warning: %.1f%% of samples missed %s and were written flat; %s",
-                              100.0 * double(s.misses) / double(s.samples_covered), high.c_str(),
+                              100.0 * double(s.trace.misses) / double(s.trace.samples_covered), high.c_str(),
                               pair.boxes_mismatch ? "LOW and HIGH do not lie in one place or differ in size (above)"
                                                   : "check --front/--rear (or --cage)"));
-  if (s.texels_covered && double(s.texels_facing_away) > kFacingAwayShareWarn * double(s.texels_covered))
+  if (s.trace.texels_covered && double(s.pad.texels_facing_away) > kFacingAwayShareWarn * double(s.trace.texels_covered))
     out.push_back(
         format_line("warning: %.1f%% of covered texels point into the low-poly: are the normals or the winding of %s inverted?",
-                    100.0 * double(s.texels_facing_away) / double(s.texels_covered), high.c_str()));
-  if (s.high_facing == BakeStats::HighFacing::inverted)
+                    100.0 * double(s.pad.texels_facing_away) / double(s.trace.texels_covered), high.c_str()));
+  if (s.distances.high_facing == BakeStats::HighFacing::inverted)
     out.push_back(format_line(
         "warning: %s: its faces look inverted (%.0f%% of the surfaces nearest the low-poly face into it): their fronts "
         "were taken the other way round%s%s",
-        high.c_str(), 100.0 * s.backface_probe_share,
-        s.high_normals_computed ? " and the computed normals turned outwards"
-                                : "; the file's normals are kept, so the map points into the surface",
+        high.c_str(), 100.0 * s.distances.backface_probe_share,
+        s.prepare.high_normals_computed ? " and the computed normals turned outwards"
+                                        : "; the file's normals are kept, so the map points into the surface",
         pair.boxes_mismatch ? " (judged from the few probes that met it: LOW and HIGH do not match, above)" : ""));
-  else if (s.high_facing == BakeStats::HighFacing::mixed)
+  else if (s.distances.high_facing == BakeStats::HighFacing::mixed)
     out.push_back(
         format_line("warning: %s: some of its parts look inverted (%.0f%% of the surfaces nearest the low-poly face into it): "
                     "back faces are kept for this bake, as with --keep-backfaces",
-                    high.c_str(), 100.0 * s.backface_probe_share));
-  if (s.suspect_share > kSuspectShareWarn)
+                    high.c_str(), 100.0 * s.distances.backface_probe_share));
+  if (s.pad.suspect_share > kSuspectShareWarn)
     out.push_back(
         format_line("warning: %.2f%% of covered texels are suspect (normal tilted over %.0f degrees from the low-poly's, or "
                     "samples disagreeing), %.0f%% of them in UV u %.3g-%.3g, v %.3g-%.3g; see --suspect-mask",
-                    100.0 * s.suspect_share, kSuspectTiltDeg, 100.0 * s.suspect_region_share, s.suspect_region[0],
-                    s.suspect_region[2], s.suspect_region[1], s.suspect_region[3]));
-  if (s.coordinate_spacing > kCoordinateSpacingWarn)
+                    100.0 * s.pad.suspect_share, kSuspectTiltDeg, 100.0 * s.pad.suspect_region_share, s.pad.suspect_region[0],
+                    s.pad.suspect_region[2], s.pad.suspect_region[1], s.pad.suspect_region[3]));
+  if (s.prepare.coordinate_spacing > kCoordinateSpacingWarn)
     out.push_back(
         format_line("warning: coordinates reach %.3g, far from the origin for a scene this size: float precision there is "
                     "%.2g of the scene diagonal (above %.0e the map degrades measurably); move the meshes near the origin",
-                    s.largest_coordinate, s.coordinate_spacing, kCoordinateSpacingWarn));
+                    s.prepare.largest_coordinate, s.prepare.coordinate_spacing, kCoordinateSpacingWarn));
   std::string topo;
   auto add = [&](std::size_t n, const char* what) {
     if (!n) return;
@@ -112,7 +112,7 @@ std::vector<std::string> bake_warnings(const BakeStats& s, const MeshTopology& t
   };
   add(t.non_manifold_edges, "non-manifold edges");
   add(t.isolated_vertices, "isolated vertices (ignored)");
-  add(t.inconsistent_winding_faces, s.high_normals_computed
+  add(t.inconsistent_winding_faces, s.prepare.high_normals_computed
                                         ? "faces wound against their neighbours (turned before computing normals)"
                                         : "faces wound against their neighbours (the file's normals are used)");
   add(t.duplicate_faces, "duplicate faces (counted once in computed normals)");

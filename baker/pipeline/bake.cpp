@@ -130,11 +130,6 @@ std::vector<glm::dvec2> sample_offsets(int samples) {
   return out;
 }
 
-raycast::BuildQuality bvh_quality_for(const BakeOptions& o, std::size_t triangles) {
-  const double rays = double(o.width) * double(o.height) * double(o.samples);
-  return rays < 16.0 * double(triangles) ? raycast::BuildQuality::low : raycast::BuildQuality::high;
-}
-
 std::uint64_t estimate_bake_bytes(const BakeOptions& o) {
   const std::uint64_t texels = std::uint64_t(std::max(o.width, 0)) * std::uint64_t(std::max(o.height, 0));
   // map (3 floats) + coverage (1 byte) + padding transform (one int) + optional miss mask.
@@ -147,74 +142,76 @@ void announce_stage(const BakeOptions& opt, const char* stage) {
   if (opt.on_stage) opt.on_stage(stage);
 }
 
-// The stages before the trace (bake_stages.h).
+// The select and BVH stages (bake_stages.h).
+BvhSource select_and_build(const Mesh& high, const ReachMode& mode, const BakeOptions& opt, int threads, TraceInputs& in,
+                           BakeStats& st, std::string& stage) {
+  const Prepared& s = in.s;
+  BvhCache* const cache = opt.bvh_cache;
+  const std::uint64_t content = cache ? bvh_content(s, high) : 0;
+  const KeptBvh* const reuse = find_kept_bvh(cache, s, content);
+  const bool keep = cache && !cache->kept;
+  const double margin = mode.probing ? mode.reach * 1.01 + 1e-6 * s.diagonal : ray_margin(s, mode.any_cage, opt.front, opt.rear);
+  in.selection = reuse ? reuse->selection : select_high(s, high, opt.cull_far && !keep ? margin : -1.0, threads);
+  const std::size_t count = in.selection.count(high);
+  announce_stage(opt, "building the BVH");
+  stage = "building the BVH of " + std::to_string(count) + " high-poly triangles";
+  build_high_scene(in.scene, s, high, in.selection.kept, reuse ? reuse->quality : bvh_quality_for(opt, count), opt.threads,
+                   reuse ? reuse->scene : nullptr, !keep);
+  st.select.high_duplicates_skipped = in.selection.duplicates_skipped;
+  st.bvh.reused = reuse != nullptr;
+  if (reuse) ++cache->reused;
+  if (keep)
+    cache->kept =
+        std::make_shared<const KeptBvh>(KeptBvh{content, s.centre, s.diagonal, in.selection, in.scene.scene, in.scene.quality});
+  return reuse ? BvhSource::reused : keep ? BvhSource::kept : BvhSource::built;
+}
+
+// The narrow stage (bake_stages.h).
+void narrow_and_rebuild(const Mesh& high, const ReachMode& mode, const BakeOptions& opt, int threads, const BakeResult& result,
+                        TraceInputs& in) {
+  const BakeStats& st = result.stats;
+  if (narrow_high(in.s, high, mode.any_cage, st.distances.front, st.distances.rear, result.vertex_search, in.selection, threads))
+    build_high_scene(in.scene, in.s, high, in.selection.kept, bvh_quality_for(opt, in.selection.kept.size()), opt.threads,
+                     nullptr, true);
+}
+
+// The stages before the trace, in order (bake_stages.h).
 void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt, int threads, TraceInputs& in,
                    BakeResult& result, std::string& stage) {
   BakeStats& st = result.stats;
   announce_stage(opt, "preparing");
   stage = "preparing " + std::to_string(low.triangle_count()) + " low-poly and " + std::to_string(high.triangle_count()) +
           " high-poly triangles";
-  st.low_triangles = low.triangle_count();
-  st.high_triangles = high.triangle_count();
+  st.prepare.low_triangles = low.triangle_count();
+  st.prepare.high_triangles = high.triangle_count();
   auto t0 = Clock::now();
-  Prepared& s = in.s;
-  s = prepare(low, high, cage, st);
-  const ReachMode mode = ReachMode::of(opt, cage, s);
-  st.seconds_prepare = seconds_since(t0);
+  in.s = prepare(low, high, cage, st);
+  const ReachMode mode = ReachMode::of(opt, cage, in.s);
+  st.prepare.seconds = seconds_since(t0);
 
-  // The high-poly triangles some ray can reach: before the distances are known, within the
-  // probes' reach (or the distances given). A BVH kept for later bakes holds them all.
   t0 = Clock::now();
-  BvhCache* const cache = opt.bvh_cache;
-  const bool reuse = cache && cache->scene && cache->high == &high && cache->centre == s.centre && cache->diagonal == s.diagonal;
-  const bool keep = cache && !cache->scene;
-  HighScene& scene = in.scene;
-  std::vector<std::uint32_t> kept;  // increasing; empty: all
-  if (reuse) {
-    announce_stage(opt, "building the BVH");
-    kept = cache->kept;
-    st.high_duplicates_skipped = cache->duplicates_skipped;
-    build_high_scene(scene, s, high, kept, cache->quality, opt.threads, cache->scene);
-    st.bvh_reused = true;
-    ++cache->reused;
-  } else {
-    if (opt.cull_far && !keep)
-      kept = select_reachable(
-          s, high, mode.probing ? mode.reach * 1.01 + 1e-6 * s.diagonal : ray_margin(s, mode.any_cage, opt.front, opt.rear),
-          threads);
-    st.high_duplicates_skipped = drop_duplicate_floods(s, high, threads, kept);
-    announce_stage(opt, "building the BVH");
-    stage = "building the BVH of " + std::to_string(kept.empty() ? high.triangle_count() : kept.size()) + " high-poly triangles";
-    build_high_scene(scene, s, high, kept, bvh_quality_for(opt, kept.empty() ? high.triangle_count() : kept.size()), opt.threads,
-                     nullptr, !keep);
-    if (keep) *cache = {scene.scene, &high, s.centre, s.diagonal, kept, st.high_duplicates_skipped, scene.quality, 0};
-  }
-  st.seconds_bvh = seconds_since(t0);
+  const BvhSource source = select_and_build(high, mode, opt, threads, in, st, stage);
+  st.bvh.seconds = seconds_since(t0);
 
   t0 = Clock::now();
   announce_stage(opt, "measuring distances");
   stage = "measuring the ray distances";
-  measure_reach(mode, low, opt, threads, s, scene, result);
-  st.seconds_distances = seconds_since(t0);
+  measure_reach(mode, low, opt, threads, in.s, in.scene, result);
+  st.distances.seconds = seconds_since(t0);
 
-  if (opt.cull_far && mode.probing && !reuse && !keep) {
-    // Rays from a cage reach the rear distance beyond P and, where they search beyond the cage,
-    // as far out as they search: the BVH is rebuilt only if that leaves out a fifth of it or more.
+  if (opt.cull_far && mode.probing && source == BvhSource::built) {
     t0 = Clock::now();
-    double reach_out = 0.0;
-    for (float d : result.vertex_search) reach_out = std::max(reach_out, double(d));
     stage = "building the BVH of the reachable high-poly triangles";
-    if (narrow_reachable(s, high, ray_margin(s, mode.any_cage, st.front, std::max<double>(st.rear, reach_out)), kept, threads))
-      build_high_scene(scene, s, high, kept, bvh_quality_for(opt, kept.size()), opt.threads, nullptr, true);
-    st.seconds_bvh += seconds_since(t0);
+    narrow_and_rebuild(high, mode, opt, threads, result, in);
+    st.bvh.seconds += seconds_since(t0);
   }
-  st.bvh_quality = scene.quality;
-  st.high_triangles_culled = high.triangle_count() - scene.triangles;
-  in.rays.front = st.front;
-  in.rays.rear = st.rear;
+  st.bvh.quality = quality_name(in.scene.quality);
+  st.select.high_triangles_culled = high.triangle_count() - in.scene.triangles;
+  in.rays.front = st.distances.front;
+  in.rays.rear = st.distances.rear;
   in.rays.cage = mode.any_cage;
   in.rays.closest = opt.policy == RayPolicy::closest;
-  in.rays.diagonal = s.diagonal;
+  in.rays.diagonal = in.s.diagonal;
 }
 
 std::shared_ptr<const TraceInputs> holding(std::shared_ptr<const TraceInputs> inputs, std::shared_ptr<const Mesh> high) {
@@ -287,33 +284,19 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     const TileBins bins = bin_triangles(low, opt.width, opt.height, trace_tile_side(opt));
     outputs.wait();
     trace_and_shade(in.s, in.scene, bins, in.rays, opt, threads, {result.map, result.coverage, result.miss_mask, disagree}, st);
-    st.seconds_trace = seconds_since(t0);
-    st.cpu_seconds_trace = process_cpu_seconds() - cpu0;
+    st.trace.seconds = seconds_since(t0);
+    st.trace.cpu_seconds = process_cpu_seconds() - cpu0;
 
     announce_stage(opt, "padding");
     stage = "padding (" + texels + ")";
     t0 = Clock::now();
     pad_map(opt, disagree, threads, result);
-    st.seconds_padding = seconds_since(t0);
+    st.pad.seconds = seconds_since(t0);
     if (opt.keep_trace) result.trace_inputs = kept;
     return result;
   } catch (const std::bad_alloc&) {
     throw ResourceError("out of memory while " + stage);
   }
-}
-
-BakeRays bake_rays(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt) {
-  if (!share_origin(low, high, cage)) {
-    const std::optional<Mesh> moved_cage = cage ? std::optional<Mesh>(with_origin(*cage, low.origin)) : std::nullopt;
-    return bake_rays(low, with_origin(high, low.origin), moved_cage ? &*moved_cage : nullptr, opt);
-  }
-  check_bake_inputs(low, high, cage, opt);
-  BakeResult result;
-  TraceInputs in;
-  std::string stage;
-  prepare_trace(low, high, cage, opt, worker_threads(opt.threads), in, result, stage);
-  const TileBins bins = bin_triangles(low, opt.width, opt.height, trace_tile_side(opt));
-  return {trace_rays(in.s, in.scene, bins, in.rays, opt, result.stats), result.stats};
 }
 
 }  // namespace nmbake

@@ -18,7 +18,6 @@
 #include "core/errors.h"
 #include "core/image.h"
 #include "core/mesh.h"
-#include "raycast.h"
 #include "core/tangent_frames.h"
 
 namespace nmbake {
@@ -38,11 +37,11 @@ constexpr double kMaxDistance = 1e30;  // --front, --rear: scene units
 // takes: Embree asserts (aborts) on ray origins beyond 1.8e18, and float geometry there has no
 // digits left for a map anyway.
 constexpr double kMaxCoordinate = 1e17;
-constexpr double kCoordinateSpacingWarn = 1e-3;  // BakeStats::coordinate_spacing above this: warn
-// BakeStats::backface_probe_share above which the high-poly is taken as inverted, and above which
+constexpr double kCoordinateSpacingWarn = 1e-3;  // BakeStats::Prepare::coordinate_spacing above this: warn
+// BakeStats::Distances::backface_probe_share above which the high-poly is taken as inverted, and above which
 // (up to the first) as partly inverted, when back faces are kept.
 constexpr double kInvertedShare = 0.5;
-// Suspect texels (BakeStats::suspect_texels): the tilt from the low-poly normal above which, and
+// Suspect texels (BakeStats::Pad::suspect_texels): the tilt from the low-poly normal above which, and
 // the length of the mean of a texel's unit sample values below which, a texel is suspect; the
 // share of covered texels above which nmbake warns.
 constexpr double kSuspectTiltDeg = 85.0;
@@ -52,20 +51,16 @@ constexpr double kMixedShare = 0.2;
 // BakeOptions::low_object_group: a low-poly object matched to no high-poly object.
 constexpr std::uint32_t kNoMatch = 0xffffffffu;
 
-// A high-poly's BVH kept for the next bakes from the same high-poly mesh (nmbake --batch). The
-// first bake given an empty cache builds its BVH over every triangle (none culled: the map is the
-// same) and keeps it; a later bake from the same mesh whose scene has the same centre and diagonal
-// (its low-poly lies within the high-poly's bounds, or is the same) traces that BVH instead of
-// building one. The maps are the same either way.
+struct KeptBvh;  // pipeline/bvh.h
+
+// A high-poly's BVH kept for the next bakes from the same high-poly (nmbake --batch). The first
+// bake given an empty cache builds its BVH over every triangle (none culled: the map is the same)
+// and keeps it; a later bake whose high-poly has the same content (positions and faces) and whose
+// scene has the same centre and diagonal (its low-poly lies within the high-poly's bounds, or is
+// the same) traces that BVH instead of building one. The maps are the same either way.
 struct BvhCache {
-  std::shared_ptr<const raycast::Scene> scene;
-  const Mesh* high = nullptr;
-  glm::dvec3 centre{0.0};
-  double diagonal = 0.0;
-  std::vector<std::uint32_t> kept;  // the triangles in it (increasing; empty: all)
-  std::size_t duplicates_skipped = 0;
-  raycast::BuildQuality quality = raycast::BuildQuality::medium;
-  std::size_t reused = 0;  // bakes that took it
+  std::shared_ptr<const KeptBvh> kept;  // null until a bake keeps its BVH
+  std::size_t reused = 0;               // bakes that took it
 };
 
 // --max-error's default (BakeOptions::max_error_deg) and the third level's factor, chosen on the
@@ -85,7 +80,7 @@ struct BakeOptions {
   // disagree (one lies more than max_error_deg from their mean, or some miss and some hit), or
   // that an island's edge cuts, is baked again with `samples` stratified samples (a square number,
   // 16 by default), exactly as a fixed bake with that many gives it, and one whose `samples` still
-  // disagree (deep_factor below) a third time with 4x as many. BakeStats::texels_refined and
+  // disagree (deep_factor below) a third time with 4x as many. BakeStats::Trace::texels_refined and
   // texels_deep count them.
   bool adaptive = false;
   double max_error_deg = kDefaultMaxErrorDeg;  // with adaptive: the disagreement that refines a texel, degrees
@@ -102,7 +97,7 @@ struct BakeOptions {
   int padding = 16;           // texels of edge padding around islands; 0 = none
   int threads = 0;            // worker threads; 0 = all cores
   bool miss_mask = false;     // fill BakeResult::miss_mask (share of missed samples per texel)
-  bool suspect_mask = false;  // fill BakeResult::suspect_mask (1 for suspect texels, BakeStats::suspect_texels)
+  bool suspect_mask = false;  // fill BakeResult::suspect_mask (1 for suspect texels, BakeStats::Pad::suspect_texels)
   // Leave high-poly triangles out of the BVH when they lie farther from the low-poly (and cage)
   // than any ray reaches (cull.h). The map is the same either way; off only for comparison.
   bool cull_far = true;
@@ -111,17 +106,12 @@ struct BakeOptions {
   // normal points to) is passed over for the next one, and a hit whose normal points away from the
   // low-poly's outside is taken only when the ray finds no other (raycast::HitRule).
   bool keep_backfaces = false;
-  // Several samples per texel are cast texel by texel under the hit rule; without it, in the order
-  // they were covered, as Embree's pick between two triangles at one distance depends on the
-  // packet's other rays. True: texel by texel either way (the bench's "no rule" timing, so that it
-  // casts the same packets as the bake under the rule; a map may then differ in such ties).
-  bool cast_by_texel = false;
   // Bytes the bake's buffers may take (estimate_bake_bytes); 0 = what the machine has
   // (memory_budget_bytes: MemAvailable, cgroup limit, ulimit -v). Larger bakes are refused.
   std::uint64_t memory_limit = 0;
   // Matching (--match names): per object of the low-poly and of the high-poly (Mesh::objects), its
   // group. A low-poly object's rays see only the high-poly objects of its group; one in kNoMatch
-  // casts no ray and is written flat (counted in BakeStats::samples_unmatched). Empty: no matching,
+  // casts no ray and is written flat (counted in BakeStats::Trace::samples_unmatched). Empty: no matching,
   // every ray sees the whole high-poly. The probes that measure the distances see all of it.
   std::vector<std::uint32_t> low_object_group, high_object_group;
   // A BVH to reuse or to keep for later bakes from the same high-poly (BvhCache); null: none.
@@ -136,85 +126,114 @@ struct BakeOptions {
   std::function<void(const char*)> on_stage;
 };
 
+// What a bake found and did, grouped by stage (docs/layout.md: prepare, select, BVH, distances,
+// trace, pad).
 struct BakeStats {
-  float front = 0.0f, rear = 0.0f;               // distances used (scene units)
-  glm::dvec3 centre{0.0};                        // subtracted from every coordinate before tracing (bounding-box centre)
-  bool auto_distances = false;                   // front/rear were measured, not given
-  double auto_probe_beyond = 0.0;                // share of probe points farther than the chosen distances
-  std::uint64_t rays = 0, hits = 0, misses = 0;  // misses/hits count samples, rays count casts
-  std::uint64_t samples_covered = 0;
-  // With BakeOptions::adaptive: covered texels baked with the first 4 samples only, those baked
-  // again with BakeOptions::samples, and those baked a third time with 4x as many (the report's
-  // sample count histogram).
-  std::uint64_t texels_base = 0, texels_refined = 0, texels_deep = 0;
-  std::uint64_t overlapping_samples = 0;  // samples covered by more than one UV triangle
-  std::size_t texels_total = 0, texels_covered = 0, texels_padded = 0;
-  double coverage = 0.0;  // texels_covered / texels_total
-  // Signed distance from the low-poly surface to the hit along the ray (positive: in front of /
-  // outside the low-poly), over all hits.
-  double hit_distance_min = 0.0, hit_distance_mean = 0.0, hit_distance_max = 0.0;
-  std::size_t low_triangles = 0, high_triangles = 0;
-  std::size_t high_triangles_culled = 0;    // left out of the BVH: out of every ray's reach
-  std::size_t high_duplicates_skipped = 0;  // of those, repeats in a stack of identical triangles (select.h)
-  raycast::BuildQuality bvh_quality = raycast::BuildQuality::medium;  // of the BVH traced (bvh_quality_for)
-  bool bvh_reused = false;  // the BVH of an earlier bake from the same high-poly (BakeOptions::bvh_cache)
-  std::size_t degenerate_uv_triangles = 0, degenerate_3d_triangles = 0, corners_without_tangent = 0;
-  std::size_t uv_outside_triangles = 0;           // low-poly triangles with a UV outside [0,1]
-  std::size_t uv_outside_entirely_triangles = 0;  // of those, UV bounding box outside [0,1]^2: not baked
-  std::size_t high_faces_reoriented = 0;          // computed high-poly normals: faces turned to their piece's winding
-  // Float spacing at the largest (referenced) coordinate of the inputs, relative to the scene
-  // diagonal: the precision the meshes themselves carry. Above kCoordinateSpacingWarn the map
-  // degrades measurably (data/stability/README.md, case 5).
-  double coordinate_spacing = 0.0;
-  double largest_coordinate = 0.0;  // largest |x|, |y| or |z| of a position a face uses
-  // Tangent space: covered texels whose normal points into the low-poly surface (z < 0), e.g.
-  // from inverted high-poly normals or winding. 0 for object-space maps.
-  std::size_t texels_facing_away = 0;
-  bool high_normals_computed = false;
-  // The hit rule (BakeOptions::keep_backfaces): whether it was applied, and why not.
-  bool backfaces_skipped = false;
-  // Probes from the low-poly both ways along its normals: of those that hit, the share whose
-  // nearest hit is a back face. Near 0 on a sound high-poly; near 1 when its winding and normals
-  // are inverted (then the faces' fronts are taken the other way round, and computed normals are
-  // turned outwards); in between, when only some parts are inverted, back faces are kept.
-  double backface_probe_share = 0.0;
-  enum class HighFacing { sound, inverted, mixed } high_facing = HighFacing::sound;
-  // Rays whose first hit was a back face, passed over for the next hit.
-  std::uint64_t backface_skips = 0;
+  enum class HighFacing { sound, inverted, mixed };
   // Where rays start: a cage from a file, the automatic cage (no --cage, --front or --rear), or
   // none (one fixed distance for the scene).
-  enum class CageSource { none, automatic, file } cage = CageSource::none;
-  // Per low-poly vertex (file vertex) distances, scene units: front with the automatic cage, rear
-  // with it and with a file's cage when --rear is not given (else all 0).
+  enum class CageSource { none, automatic, file };
   struct Range {
     double min = 0.0, mean = 0.0, max = 0.0;
-  } vertex_front, vertex_rear;
-  // Welded vertices whose measured front or rear need was cut by the limit (half the distance to
-  // the next part of the low-poly along the normal).
-  std::size_t cage_front_limited = 0, cage_rear_limited = 0;
-  // The distances measured for the whole scene (1.25 x the 99.9th percentile of the probes' nearest
-  // facing hits, each side), which every vertex of the automatic cage gets at least; 0 when not measured.
-  double scene_front = 0.0, scene_rear = 0.0;
-  // Suspect texels: covered texels whose tangent-space normal tilts more than 85 degrees from the
-  // low-poly normal (z below cos 85 degrees: black patches where a ray took another part), or whose
-  // samples disagree strongly (their mean is shorter than kSuspectAgreement: one texel, two
-  // surfaces). suspect_share = suspect_texels / texels_covered. suspect_region: the cell of an 8 x 8
-  // grid over the UV square holding most of them (u0, v0, u1, v1), and the share of them it holds.
-  std::size_t suspect_texels = 0;
-  double suspect_share = 0.0;
-  double suspect_region[4] = {0, 0, 0, 0};
-  double suspect_region_share = 0.0;
-  // Samples whose hit has a normal pointing away from the low-poly's outside (no other hit was found).
-  std::uint64_t hits_facing_away = 0;
-  // Seconds per stage.
-  double seconds_prepare = 0, seconds_bvh = 0, seconds_distances = 0, seconds_trace = 0, seconds_padding = 0;
-  double cpu_seconds_trace = 0;  // process CPU time of the trace stage (all threads)
-  // Per object (Mesh::objects order): the covered samples of each low-poly object and how many of
-  // them hit, and the hits on each high-poly object.
-  std::vector<std::uint64_t> low_object_samples, low_object_hits, high_object_hits;
-  // Covered samples of low-poly objects without a match (BakeOptions::low_object_group): written
-  // flat, no ray cast; they count as neither hits nor misses.
-  std::uint64_t samples_unmatched = 0;
+  };
+
+  struct Prepare {
+    std::size_t low_triangles = 0, high_triangles = 0;
+    glm::dvec3 centre{0.0};  // subtracted from every coordinate before tracing (bounding-box centre)
+    std::size_t degenerate_uv_triangles = 0, degenerate_3d_triangles = 0, corners_without_tangent = 0;
+    std::size_t uv_outside_triangles = 0;           // low-poly triangles with a UV outside [0,1]
+    std::size_t uv_outside_entirely_triangles = 0;  // of those, UV bounding box outside [0,1]^2: not baked
+    std::size_t high_faces_reoriented = 0;          // computed high-poly normals: faces turned to their piece's winding
+    bool high_normals_computed = false;
+    // Float spacing at the largest (referenced) coordinate of the inputs, relative to the scene
+    // diagonal: the precision the meshes themselves carry. Above kCoordinateSpacingWarn the map
+    // degrades measurably (data/stability/README.md, case 5).
+    double coordinate_spacing = 0.0;
+    double largest_coordinate = 0.0;  // largest |x|, |y| or |z| of a position a face uses
+    double seconds = 0;
+  } prepare;
+
+  struct Select {
+    std::size_t high_triangles_culled = 0;    // left out of the BVH: out of every ray's reach
+    std::size_t high_duplicates_skipped = 0;  // of those, repeats in a stack of identical triangles (select.h)
+  } select;
+
+  struct Bvh {
+    const char* quality = "medium";  // of the BVH traced: "low", "medium" or "high" (bvh_quality_for, bvh.h)
+    bool reused = false;             // the BVH of an earlier bake from the same high-poly (BakeOptions::bvh_cache)
+    double seconds = 0;              // select, BVH and narrow
+  } bvh;
+
+  struct Distances {
+    float front = 0.0f, rear = 0.0f;  // distances used (scene units)
+    bool auto_distances = false;      // front/rear were measured, not given
+    double auto_probe_beyond = 0.0;   // share of probe points farther than the chosen distances
+    // The distances measured for the whole scene (1.25 x the 99.9th percentile of the probes'
+    // nearest facing hits, each side), which every vertex of the automatic cage gets at least; 0
+    // when not measured.
+    double scene_front = 0.0, scene_rear = 0.0;
+    CageSource cage = CageSource::none;
+    // Per low-poly vertex (file vertex) distances, scene units: front with the automatic cage, rear
+    // with it and with a file's cage when --rear is not given (else all 0).
+    Range vertex_front, vertex_rear;
+    // Welded vertices whose measured front or rear need was cut by the limit (half the distance to
+    // the next part of the low-poly along the normal).
+    std::size_t cage_front_limited = 0, cage_rear_limited = 0;
+    // Probes from the low-poly both ways along its normals: of those that hit, the share whose
+    // nearest hit is a back face. Near 0 on a sound high-poly; near 1 when its winding and normals
+    // are inverted (then the faces' fronts are taken the other way round, and computed normals are
+    // turned outwards); in between, when only some parts are inverted, back faces are kept.
+    double backface_probe_share = 0.0;
+    HighFacing high_facing = HighFacing::sound;
+    // The hit rule (BakeOptions::keep_backfaces): whether it was applied, and why not.
+    bool backfaces_skipped = false;
+    double seconds = 0;
+  } distances;
+
+  struct Trace {
+    std::uint64_t rays = 0, hits = 0, misses = 0;  // misses/hits count samples, rays count casts
+    std::uint64_t samples_covered = 0;
+    // Covered samples of low-poly objects without a match (BakeOptions::low_object_group): written
+    // flat, no ray cast; they count as neither hits nor misses.
+    std::uint64_t samples_unmatched = 0;
+    std::uint64_t overlapping_samples = 0;  // samples covered by more than one UV triangle
+    // With BakeOptions::adaptive: covered texels baked with the first 4 samples only, those baked
+    // again with BakeOptions::samples, and those baked a third time with 4x as many (the report's
+    // sample count histogram).
+    std::uint64_t texels_base = 0, texels_refined = 0, texels_deep = 0;
+    std::size_t texels_total = 0, texels_covered = 0;
+    double coverage = 0.0;  // texels_covered / texels_total
+    // Signed distance from the low-poly surface to the hit along the ray (positive: in front of /
+    // outside the low-poly), over all hits.
+    double hit_distance_min = 0.0, hit_distance_mean = 0.0, hit_distance_max = 0.0;
+    // Rays whose first hit was a back face, passed over for the next hit.
+    std::uint64_t backface_skips = 0;
+    // Samples whose hit has a normal pointing away from the low-poly's outside (no other hit was found).
+    std::uint64_t hits_facing_away = 0;
+    // Per object (Mesh::objects order): the covered samples of each low-poly object and how many of
+    // them hit, and the hits on each high-poly object.
+    std::vector<std::uint64_t> low_object_samples, low_object_hits, high_object_hits;
+    double seconds = 0;
+    double cpu_seconds = 0;  // process CPU time of the trace stage (all threads)
+  } trace;
+
+  struct Pad {
+    std::size_t texels_padded = 0;
+    // Tangent space: covered texels whose normal points into the low-poly surface (z < 0), e.g.
+    // from inverted high-poly normals or winding. 0 for object-space maps.
+    std::size_t texels_facing_away = 0;
+    // Suspect texels: covered texels whose tangent-space normal tilts more than 85 degrees from the
+    // low-poly normal (z below cos 85 degrees: black patches where a ray took another part), or
+    // whose samples disagree strongly (their mean is shorter than kSuspectAgreement: one texel, two
+    // surfaces). suspect_share = suspect_texels / Trace::texels_covered. suspect_region: the cell of
+    // an 8 x 8 grid over the UV square holding most of them (u0, v0, u1, v1), and the share of them
+    // it holds.
+    std::size_t suspect_texels = 0;
+    double suspect_share = 0.0;
+    double suspect_region[4] = {0, 0, 0, 0};
+    double suspect_region_share = 0.0;
+    double seconds = 0;
+  } pad;
 };
 
 struct TraceInputs;  // bake_stages.h: the prepared scene, its BVH and the rays' set-up
@@ -250,21 +269,6 @@ void validate_options(const BakeOptions& options);
 // Throws UsageError for absurd options (validate_options), InputError for meshes that cannot be baked (no UVs, cage
 // topology mismatch), ResourceError when the buffers would not fit in memory, Cancelled.
 BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& options);
-
-// The rays bake_normal_map would cast with these options, in coordinates re-centred on
-// stats.centre, tile by tile, and the stats of the stages before the trace (distances, culling,
-// BVH quality). The bench traces them with a bare Embree loop.
-struct BakeRays {
-  std::vector<raycast::Ray> rays;
-  BakeStats stats;
-};
-BakeRays bake_rays(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& options);
-
-// The BVH build quality a bake with these options picks for `triangles` high-poly triangles (after
-// culling), by measurement (bench, issue 6): with few rays per triangle the quick Morton build wins
-// end to end (1M triangles at 2048^2, 1 sample: 0.15 s build instead of 0.64 s, trace 20% slower);
-// with 16 or more, the high-quality build's faster trace wins (8-9% faster than medium).
-raycast::BuildQuality bvh_quality_for(const BakeOptions& options, std::size_t triangles);
 
 // Bytes the bake will allocate for its images at this size (for the memory check and reports).
 std::uint64_t estimate_bake_bytes(const BakeOptions& options);

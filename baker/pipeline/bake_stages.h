@@ -14,12 +14,14 @@
 
 #include "pipeline/bake.h"
 #include "pipeline/bvh.h"
+#include "pipeline/distances.h"
 #include "pipeline/prepare.h"
 #include "pipeline/rays.h"
+#include "pipeline/select.h"
 
 namespace nmbake {
 
-// Process CPU time in seconds (all threads), for BakeStats::cpu_seconds_trace.
+// Process CPU time in seconds (all threads), for BakeStats::Trace::cpu_seconds.
 double process_cpu_seconds();
 
 // Calls options.on_stage when set.
@@ -34,19 +36,40 @@ void check_bake_inputs(const Mesh& low, const Mesh& high, const Mesh* cage, cons
 // What the trace reads but the bins: the stages up to the trace's, run once per scene.
 struct TraceInputs {
   Prepared s;
+  HighSelection selection;  // the high-poly triangles in the BVH
   HighScene scene;
   RaySetup rays;
 };
 
-// Prepare, select, BVH, distances (and a narrower selection once they are known): fills `in`,
-// result.stats (the stages' stats) and result's cage_positions, vertex_rear, vertex_search.
-// `stage` says what runs, for an out-of-memory message.
+// The stages before the trace, in order: prepare (prepare.h), select and BVH (select_and_build),
+// distances (measure_reach, distances.h), narrow (narrow_and_rebuild). Fills `in`, result.stats
+// (the stages' stats) and result's cage_positions, vertex_rear, vertex_search. `stage` says what
+// runs, for an out-of-memory message.
 void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt, int threads, TraceInputs& in,
                    BakeResult& result, std::string& stage);
 
 // `inputs` made to hold `high` too: a high-poly moved to the low-poly's origin for the bake, which
 // they read (BakeResult::trace_inputs). Null stays null.
 std::shared_ptr<const TraceInputs> holding(std::shared_ptr<const TraceInputs> inputs, std::shared_ptr<const Mesh> high);
+
+// How select_and_build got the BVH: built for this bake alone, built over every triangle and kept
+// in an empty BvhCache, or reused from the cache.
+enum class BvhSource { built, kept, reused };
+
+// The select and BVH stages, on in.s: in.selection and in.scene. The BVH a BakeOptions::bvh_cache
+// keeps for this content (find_kept_bvh) is reused with its selection; otherwise the triangles some
+// ray can reach before the distances are known (within the probes' reach `mode.reach`, or the
+// distances given; all of them without cull_far or for a BVH to keep), less duplicate floods
+// (select_high), in a BVH of the quality bvh_quality_for picks, kept by an empty cache. Sets
+// st.select.high_duplicates_skipped and st.bvh.reused; `stage` names the build.
+BvhSource select_and_build(const Mesh& high, const ReachMode& mode, const BakeOptions& opt, int threads, TraceInputs& in,
+                           BakeStats& st, std::string& stage);
+
+// The narrow stage, after the distances (result.stats.front, rear, result.vertex_search): the
+// selection narrowed to what the rays reach (narrow_high) and the BVH rebuilt over it when that
+// leaves out a fifth of it or more. For a BVH built for this bake alone.
+void narrow_and_rebuild(const Mesh& high, const ReachMode& mode, const BakeOptions& opt, int threads, const BakeResult& result,
+                        TraceInputs& in);
 
 // Texels per side of the trace's bins for these options (TileBins::side).
 int trace_tile_side(const BakeOptions& opt);

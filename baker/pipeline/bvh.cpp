@@ -1,8 +1,32 @@
 #include "pipeline/bvh.h"
 
+#include <functional>
+#include <string_view>
+
 #include "core/parallel.h"
 
 namespace nmbake {
+
+raycast::BuildQuality bvh_quality_for(const BakeOptions& o, std::size_t triangles) {
+  const double rays = double(o.width) * double(o.height) * double(o.samples);
+  return rays < 16.0 * double(triangles) ? raycast::BuildQuality::low : raycast::BuildQuality::high;
+}
+
+const char* quality_name(raycast::BuildQuality q) {
+  return q == raycast::BuildQuality::low ? "low" : q == raycast::BuildQuality::medium ? "medium" : "high";
+}
+
+std::uint64_t bvh_content(const Prepared& s, const Mesh& high) {
+  const auto bytes = [](const auto& v) {
+    return std::hash<std::string_view>{}({reinterpret_cast<const char*>(v.data()), v.size() * sizeof(v[0])});
+  };
+  return bytes(s.high_pos) * 0x9e3779b97f4a7c15ull ^ bytes(high.position_index);
+}
+
+const KeptBvh* find_kept_bvh(const BvhCache* cache, const Prepared& s, std::uint64_t content) {
+  const KeptBvh* k = cache ? cache->kept.get() : nullptr;
+  return k && k->content == content && k->centre == s.centre && k->diagonal == s.diagonal ? k : nullptr;
+}
 
 void build_high_scene(HighScene& h, const Prepared& s, const Mesh& high, const std::vector<std::uint32_t>& kept,
                       raycast::BuildQuality quality, int threads, std::shared_ptr<const raycast::Scene> reuse, bool share) {

@@ -11,6 +11,7 @@
 
 #include "core/mesh.h"
 #include "pipeline/prepare.h"
+#include "pipeline/select.h"
 #include "raycast.h"
 
 namespace nmbake {
@@ -50,7 +51,7 @@ struct RayGroups {
 RayGroups ray_groups(const Prepared& s, const HighScene& h, const BakeOptions& opt);
 
 // The rule the trace casts under, or null for none: h.hit_rule() when back faces are skipped
-// (BakeStats::backfaces_skipped); with match groups, the groups too (alone when back faces are
+// (BakeStats::Distances::backfaces_skipped); with match groups, the groups too (alone when back faces are
 // kept). `rule` holds it.
 const raycast::HitRule* trace_rule(const HighScene& h, bool backfaces_skipped, const RayGroups& groups, raycast::HitRule& rule);
 
@@ -61,6 +62,35 @@ const raycast::HitRule* trace_rule(const HighScene& h, bool backfaces_skipped, c
 void build_high_scene(HighScene& h, const Prepared& s, const Mesh& high, const std::vector<std::uint32_t>& kept,
                       raycast::BuildQuality quality, int threads, std::shared_ptr<const raycast::Scene> reuse = nullptr,
                       bool share = false);
+
+// The BVH build quality a bake with these options picks for `triangles` high-poly triangles (after
+// culling), by measurement (bench, issue 6): with few rays per triangle the quick Morton build wins
+// end to end (1M triangles at 2048^2, 1 sample: 0.15 s build instead of 0.64 s, trace 20% slower);
+// with 16 or more, the high-quality build's faster trace wins (8-9% faster than medium).
+raycast::BuildQuality bvh_quality_for(const BakeOptions& options, std::size_t triangles);
+
+// "low", "medium" or "high" (BakeStats::Bvh::quality).
+const char* quality_name(raycast::BuildQuality quality);
+
+// A BVH a BvhCache keeps (bake.h) and what it was built from. Keyed by content, not by address: a
+// hash of the re-centred positions and vertex indices the BVH reads (bvh_content), and the centre
+// and diagonal of the scene they were re-centred in.
+struct KeptBvh {
+  std::uint64_t content = 0;
+  glm::dvec3 centre{0.0};
+  double diagonal = 0.0;
+  HighSelection selection;  // the triangles in it
+  std::shared_ptr<const raycast::Scene> scene;
+  raycast::BuildQuality quality = raycast::BuildQuality::medium;
+};
+
+// KeptBvh::content of this scene's high-poly: a 64-bit hash of s.high_pos and high.position_index,
+// one pass over 18 bytes a triangle (a BVH build reads them many times over).
+std::uint64_t bvh_content(const Prepared& s, const Mesh& high);
+
+// The one way to a kept BVH: the one `cache` keeps when it was built from the same content, on the
+// same centre and diagonal, else null (also for a null or empty cache).
+const KeptBvh* find_kept_bvh(const BvhCache* cache, const Prepared& s, std::uint64_t content);
 
 // The high-poly found inverted (BakeStats::HighFacing): fronts are taken the other way round, and
 // normals nmbake computed itself are turned outwards with them (a file's normals are kept: the map

@@ -90,40 +90,40 @@ std::pair<double, double> probe_scene(const ReachMode& mode, const BakeOptions& 
       ++probes_hit;
       nearest_back += o.hit() && (!in.hit() || o.t <= in.t) ? is_back[2 * i] : is_back[2 * i + 1];
     }
-    st.backface_probe_share = probes_hit ? double(nearest_back) / double(probes_hit) : 0.0;
+    st.distances.backface_probe_share = probes_hit ? double(nearest_back) / double(probes_hit) : 0.0;
     if (!opt.keep_backfaces) {
-      st.high_facing = st.backface_probe_share > kInvertedShare ? BakeStats::HighFacing::inverted
-                       : st.backface_probe_share > kMixedShare  ? BakeStats::HighFacing::mixed
-                                                                : BakeStats::HighFacing::sound;
-      st.backfaces_skipped = st.high_facing != BakeStats::HighFacing::mixed;
+      st.distances.high_facing = st.distances.backface_probe_share > kInvertedShare ? BakeStats::HighFacing::inverted
+                                 : st.distances.backface_probe_share > kMixedShare  ? BakeStats::HighFacing::mixed
+                                                                                    : BakeStats::HighFacing::sound;
+      st.distances.backfaces_skipped = st.distances.high_facing != BakeStats::HighFacing::mixed;
     }
     // How far the high-poly lies: by the nearest hit either way that the rays may take (with back
     // faces skipped, not a back face as the faces were found to point: that is another part's inside).
-    const std::uint8_t back_is = st.high_facing == BakeStats::HighFacing::inverted ? 0 : 1;
+    const std::uint8_t back_is = st.distances.high_facing == BakeStats::HighFacing::inverted ? 0 : 1;
     std::vector<float> outside, inside;
     for (std::size_t i = 0; i < pairs; ++i) {
       const raycast::Hit &o = hits[2 * i], &in = hits[2 * i + 1];
-      const bool o_ok = o.hit() && !(st.backfaces_skipped && is_back[2 * i] == back_is);
-      const bool in_ok = in.hit() && !(st.backfaces_skipped && is_back[2 * i + 1] == back_is);
+      const bool o_ok = o.hit() && !(st.distances.backfaces_skipped && is_back[2 * i] == back_is);
+      const bool in_ok = in.hit() && !(st.distances.backfaces_skipped && is_back[2 * i + 1] == back_is);
       if (o_ok && (!in_ok || o.t <= in.t)) outside.push_back(o.t);
       else if (in_ok) inside.push_back(in.t);
     }
     if (mode.probing) {
-      st.auto_distances = true;
+      st.distances.auto_distances = true;
       // Cover all but the farthest 0.1% of probes, with a 25% margin and a floor for coincident meshes.
       global_front = 1.25 * quantile(outside, 0.999) + mode.floor;
       global_rear = 1.25 * quantile(inside, 0.999) + mode.floor;
-      st.scene_front = global_front;
-      st.scene_rear = global_rear;
+      st.distances.scene_front = global_front;
+      st.distances.scene_rear = global_rear;
     }
     if (mode.auto_distances) {
       const double front = global_front, rear = global_rear;
-      if (opt.front < 0.0f) st.front = float(front);
-      if (opt.rear < 0.0f) st.rear = float(rear);
+      if (opt.front < 0.0f) st.distances.front = float(front);
+      if (opt.rear < 0.0f) st.distances.rear = float(rear);
       std::size_t beyond = 0;
-      for (float d : outside) beyond += d > st.front;
-      for (float d : inside) beyond += d > st.rear;
-      st.auto_probe_beyond = pairs ? double(beyond) / double(pairs) : 0.0;
+      for (float d : outside) beyond += d > st.distances.front;
+      for (float d : inside) beyond += d > st.distances.rear;
+      st.distances.auto_probe_beyond = pairs ? double(beyond) / double(pairs) : 0.0;
     }
   }
   return {global_front, global_rear};
@@ -147,20 +147,20 @@ ReachMode ReachMode::of(const BakeOptions& opt, const Mesh* cage, const Prepared
 void measure_reach(const ReachMode& mode, const Mesh& low, const BakeOptions& opt, int threads, Prepared& s, HighScene& h,
                    BakeResult& result) {
   BakeStats& st = result.stats;
-  st.front = opt.front;
-  st.rear = opt.rear;
+  st.distances.front = opt.front;
+  st.distances.rear = opt.rear;
   const RayGroups groups = ray_groups(s, h, opt);
   const auto [global_front, global_rear] = probe_scene(mode, opt, threads, s, h, groups, st);
-  if (st.high_facing == BakeStats::HighFacing::inverted) turn_inverted_high(s, h, st.high_normals_computed);
+  if (st.distances.high_facing == BakeStats::HighFacing::inverted) turn_inverted_high(s, h, st.prepare.high_normals_computed);
   if (mode.local_rear) {
     // Per-vertex distances (after the facing decision: the probes judge faces by it).
     const LocalDistances ld =
         measure_local_distances({&s.low_pos, &low.position_index, &s.ray_normal, groups.active() ? &groups.low : nullptr},
                                 {&*h.scene, h.positions, h.index, h.facing, groups.active() ? groups.high.data() : nullptr},
                                 mode.reach, mode.floor, global_front, global_rear, kNeedSlope, kLimitSlope, threads);
-    st.auto_distances = true;
-    st.cage_front_limited = mode.auto_cage ? ld.front_limited : 0;
-    st.cage_rear_limited = ld.rear_limited;
+    st.distances.auto_distances = true;
+    st.distances.cage_front_limited = mode.auto_cage ? ld.front_limited : 0;
+    st.distances.cage_rear_limited = ld.rear_limited;
     result.vertex_rear = ld.rear;
     result.vertex_search = ld.search;
     if (mode.auto_cage) {
@@ -171,16 +171,16 @@ void measure_reach(const ReachMode& mode, const Mesh& low, const BakeOptions& op
         result.cage_positions[i] = glm::vec3(glm::dvec3(low.positions[i]) + double(ld.front[i]) * glm::dvec3(s.ray_normal[i]));
       attach_cage(s, result.cage_positions, low.position_index);
     }
-    summarize(mode.auto_cage ? ld.front : std::vector<float>(), st.vertex_front);
-    summarize(ld.rear, st.vertex_rear);
-    if (mode.auto_cage) st.front = float(st.vertex_front.max);
-    st.rear = float(st.vertex_rear.max);
+    summarize(mode.auto_cage ? ld.front : std::vector<float>(), st.distances.vertex_front);
+    summarize(ld.rear, st.distances.vertex_rear);
+    if (mode.auto_cage) st.distances.front = float(st.distances.vertex_front.max);
+    st.distances.rear = float(st.distances.vertex_rear.max);
   }
-  st.cage = mode.file_cage   ? BakeStats::CageSource::file
-            : mode.auto_cage ? BakeStats::CageSource::automatic
-                             : BakeStats::CageSource::none;
-  if (mode.any_cage) set_cage_reach(s, low, st.rear, result.vertex_rear, result.vertex_search);
-  if (mode.file_cage && st.front < 0.0f) st.front = 0.0f;
+  st.distances.cage = mode.file_cage   ? BakeStats::CageSource::file
+                      : mode.auto_cage ? BakeStats::CageSource::automatic
+                                       : BakeStats::CageSource::none;
+  if (mode.any_cage) set_cage_reach(s, low, st.distances.rear, result.vertex_rear, result.vertex_search);
+  if (mode.file_cage && st.distances.front < 0.0f) st.distances.front = 0.0f;
 }
 
 }  // namespace nmbake

@@ -28,7 +28,7 @@ struct ReachMode {
 };
 
 // Measures what `mode` leaves to measure and decides the high-poly's facing (unless back faces are
-// kept), over the BVH `h`. Fills in `result.stats`: front, rear, scene_front, scene_rear,
+// kept), over the BVH `h`. Fills in `result.stats.distances`: front, rear, scene_front, scene_rear,
 // auto_distances, auto_probe_beyond, backface_probe_share, high_facing, backfaces_skipped, cage,
 // vertex_front, vertex_rear, cage_front_limited, cage_rear_limited; in `result`: cage_positions
 // (automatic cage), vertex_rear and vertex_search (per-vertex rear). Turns an inverted high-poly

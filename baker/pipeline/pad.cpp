@@ -55,22 +55,22 @@ void scan_band(const BakeOptions& opt, const std::vector<std::uint8_t>& disagree
 void sum_bands(const std::vector<BandCounts>& bands, BakeStats& st) {
   std::size_t cells[8][8] = {};
   for (const BandCounts& b : bands) {
-    st.texels_facing_away += b.facing_away;
-    st.suspect_texels += b.suspect;
+    st.pad.texels_facing_away += b.facing_away;
+    st.pad.suspect_texels += b.suspect;
     for (int r = 0; r < 8; ++r)
       for (int c = 0; c < 8; ++c) cells[r][c] += b.cells[r][c];
   }
-  if (!st.suspect_texels) return;
-  st.suspect_share = st.texels_covered ? double(st.suspect_texels) / double(st.texels_covered) : 0.0;
+  if (!st.pad.suspect_texels) return;
+  st.pad.suspect_share = st.trace.texels_covered ? double(st.pad.suspect_texels) / double(st.trace.texels_covered) : 0.0;
   int best_r = 0, best_c = 0;
   for (int r = 0; r < 8; ++r)
     for (int c = 0; c < 8; ++c)
       if (cells[r][c] > cells[best_r][best_c]) best_r = r, best_c = c;
-  st.suspect_region[0] = best_c / 8.0;
-  st.suspect_region[1] = 1.0 - (best_r + 1) / 8.0;
-  st.suspect_region[2] = (best_c + 1) / 8.0;
-  st.suspect_region[3] = 1.0 - best_r / 8.0;
-  st.suspect_region_share = double(cells[best_r][best_c]) / double(st.suspect_texels);
+  st.pad.suspect_region[0] = best_c / 8.0;
+  st.pad.suspect_region[1] = 1.0 - (best_r + 1) / 8.0;
+  st.pad.suspect_region[2] = (best_c + 1) / 8.0;
+  st.pad.suspect_region[3] = 1.0 - best_r / 8.0;
+  st.pad.suspect_region_share = double(cells[best_r][best_c]) / double(st.pad.suspect_texels);
 }
 
 }  // namespace
@@ -83,7 +83,7 @@ void pad_map(const BakeOptions& opt, const std::vector<std::uint8_t>& disagree, 
     for (std::size_t b = begin; b < end; ++b) scan_band(opt, disagree, int(b), result, bands[b]);
   });
   sum_bands(bands, st);
-  st.texels_padded = pad_islands(result.map, result.coverage, opt.padding, threads);
+  st.pad.texels_padded = pad_islands(result.map, result.coverage, opt.padding, threads);
 }
 
 }  // namespace nmbake

@@ -10,7 +10,7 @@
 namespace nmbake {
 
 // `disagree`: per texel, whether its samples disagree (trace.h; empty with one sample). Fills in
-// result.stats: texels_facing_away, suspect_*, texels_padded; and result.suspect_mask when asked.
+// result.stats.pad: texels_facing_away, suspect_*, texels_padded; and result.suspect_mask when asked.
 void pad_map(const BakeOptions& opt, const std::vector<std::uint8_t>& disagree, int threads, BakeResult& result);
 
 }  // namespace nmbake

@@ -143,9 +143,9 @@ Prepared prepare(const Mesh& low, const Mesh& high, const Mesh* cage, BakeStats&
   s.low_objects = low.object_count();
   s.high_objects = high.object_count();
   s.frames = compute_tangent_frames(low);
-  st.degenerate_uv_triangles = s.frames.degenerate_uv_triangles;
-  st.degenerate_3d_triangles = s.frames.degenerate_3d_triangles;
-  st.corners_without_tangent = s.frames.corners_without_tangent;
+  st.prepare.degenerate_uv_triangles = s.frames.degenerate_uv_triangles;
+  st.prepare.degenerate_3d_triangles = s.frames.degenerate_3d_triangles;
+  st.prepare.corners_without_tangent = s.frames.corners_without_tangent;
   {
     glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
     grow_box(lo, hi, low.positions, low.position_index);
@@ -153,14 +153,15 @@ Prepared prepare(const Mesh& low, const Mesh& high, const Mesh* cage, BakeStats&
     // Not the cage's: an automatic cage is made after this, and the same cage read from a file
     // must give the same centre, so the same rays to the bit.
     s.centre = 0.5 * (lo + hi);
-    st.centre = s.centre;
+    st.prepare.centre = s.centre;
     s.diagonal = glm::length(hi - lo);
     if (!(s.diagonal > 0.0)) s.diagonal = 1.0;
     // Float spacing at the largest coordinate: the precision the inputs carry (float positions).
     const glm::dvec3 far = glm::max(glm::abs(lo), glm::abs(hi));
     const float largest = float(std::max({far.x, far.y, far.z}));
-    st.largest_coordinate = largest;
-    st.coordinate_spacing = double(std::nextafter(largest, std::numeric_limits<float>::infinity()) - largest) / s.diagonal;
+    st.prepare.largest_coordinate = largest;
+    st.prepare.coordinate_spacing =
+        double(std::nextafter(largest, std::numeric_limits<float>::infinity()) - largest) / s.diagonal;
   }
   s.low_pos = recentre(low.positions, s.centre);
   s.high_pos = recentre(high.positions, s.centre, 1);
@@ -173,8 +174,8 @@ Prepared prepare(const Mesh& low, const Mesh& high, const Mesh* cage, BakeStats&
   } else {
     // Welded by value, duplicate faces once, one winding per piece (mesh_topology.h).
     s.high_corner_normals.resize(3 * high.triangle_count());
-    compute_high_corner_normals(high, s.high_corner_normals.data(), &st.high_faces_reoriented);
-    st.high_normals_computed = true;
+    compute_high_corner_normals(high, s.high_corner_normals.data(), &st.prepare.high_faces_reoriented);
+    st.prepare.high_normals_computed = true;
   }
   s.high_facing = triangle_facing(s.high_pos, high.position_index, s.high_corner_normals);
   s.low_tris.resize(low.triangle_count());
@@ -194,10 +195,10 @@ Prepared prepare(const Mesh& low, const Mesh& high, const Mesh* cage, BakeStats&
     for (int c = 0; c < 3; ++c) {
       const glm::vec2 uv = low.corner_uv(t, c);
       if (uv.x < 0.0f || uv.x > 1.0f || uv.y < 0.0f || uv.y > 1.0f) {
-        ++st.uv_outside_triangles;
+        ++st.prepare.uv_outside_triangles;
         glm::vec2 lo = uv, hi = uv;
         for (int k = 0; k < 3; ++k) lo = glm::min(lo, low.corner_uv(t, k)), hi = glm::max(hi, low.corner_uv(t, k));
-        st.uv_outside_entirely_triangles += hi.x < 0.0f || lo.x > 1.0f || hi.y < 0.0f || lo.y > 1.0f;
+        st.prepare.uv_outside_entirely_triangles += hi.x < 0.0f || lo.x > 1.0f || hi.y < 0.0f || lo.y > 1.0f;
         break;
       }
     }

@@ -40,7 +40,7 @@ struct Prepared {
   std::size_t low_objects = 1, high_objects = 1;
 };
 
-// Fills the stats it learns on the way: degenerate counts, centre, coordinate precision, computed
+// Fills st.prepare with what it learns on the way: degenerate counts, centre, coordinate precision, computed
 // high-poly normals, UVs outside the unit square. A cage given is attached (and must enclose the
 // low-poly: InputError otherwise).
 Prepared prepare(const Mesh& low, const Mesh& high, const Mesh* cage, BakeStats& st);

@@ -47,6 +47,20 @@ bool narrow_reachable(const Prepared& s, const Mesh& high, double margin, std::v
   return true;
 }
 
+HighSelection select_high(const Prepared& s, const Mesh& high, double margin, int threads) {
+  HighSelection sel;
+  if (margin >= 0.0) sel.kept = select_reachable(s, high, margin, threads);
+  sel.duplicates_skipped = drop_duplicate_floods(s, high, threads, sel.kept);
+  return sel;
+}
+
+bool narrow_high(const Prepared& s, const Mesh& high, bool cage, double front, double rear,
+                 const std::vector<float>& vertex_search, HighSelection& sel, int threads) {
+  double reach_out = 0.0;
+  for (float d : vertex_search) reach_out = std::max(reach_out, double(d));
+  return narrow_reachable(s, high, ray_margin(s, cage, front, std::max(rear, reach_out)), sel.kept, threads);
+}
+
 namespace {
 
 // A triangle's corner positions as bits, rotated to start at the smallest (winding kept).

@@ -12,6 +12,24 @@
 
 namespace nmbake {
 
+// The high-poly triangles a BVH holds.
+struct HighSelection {
+  std::vector<std::uint32_t> kept;     // increasing; empty: all
+  std::size_t duplicates_skipped = 0;  // left out as repeats in stacks of identical triangles (drop_duplicate_floods)
+  std::size_t count(const Mesh& high) const { return kept.empty() ? high.triangle_count() : kept.size(); }
+};
+
+// The select stage: the triangles within `margin` of some region (select_reachable), or all of
+// them when `margin` < 0, less the repeats of duplicate floods.
+HighSelection select_high(const Prepared& s, const Mesh& high, double margin, int threads);
+
+// The narrow stage, once the distances are known: `sel` narrowed to the triangles rays reach
+// (narrow_reachable with ray_margin), when that leaves out a fifth of them or more. Rays from a
+// cage reach `rear` beyond P and, where they search beyond the cage, as far out as they search
+// (`vertex_search`, per low-poly position). Returns whether `sel` changed (the BVH is then rebuilt).
+bool narrow_high(const Prepared& s, const Mesh& high, bool cage, double front, double rear,
+                 const std::vector<float>& vertex_search, HighSelection& sel, int threads);
+
 // Per low-poly triangle, its box, grown over its cage triangle when there is one.
 std::vector<Box> low_regions(const Prepared& s);
 

@@ -56,8 +56,9 @@ struct Shared {
   bool batched = false;     // tangent space, per-pixel bitangent: shade_batch.h shades most samples
   bool per_object = false;  // several objects: hits counted per object
   const raycast::HitRule* hit_rule = nullptr;
-  bool prefer = false;  // the rule looks at the rays' preferred parts (back faces skipped)
-  RayGroups groups;     // with --match: per low-poly triangle and BVH triangle
+  bool prefer = false;    // the rule looks at the rays' preferred parts (back faces skipped)
+  bool by_texel = false;  // cast texel by texel even without a rule (trace_and_shade's by_texel)
+  RayGroups groups;       // with --match: per low-poly triangle and BVH triangle
   std::vector<ThreadStats> stats;
   // Hit distances summed per tile, then over tiles in order: the mean does not depend on which
   // thread took which tile.
@@ -127,18 +128,6 @@ class TileTracer {
     // Every default-policy ray without a cage starts at 0 and reaches front + rear (sample_rays'
     // too); a cage's rays have each their own reach, made with them.
     if (kernel_rays_ && !sh.setup.cage) std::fill(rays_.tfar(), rays_.tfar() + rays_.size(), sh.setup.front + sh.setup.rear);
-  }
-
-  // Appends the rays of every tile to `out`, in tile order, and casts none.
-  void collect_rays(std::vector<raycast::Ray>& out) {
-    for (std::size_t tile = 0; tile < sh_.bins.count(); ++tile) {
-      if (sh_.bins.start[tile] == sh_.bins.start[tile + 1]) continue;
-      const std::size_t sample_count = cover_tile(tile, rect_of(tile), sh_.offsets, nullptr);
-      make_rays(sample_count);
-      const std::uint32_t* order = cast_order(sh_.offsets, sample_count);
-      for (std::size_t r = 0; r < sample_count * std::size_t(sh_.rays_per_sample); ++r)
-        out.push_back(rays_.ray(order ? order[r] : r));
-    }
   }
 
   // trace_texels: texels[order[i]] for first[k] <= i < first[k + 1] lie in one tile, traced alone
@@ -356,8 +345,8 @@ class TileTracer {
     // Only under a hit rule, whose hit does not depend on which rays share a packet. Without one, of
     // two triangles at one distance Embree keeps the one its traversal meets last, and a packet's
     // traversal order depends on all its rays (a bake with --keep-backfaces moved a texel). The
-    // bench's timing without the rule asks for it anyway (BakeOptions::cast_by_texel).
-    if ((!sh_.hit_rule && !sh_.opt.cast_by_texel) || offsets.size() < 2 || count < 2) return nullptr;
+    // bench's timing without the rule asks for it anyway (trace_and_shade's by_texel).
+    if ((!sh_.hit_rule && !sh_.by_texel) || offsets.size() < 2 || count < 2) return nullptr;
     texel_start_.assign(tile_texels_ + 1, 0);
     for (std::size_t r = 0; r < count; ++r) ++texel_start_[std::size_t(sample_texel_[r]) + 1];
     for (std::size_t i = 1; i <= tile_texels_; ++i) texel_start_[i] += texel_start_[i - 1];
@@ -568,24 +557,11 @@ class TileTracer {
 // `rule` holds it.
 void set_rule(Shared& sh, const BakeStats& st, raycast::HitRule& rule) {
   sh.groups = ray_groups(sh.s, sh.scene, sh.opt);
-  sh.hit_rule = trace_rule(sh.scene, st.backfaces_skipped, sh.groups, rule);
-  sh.prefer = st.backfaces_skipped;
+  sh.hit_rule = trace_rule(sh.scene, st.distances.backfaces_skipped, sh.groups, rule);
+  sh.prefer = st.distances.backfaces_skipped;
 }
 
 }  // namespace
-
-std::vector<raycast::Ray> trace_rays(const Prepared& s, const HighScene& scene, const TileBins& bins, const RaySetup& rays,
-                                     const BakeOptions& opt, const BakeStats& st) {
-  Image map;
-  std::vector<std::uint8_t> coverage, disagree;
-  const TraceTargets out{map, coverage, map, disagree};
-  Shared sh(s, scene, bins, rays, opt, out, 1);
-  raycast::HitRule rule;
-  set_rule(sh, st, rule);  // its cast order (TileTracer::cast_order)
-  std::vector<raycast::Ray> all;
-  TileTracer(sh, 0).collect_rays(all);
-  return all;
-}
 
 std::vector<glm::dvec3> trace_texels(const Prepared& s, const HighScene& scene, const TileBins& bins, const RaySetup& rays,
                                      const BakeOptions& opt, int threads, const BakeStats& st,
@@ -611,10 +587,11 @@ std::vector<glm::dvec3> trace_texels(const Prepared& s, const HighScene& scene, 
 }
 
 void trace_and_shade(const Prepared& s, const HighScene& scene, const TileBins& bins, const RaySetup& rays,
-                     const BakeOptions& opt, int threads, const TraceTargets& out, BakeStats& st) {
+                     const BakeOptions& opt, int threads, const TraceTargets& out, BakeStats& st, bool by_texel) {
   Shared sh(s, scene, bins, rays, opt, out, threads);
   raycast::HitRule rule;
   set_rule(sh, st, rule);
+  sh.by_texel = by_texel;
   sh.tile_dsum.assign(bins.count(), 0.0);
   // Tiles are taken from a shared counter, so the tracers that start cover them all.
   run_workers(
@@ -622,9 +599,9 @@ void trace_and_shade(const Prepared& s, const HighScene& scene, const TileBins& 
       [&sh] { return double(sh.tiles_done.load()) / double(sh.bins.count()); });
 
   sum_thread_stats(sh.stats, sh.per_object, s.low_objects, s.high_objects, sh.tile_dsum, st);
-  st.texels_total = std::size_t(opt.width) * std::size_t(opt.height);
-  for (std::uint8_t c : out.coverage) st.texels_covered += c;
-  st.coverage = double(st.texels_covered) / double(st.texels_total);
+  st.trace.texels_total = std::size_t(opt.width) * std::size_t(opt.height);
+  for (std::uint8_t c : out.coverage) st.trace.texels_covered += c;
+  st.trace.coverage = double(st.trace.texels_covered) / double(st.trace.texels_total);
 }
 
 }  // namespace nmbake

@@ -26,21 +26,18 @@ struct TraceTargets {
   std::vector<std::uint8_t>& disagree;
 };
 
-// The rays trace_and_shade casts, tile by tile, in its order (no map is made); `st` as for
-// trace_and_shade (its backfaces_skipped).
-std::vector<raycast::Ray> trace_rays(const Prepared& s, const HighScene& scene, const TileBins& bins, const RaySetup& rays,
-                                     const BakeOptions& opt, const BakeStats& st);
-
-// Traces every tile of `bins`, applying the hit rule of `scene` unless stats.backfaces_skipped is
-// false. Fills in `st`: rays, hits, misses, samples_covered, overlapping_samples, backface_skips,
+// Traces every tile of `bins`, applying the hit rule of `scene` unless st.distances.backfaces_skipped is
+// false. Fills in `st.trace`: rays, hits, misses, samples_covered, overlapping_samples, backface_skips,
 // hits_facing_away, hit_distance_*, texels_total, texels_covered, coverage.
 // Calls options.progress from the calling thread; throws Cancelled when it returns false.
+// `by_texel`: several samples per texel cast texel by texel even without the hit rule, as under it
+// (cast_order in trace.cpp; a map may then differ in ties between triangles at one distance).
 void trace_and_shade(const Prepared& s, const HighScene& scene, const TileBins& bins, const RaySetup& rays,
-                     const BakeOptions& opt, int threads, const TraceTargets& out, BakeStats& st);
+                     const BakeOptions& opt, int threads, const TraceTargets& out, BakeStats& st, bool by_texel = false);
 
 // The texels `texels` (indices y * width + x, each once) of `bins` traced as trace_and_shade traces
 // them, by the same tracer, with the samples of opt.samples (sample_offsets; opt.adaptive false);
-// `st` as for trace_rays. Per texel, the renormalized mean of its samples (tangent space with
+// `st` as for trace_and_shade (its hit rule). Per texel, the renormalized mean of its samples (tangent space with
 // --green down applied, or object space) as n in [-1,1]^3, not encoded and not snapped to 0, or
 // (0,0,0) when the layout covers none of its samples. No progress is reported.
 std::vector<glm::dvec3> trace_texels(const Prepared& s, const HighScene& scene, const TileBins& bins, const RaySetup& rays,

@@ -12,9 +12,9 @@ namespace nmbake {
 // One cache line each: the counters change per sample, and shared lines would serialize threads.
 struct alignas(64) ThreadStats {
   std::uint64_t rays = 0, hits = 0, misses = 0, covered = 0, overlaps = 0, backface_skips = 0, facing_away = 0, unmatched = 0;
-  std::uint64_t base_texels = 0, refined_texels = 0, deep_texels = 0;  // adaptive (BakeStats::texels_base, ...)
+  std::uint64_t base_texels = 0, refined_texels = 0, deep_texels = 0;  // adaptive (BakeStats::Trace::texels_base, ...)
   double dmin = std::numeric_limits<double>::infinity(), dmax = -std::numeric_limits<double>::infinity();
-  // Per object, with several (BakeStats::low_object_samples, ...).
+  // Per object, with several (BakeStats::Trace::low_object_samples, ...).
   std::vector<std::uint64_t> low_samples, low_hits, high_hits;
 };
 

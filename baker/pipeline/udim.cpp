@@ -85,34 +85,37 @@ void sum_tile_stats(const std::vector<TileBake>& tiles, BakeStats& total) {
   bool any_hit = false;
   for (const TileBake& tb : tiles) {
     const BakeStats& s = tb.result.stats;
-    total.rays += s.rays;
-    total.hits += s.hits;
-    total.misses += s.misses;
-    total.samples_covered += s.samples_covered;
-    total.overlapping_samples += s.overlapping_samples;
-    total.backface_skips += s.backface_skips;
-    total.hits_facing_away += s.hits_facing_away;
-    total.samples_unmatched += s.samples_unmatched;
-    add_counts(total.low_object_samples, s.low_object_samples);
-    add_counts(total.low_object_hits, s.low_object_hits);
-    add_counts(total.high_object_hits, s.high_object_hits);
-    total.texels_total += s.texels_total;
-    total.texels_covered += s.texels_covered;
-    total.texels_padded += s.texels_padded;
-    total.texels_facing_away += s.texels_facing_away;
-    total.suspect_texels += s.suspect_texels;
-    total.seconds_trace += s.seconds_trace;
-    total.cpu_seconds_trace += s.cpu_seconds_trace;
-    total.seconds_padding += s.seconds_padding;
-    if (!s.hits) continue;
-    total.hit_distance_min = any_hit ? std::min(total.hit_distance_min, s.hit_distance_min) : s.hit_distance_min;
-    total.hit_distance_max = any_hit ? std::max(total.hit_distance_max, s.hit_distance_max) : s.hit_distance_max;
-    dsum += s.hit_distance_mean * double(s.hits);
+    total.trace.rays += s.trace.rays;
+    total.trace.hits += s.trace.hits;
+    total.trace.misses += s.trace.misses;
+    total.trace.samples_covered += s.trace.samples_covered;
+    total.trace.overlapping_samples += s.trace.overlapping_samples;
+    total.trace.backface_skips += s.trace.backface_skips;
+    total.trace.hits_facing_away += s.trace.hits_facing_away;
+    total.trace.samples_unmatched += s.trace.samples_unmatched;
+    add_counts(total.trace.low_object_samples, s.trace.low_object_samples);
+    add_counts(total.trace.low_object_hits, s.trace.low_object_hits);
+    add_counts(total.trace.high_object_hits, s.trace.high_object_hits);
+    total.trace.texels_total += s.trace.texels_total;
+    total.trace.texels_covered += s.trace.texels_covered;
+    total.pad.texels_padded += s.pad.texels_padded;
+    total.pad.texels_facing_away += s.pad.texels_facing_away;
+    total.pad.suspect_texels += s.pad.suspect_texels;
+    total.trace.seconds += s.trace.seconds;
+    total.trace.cpu_seconds += s.trace.cpu_seconds;
+    total.pad.seconds += s.pad.seconds;
+    if (!s.trace.hits) continue;
+    total.trace.hit_distance_min =
+        any_hit ? std::min(total.trace.hit_distance_min, s.trace.hit_distance_min) : s.trace.hit_distance_min;
+    total.trace.hit_distance_max =
+        any_hit ? std::max(total.trace.hit_distance_max, s.trace.hit_distance_max) : s.trace.hit_distance_max;
+    dsum += s.trace.hit_distance_mean * double(s.trace.hits);
     any_hit = true;
   }
-  if (total.hits) total.hit_distance_mean = dsum / double(total.hits);
-  total.coverage = total.texels_total ? double(total.texels_covered) / double(total.texels_total) : 0.0;
-  total.suspect_share = total.texels_covered ? double(total.suspect_texels) / double(total.texels_covered) : 0.0;
+  if (total.trace.hits) total.trace.hit_distance_mean = dsum / double(total.trace.hits);
+  total.trace.coverage = total.trace.texels_total ? double(total.trace.texels_covered) / double(total.trace.texels_total) : 0.0;
+  total.pad.suspect_share =
+      total.trace.texels_covered ? double(total.pad.suspect_texels) / double(total.trace.texels_covered) : 0.0;
 }
 
 }  // namespace
@@ -213,8 +216,8 @@ UdimBake bake_udim_tiles(const Mesh& low, const Mesh& high, const Mesh* cage, co
       tb.tile = layout.tiles[i];
       BakeStats& st = tb.result.stats;
       st = shared.stats;
-      st.uv_outside_triangles = tb.tile.straddling;
-      st.uv_outside_entirely_triangles = 0;
+      st.prepare.uv_outside_triangles = tb.tile.straddling;
+      st.prepare.uv_outside_entirely_triangles = 0;
       stage = "tracing UDIM tile " + std::to_string(tb.tile.number) + " (" + texels + ")";
       if (opt.progress) tile_opt.progress = [&opt, i, n](double f) { return opt.progress((double(i) + f) / double(n)); };
       const auto t0 = Clock::now();
@@ -229,8 +232,8 @@ UdimBake bake_udim_tiles(const Mesh& low, const Mesh& high, const Mesh* cage, co
       }
       trace_and_shade(in.s, in.scene, bins, in.rays, tile_opt, threads,
                       {tb.result.map, tb.result.coverage, tb.result.miss_mask, disagree[i]}, st);
-      st.seconds_trace = seconds_since(t0);
-      st.cpu_seconds_trace = process_cpu_seconds() - cpu0;
+      st.trace.seconds = seconds_since(t0);
+      st.trace.cpu_seconds = process_cpu_seconds() - cpu0;
     }
 
     announce_stage(opt, "padding");
@@ -239,13 +242,13 @@ UdimBake bake_udim_tiles(const Mesh& low, const Mesh& high, const Mesh* cage, co
       stage = "padding UDIM tile " + std::to_string(tb.tile.number) + " (" + texels + ")";
       const auto t0 = Clock::now();
       pad_map(opt, disagree[i], threads, tb.result);
-      tb.result.stats.seconds_padding = seconds_since(t0);
+      tb.result.stats.pad.seconds = seconds_since(t0);
       std::vector<std::uint8_t>().swap(disagree[i]);
     }
 
     out.stats = shared.stats;
-    out.stats.uv_outside_triangles = layout.straddling_triangles;
-    out.stats.uv_outside_entirely_triangles = layout.outside_triangles;
+    out.stats.prepare.uv_outside_triangles = layout.straddling_triangles;
+    out.stats.prepare.uv_outside_entirely_triangles = layout.outside_triangles;
     sum_tile_stats(out.tiles, out.stats);
     out.outside_triangles = layout.outside_triangles;
     out.straddling_triangles = layout.straddling_triangles;

@@ -13,7 +13,7 @@
 // tile's UVs moved into 0-1 by its integer offset and the other triangles' UVs moved out of every
 // map (tests/test_udim.cpp): the stages before the trace (prepare, select, BVH, distances) read no
 // UV but the tangent frames', which take UV differences, and those the exact shift keeps. Overlap
-// (BakeStats::overlapping_samples) is counted per tile: islands stacked in different tiles do not
+// (BakeStats::Trace::overlapping_samples) is counted per tile: islands stacked in different tiles do not
 // overlap.
 #pragma once
 
