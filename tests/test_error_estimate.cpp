@@ -57,7 +57,7 @@ TEST(ErrorEstimate, TheBakesTracerGivesItsTexelsAgain) {
     if (variant == 4) o.space = NormalSpace::object;
     const BakeResult r = bake_normal_map(low, high, nullptr, o);
     ASSERT_TRUE(r.trace_inputs);
-    EXPECT_EQ(r.stats.cage == BakeStats::CageSource::automatic, variant == 3);
+    EXPECT_EQ(r.stats.distances.cage == BakeStats::CageSource::automatic, variant == 3);
     std::size_t covered = 0;
     EXPECT_EQ(test::texels_traced_otherwise(low, *r.trace_inputs, o, r, &covered), 0u) << "variant " << variant;
     EXPECT_GT(covered, 4000u);
@@ -82,7 +82,7 @@ TEST(ErrorEstimate, AHighPolyMovedForTheBakeIsKeptWithItsTrace) {
   std::size_t covered = 0;
   EXPECT_EQ(test::texels_traced_otherwise(low, *r.trace_inputs, o, r, &covered), 0u);
   EXPECT_GT(covered, 2000u);
-  EXPECT_EQ(r.stats.misses, 0u);
+  EXPECT_EQ(r.stats.trace.misses, 0u);
   EXPECT_EQ(clobber.back().back(), 0xffffffffu);
 }
 

@@ -126,7 +126,6 @@ OIIO::ImageSpec output_spec(const Image& image, OIIO::TypeDesc stored, const std
   if (const std::string date = image_write::reproducible_date_time();
       !date.empty() && spec.get_string_attribute("DateTime").empty())
     spec.attribute("DateTime", date);
-  // EXR zip shrank float normals by 1% in 2.3 s (2048^2), uncompressed takes 0.1 s. PNG: png_write.cpp.
   // EXR: ZIP (lossless) unless WriteOptions::compression says otherwise.
   if (ext == ".exr") spec.attribute("compression", options.compression.empty() ? "zip" : options.compression);
   // The TIFF writer drops attributes it does not know; keep them readable (and parsable by

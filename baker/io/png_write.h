@@ -15,12 +15,10 @@
 
 namespace nmbake {
 
-// The encoder's settings. The defaults were chosen by measurement (bench section 9, on the 1M
-// sculpt's 2048^2 8-bit map): zlib's RLE strategy after the Paeth filter gave 2.75 MB in 0.11 s,
-// where level 1 with the Up filter (the settings before) gave 3.56 MB in 0.10 s, libpng's own
-// defaults (level 6, adaptive filters) 2.88 MB in 0.76 s and level 9 2.87 MB in 1.8 s. A normal
-// map's rows differ little from their neighbours, so after Paeth prediction most bytes repeat the
-// one before: what RLE codes, and it searches for nothing else.
+// The encoder's settings. The defaults were chosen by measurement (bench section 9, docs/bench.md):
+// zlib's RLE strategy after the Paeth filter, about as small as libpng's defaults at the speed of
+// zlib's fastest level. A normal map's rows differ little from their neighbours, so after Paeth
+// prediction most bytes repeat the one before: what RLE codes, and it searches for nothing else.
 struct PngSettings {
   int level = 1;       // zlib level 0-9 (with the RLE strategy any level from 1 codes the same)
   int filters = 0x80;  // one PNG filter: 0x08 none, 0x10 sub, 0x20 up, 0x40 average, 0x80 Paeth (libpng's PNG_FILTER_*)

@@ -64,10 +64,8 @@ struct BvhCache {
 };
 
 // --max-error's default (BakeOptions::max_error_deg) and the third level's factor, chosen on the
-// accuracy bench's real scenes (suz_L4, torus_s3, bunny00 at 512-2048^2; max errors 2, 3, 4, 6
-// with factors 2, 4, 8 and without a third level; docs/accuracy.md): 4 degrees and 4x reached the
-// fixed 16-sample bake's mean error in 32-43% of its time on suz_L4 and bunny00 at 2048^2 (and
-// bunny00 at 1024^2); lower thresholds cost more time, higher ones more error.
+// accuracy bench's real scenes (docs/accuracy.md): the fixed 16-sample bake's mean error in well
+// under half its time; lower thresholds cost more time, higher ones more error.
 inline constexpr double kDefaultMaxErrorDeg = 4.0;
 inline constexpr double kDefaultDeepFactor = 4.0;  // BakeOptions::deep_factor
 

@@ -79,10 +79,8 @@ int trace_tile_side(const BakeOptions& opt);
 void allocate_outputs(const BakeOptions& opt, BakeResult& result, std::vector<std::uint8_t>& disagree);
 
 // Runs `allocate` on a helper thread while the caller prepares: the system zeroes each fresh page
-// at its first touch (18-40 ms for a 2048^2 map on our 2-core VM), work that would otherwise fall
-// between the trace's rays. Starting a thread waits while another thread of the process is loading
-// a shared library (glibc's loader lock; the CLI loads its image module in the background, up to
-// 0.2 s): in prepare's time, where it shows. wait() rethrows what `allocate` threw.
+// at its first touch, work that would otherwise fall between the trace's rays. wait() rethrows
+// what `allocate` threw.
 class OutputAllocation {
  public:
   explicit OutputAllocation(std::function<void()> allocate)

@@ -64,9 +64,9 @@ void build_high_scene(HighScene& h, const Prepared& s, const Mesh& high, const s
                       bool share = false);
 
 // The BVH build quality a bake with these options picks for `triangles` high-poly triangles (after
-// culling), by measurement (bench, issue 6): with few rays per triangle the quick Morton build wins
-// end to end (1M triangles at 2048^2, 1 sample: 0.15 s build instead of 0.64 s, trace 20% slower);
-// with 16 or more, the high-quality build's faster trace wins (8-9% faster than medium).
+// culling): with fewer than 16 rays per triangle the quick Morton build wins end to end (its
+// build saves more than its slower trace costs); with 16 or more, the high-quality build's faster
+// trace wins (docs/bench.md).
 raycast::BuildQuality bvh_quality_for(const BakeOptions& options, std::size_t triangles);
 
 // "low", "medium" or "high" (BakeStats::Bvh::quality).

@@ -17,8 +17,8 @@
 
 namespace nmbake {
 
-// Per-corner normals, left unset as they grow: filled on every core, so the system's zeroing of a
-// 1M-triangle sculpt's 36 MB (its first touch) is shared out too.
+// Per-corner normals, left unset as they grow: filled on every core, so the system's zeroing of
+// their pages (their first touch) is shared out too.
 using CornerNormals = std::vector<glm::vec3, DefaultInitAllocator<glm::vec3>>;
 
 // The scene in re-centred coordinates, flat arrays for the hot loop.

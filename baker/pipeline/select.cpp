@@ -38,7 +38,7 @@ std::vector<std::uint32_t> select_reachable(const Prepared& s, const Mesh& high,
 }
 
 bool narrow_reachable(const Prepared& s, const Mesh& high, double margin, std::vector<std::uint32_t>& kept, int threads) {
-  // Empty: all (no list of every triangle, which at 4M triangles would be 16 MB at the bake's peak).
+  // Empty: all (no list of every triangle, which would add to the bake's peak memory).
   std::vector<std::uint32_t> nearer =
       triangles_near(low_regions(s), margin, s.high_pos, high.position_index, kept.empty() ? nullptr : &kept, threads);
   const std::size_t current = kept.empty() ? high.triangle_count() : kept.size();

@@ -52,10 +52,9 @@ constexpr std::size_t kDuplicateFlood = 8;
 
 // Leaves out of `kept` (empty: all triangles) every triangle of a group of more than
 // kDuplicateFlood identical ones but the first: a ray that meets such a stack met every triangle
-// of it (and its hit filter ran for each), so a million copies of a face took minutes to bake.
+// of it (and its hit filter ran for each).
 // Found in O(n) for meshes without such groups (hashes on `threads` threads, then a count), and
-// O(k log k) for k suspects: 12-17 ms for 0.4 million triangles on our 2-core VM. Returns
-// the number left out.
+// O(k log k) for k suspects. Returns the number left out.
 std::size_t drop_duplicate_floods(const Prepared& s, const Mesh& high, int threads, std::vector<std::uint32_t>& kept);
 
 }  // namespace nmbake
