@@ -308,8 +308,8 @@ TEST(HardAssets, LowPolyIsWithinMaxSOfTheHighPoly) {
         ASSERT_TRUE(any) << a.name << ": no part of the high-poly within max_s of low triangle " << t;
         ++other;
       }
-    std::printf("%-40s low samples %zu: own part crossed %zu, another part %zu, largest |s| %.5f (max_s %.5f)\n",
-                a.name.c_str(), samples, own, other, worst, a.max_s);
+    std::printf("%-40s low samples %zu: own part crossed %zu, another part %zu, largest |s| %.5f (max_s %.5f)\n", a.name.c_str(),
+                samples, own, other, worst, a.max_s);
     // Only the thin shell's rim, near its edges, may meet a face instead (hard_assets.h).
     EXPECT_GE(double(own), 0.95 * double(samples)) << a.name;
     if (a.name.rfind("thin_shell", 0) != 0) {
