@@ -2,14 +2,16 @@
 # Thread identity: every map nmbake writes is identical, byte for byte, with --threads 1 and
 # --threads 2. Bakes the bundled sample and a generated displaced sphere at a few sizes, sample
 # counts and options, as PNG (8-bit) and EXR (32-bit float, so no rounding can hide a difference).
-# Uses the nmbake of the normal build (build/, or NMBAKE_BUILD_DIR); run scripts/build.sh first.
+#   test-threads.sh [NMBAKE [WORK]]
+# ctest runs it (threads.identical, label robustness); by default it uses the nmbake of the normal
+# build (build/, or NMBAKE_BUILD_DIR; run scripts/build.sh first).
 # SOURCE_DATE_EPOCH pins the DateTime the EXR writer would otherwise stamp with the current time.
 set -euo pipefail
 export SOURCE_DATE_EPOCH=0
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${NMBAKE_BUILD_DIR:-$root/build}
-nmbake=$build/baker/nmbake
-work=$build/thread-identity
+nmbake=${1:-$build/baker/nmbake}
+work=${2:-$build/thread-identity}
 [ -x "$nmbake" ] || { echo "error: test-threads: $nmbake not built (run scripts/build.sh)" >&2; exit 1; }
 rm -rf "$work" && mkdir -p "$work"
 

@@ -1,7 +1,6 @@
 // Tests of load_mesh() on the real meshes under ../shared/data (skipped when it is absent): the
 // sculpts, and the edge cases of the Assimp and CGAL sample meshes.
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <string>
@@ -47,21 +46,6 @@ TEST(MeshIo, SculptCountsMatchGenerationJson) {
   Mesh torus = load_mesh(shared_data_path("sculpts/torus_s3/high.ply"));
   EXPECT_EQ(torus.positions.size(), 196608u);
   EXPECT_EQ(torus.triangle_count(), 393216u);
-}
-
-TEST(MeshIo, LoadTimes) {
-  SKIP_WITHOUT_SHARED_DATA();
-  for (const char* file : {"sculpts/torus_s3/high.ply", "sculpts/suz_L4/low.obj"}) {
-    double best = 1e9;
-    std::size_t triangles = 0;
-    for (int run = 0; run < 3; ++run) {
-      auto start = std::chrono::steady_clock::now();
-      Mesh m = load_mesh(shared_data_path(file));
-      best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-      triangles = m.triangle_count();
-    }
-    std::printf("[ timing   ] %s: %zu triangles in %.1f ms (best of 3)\n", file, triangles, best * 1e3);
-  }
 }
 
 struct SharedCase {

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # SIGTERM, SIGHUP and SIGINT during the bake or during the writes, and SIGKILL during the writes.
 #   signals.sh NMBAKE REPO WORK
-# 1. SIGTERM / SIGHUP while the bake runs: exit 143 / 129, one "error: interrupted by ..." line,
-#    the old map, miss mask and report byte-identical, no temporary left.
+# 1. SIGTERM / SIGHUP while the bake runs (sent when its progress line, --progress, names the trace):
+#    exit 143 / 129, one "error: interrupted by ..." line besides the progress line, the old map,
+#    miss mask and report byte-identical, no temporary left.
 # 2. SIGTERM and SIGINT once the map's temporary file exists (the writes have begun): the same
 #    (exit 143 / 130).
 # 3. SIGKILL during the writes leaves only temporaries named ".<name>.nmbake-tmp.<pid>"; the next
@@ -21,19 +22,20 @@ state() { for f in $(ls -A | sort); do echo "$f $(md5sum <"$f")"; done; }
 old=$(state)
 
 # run_and_signal SIGNAL WHEN: starts a bake over the old outputs, sends SIGNAL once WHEN holds
-# ("bake": its worker threads exist; "write": the map's temporary exists), waits, sets $code.
+# ("bake": the progress line says it is tracing; "write": the map's temporary exists), waits, sets
+# $code. The waits are for those events, not for a time.
 run_and_signal() {
   local sig=$1 when=$2
-  # 2048^2 texels: the bake takes about 1 s, the writes 0.2 s (several times that under ASan).
-  "$nmbake" "$low" "$high" -o m.png --size 2048 --threads 2 --miss-mask miss.png --report r.json --quiet \
+  # 2048^2 texels: the trace, padding and writes after the trace's first line take about 0.5 s
+  # (several times that under ASan), against the few milliseconds the signal takes to be sent.
+  "$nmbake" "$low" "$high" -o m.png --size 2048 --threads 2 --miss-mask miss.png --report r.json --progress \
     >"$log/stdout.txt" 2>"$log/stderr.txt" &
   pid=$!
   local seen=0 until=$((SECONDS + 120))
   while [ "$SECONDS" -lt "$until" ]; do
     kill -0 "$pid" 2>/dev/null || break
     if [ "$when" = bake ]; then
-      threads=$(awk '/^Threads:/ {print $2}' "/proc/$pid/status" 2>/dev/null || echo 0)
-      [ "${threads:-0}" -gt 1 ] && { sleep 0.3; seen=1; break; }
+      grep -q 'nmbake: tracing' "$log/stderr.txt" && { seen=1; break; }
     elif [ -e ".m.png.nmbake-tmp.$pid" ]; then
       seen=1
       break
@@ -52,7 +54,8 @@ run_and_signal() {
 for case in TERM:bake:143 HUP:bake:129 TERM:write:143 INT:write:130; do
   IFS=: read -r sig when expect <<<"$case"
   run_and_signal "$sig" "$when"
-  err=$(cat "$log/stderr.txt")
+  # Less the progress line (its redraws end in carriage returns) and the clearing of it.
+  err=$(tr '\r' '\n' <"$log/stderr.txt" | grep -v -e '^ *$' -e '^nmbake: ')
   [ "$code" = "$expect" ] || bad "SIG$sig during the $when: exit $code, expected $expect ($err)"
   [ "$err" = "error: interrupted by SIG$sig; no output written" ] || bad "SIG$sig during the $when: stderr: $err"
   [ "$(state)" = "$old" ] || bad "SIG$sig during the $when: files changed or left: $(ls -A | tr '\n' ' ')"
