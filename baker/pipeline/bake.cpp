@@ -10,7 +10,6 @@
 #include <cstdio>
 #include <exception>
 #include <new>
-#include <optional>
 #include <string>
 #include <thread>
 #include <utility>
@@ -256,13 +255,7 @@ void validate_options(const BakeOptions& o) {
 // selection once they are known), rasterize, trace and shade, pad. Loading and writing are the
 // caller's (io/).
 BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt) {
-  if (!share_origin(low, high, cage)) {  // loaded each on its own (nmbake loads them on one origin)
-    const std::optional<Mesh> moved_cage = cage ? std::optional<Mesh>(with_origin(*cage, low.origin)) : std::nullopt;
-    const auto moved_high = std::make_shared<const Mesh>(with_origin(high, low.origin));
-    BakeResult result = bake_normal_map(low, *moved_high, moved_cage ? &*moved_cage : nullptr, opt);
-    result.trace_inputs = holding(std::move(result.trace_inputs), moved_high);
-    return result;
-  }
+  if (!share_origin(low, high, cage)) return bake_on_low_origin(bake_normal_map, low, high, cage, opt);
   check_bake_inputs(low, high, cage, opt);
   const int threads = worker_threads(opt.threads);
   const std::string texels = std::to_string(opt.width) + "x" + std::to_string(opt.height) + " texels, " +

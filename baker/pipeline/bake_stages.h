@@ -8,6 +8,7 @@
 #include <exception>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -51,6 +52,19 @@ void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const Ba
 // `inputs` made to hold `high` too: a high-poly moved to the low-poly's origin for the bake, which
 // they read (BakeResult::trace_inputs). Null stays null.
 std::shared_ptr<const TraceInputs> holding(std::shared_ptr<const TraceInputs> inputs, std::shared_ptr<const Mesh> high);
+
+// For meshes loaded each on its own (!share_origin; nmbake loads them on one origin): `bake`
+// (bake_normal_map, bake_udim_tiles) of the high-poly and cage moved to the low-poly's origin, the
+// moved high-poly held by the result's trace_inputs (holding).
+template <typename Result>
+Result bake_on_low_origin(Result (*bake)(const Mesh&, const Mesh&, const Mesh*, const BakeOptions&), const Mesh& low,
+                          const Mesh& high, const Mesh* cage, const BakeOptions& opt) {
+  const std::optional<Mesh> moved_cage = cage ? std::optional<Mesh>(with_origin(*cage, low.origin)) : std::nullopt;
+  const auto moved_high = std::make_shared<const Mesh>(with_origin(high, low.origin));
+  Result result = bake(low, *moved_high, moved_cage ? &*moved_cage : nullptr, opt);
+  result.trace_inputs = holding(std::move(result.trace_inputs), moved_high);
+  return result;
+}
 
 // How select_and_build got the BVH: built for this bake alone, built over every triangle and kept
 // in an empty BvhCache, or reused from the cache.

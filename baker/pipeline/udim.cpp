@@ -5,7 +5,6 @@
 #include <cmath>
 #include <memory>
 #include <new>
-#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -177,13 +176,7 @@ UdimLayout find_udim_tiles(const Mesh& low, int width, int height) {
 }
 
 UdimBake bake_udim_tiles(const Mesh& low, const Mesh& high, const Mesh* cage, const BakeOptions& opt) {
-  if (!share_origin(low, high, cage)) {  // loaded each on its own (nmbake loads them on one origin)
-    const std::optional<Mesh> moved_cage = cage ? std::optional<Mesh>(with_origin(*cage, low.origin)) : std::nullopt;
-    const auto moved_high = std::make_shared<const Mesh>(with_origin(high, low.origin));
-    UdimBake out = bake_udim_tiles(low, *moved_high, moved_cage ? &*moved_cage : nullptr, opt);
-    out.trace_inputs = holding(std::move(out.trace_inputs), moved_high);
-    return out;
-  }
+  if (!share_origin(low, high, cage)) return bake_on_low_origin(bake_udim_tiles, low, high, cage, opt);
   const UdimLayout layout = low.has_uvs() ? find_udim_tiles(low) : UdimLayout{};  // no UVs: check_bake_inputs says so
   const std::size_t n = layout.tiles.size();
   check_bake_inputs(low, high, cage, opt, std::max<std::size_t>(n, 1),
