@@ -140,7 +140,7 @@ void add_options(CLI::App& app, Args& a) {
   app.add_flag("--estimate-error", a.estimate_error,
                "Re-bake 4096 random covered texels (fixed seed) with 64 samples (4x --samples if more) and report the "
                "angular error of the float map against them (one stderr line, \"error_estimate\" in --report); costs "
-               "about 10% of a 2048^2 1-sample bake (measured on torus_s3 and suz_L4: 0.13-0.31 s, 6-12% of the command)");
+               "about 10% of a 2048^2 1-sample bake");
   app.set_version_flag("--version", std::string("nmbake ") + NMBAKE_VERSION);
   require_numbers(app);
 }
