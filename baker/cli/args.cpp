@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <tuple>
 
+#include "cli/map_outputs.h"
 #include "cli/outputs.h"
 #include "core/errors.h"
 #include "core/object_match.h"
@@ -141,8 +142,102 @@ void add_options(CLI::App& app, Args& a) {
                "Re-bake 4096 random covered texels (fixed seed) with 64 samples (4x --samples if more) and report the "
                "angular error of the float map against them (one stderr line, \"error_estimate\" in --report); costs "
                "about 10% of a 2048^2 1-sample bake");
+  app.add_option("--maps", a.maps,
+                 "Maps to bake from the same hits, comma-separated (default normal): " + map_name_list() +
+                     ". Several need <MAP> in -o (crate_<MAP>.png); README, \"Texture sets\", defines each");
+  app.add_option("--ao-rays", a.ao_rays,
+                 "Rays per texel for ao, bent-normal and thickness, 1-65536, or auto: rays in rounds of 16 until the AO's "
+                 "standard error is below --max-ao-error (default 64)");
+  app.add_option("--max-ao-error", a.max_ao_error, "With --ao-rays auto: the standard error a texel's AO stops at (default 0.01)");
+  app.add_option("--ao-distance", a.ao_distance,
+                 "ao, bent-normal: a ray meeting the high-poly within D scene units is occluded (default 0.1 x the scene's "
+                 "diagonal)");
+  app.add_option("--ao-occluders", a.ao_occluders,
+                 "With --match names: group (default: only the object's own high-poly objects occlude) or all")
+      ->check(CLI::IsMember({"group", "all"}));
+  app.add_option("--height-range", a.height_range,
+                 "height: A:B, the distances (scene units, outwards positive) written as 0 and 1 (default: the bake's own "
+                 "largest distance each way, so 0.5 is the low-poly surface; in the report)");
+  app.add_option("--thickness-distance", a.thickness_distance,
+                 "thickness: the distance that counts as fully thick, scene units (default 0.1 x the scene's diagonal)");
+  app.add_option("--curvature-scale", a.curvature_scale,
+                 "curvature: the mean curvature (1/scene units) written as 0 or 1 (default: the bake's mean + one standard "
+                 "deviation of |curvature|, in the report)");
   app.set_version_flag("--version", std::string("nmbake ") + NMBAKE_VERSION);
   require_numbers(app);
+}
+
+// The texture set's options from the flags, each refused where it is absurd or applies to no map
+// asked for.
+MapOptions map_options(const Args& a) {
+  MapOptions m;
+  m.maps = parse_maps(a.maps);
+  const auto needs = [&](bool given, const char* option, std::initializer_list<MapKind> kinds) {
+    if (!given) return;
+    for (MapKind k : kinds)
+      if (m.wants(k)) return;
+    std::string names;
+    for (MapKind k : kinds) names += (names.empty() ? "" : " or ") + std::string(map_name(k));
+    throw UsageError(std::string(option) + " applies to --maps with " + names);
+  };
+  const auto distance = [](bool given, double d, const char* option) {
+    if (given && !(d > 0.0 && d < kMaxDistance)) {
+      char got[32];
+      std::snprintf(got, sizeof got, "%g", d);
+      throw UsageError(std::string(option) + " must be a distance above 0 in scene units, got " + got);
+    }
+  };
+  needs(a.ao_distance_given, "--ao-distance", {MapKind::ao, MapKind::bent_normal});
+  distance(a.ao_distance_given, a.ao_distance, "--ao-distance");
+  if (a.ao_distance_given) m.ao_distance = a.ao_distance;
+  needs(a.thickness_distance_given, "--thickness-distance", {MapKind::thickness});
+  distance(a.thickness_distance_given, a.thickness_distance, "--thickness-distance");
+  if (a.thickness_distance_given) m.thickness_distance = a.thickness_distance;
+  needs(a.curvature_scale_given, "--curvature-scale", {MapKind::curvature});
+  distance(a.curvature_scale_given, a.curvature_scale, "--curvature-scale");
+  if (a.curvature_scale_given) m.curvature_scale = a.curvature_scale;
+  needs(a.ao_rays != "64", "--ao-rays", {MapKind::ao, MapKind::bent_normal, MapKind::thickness});
+  if (a.ao_rays == "auto") {
+    m.ao_rays_auto = true;
+    needs(true, "--ao-rays auto", {MapKind::ao, MapKind::bent_normal});
+  } else {
+    std::size_t used = 0;
+    long long n = 0;
+    try {
+      if (is_number(a.ao_rays, true)) n = std::stoll(a.ao_rays, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != a.ao_rays.size() || n < 1 || n > kMaxAoRays)
+      throw UsageError("--ao-rays takes a number of rays (1-" + std::to_string(kMaxAoRays) + ") or auto, got '" +
+                       printable(a.ao_rays) + "'");
+    m.ao_rays = int(n);
+  }
+  if (a.max_ao_error_given) {
+    if (!m.ao_rays_auto) throw UsageError("--max-ao-error applies to --ao-rays auto");
+    if (!(a.max_ao_error > 0.0 && a.max_ao_error < 0.5))
+      throw UsageError("--max-ao-error must be a standard error above 0 and below 0.5");
+    m.max_ao_error = a.max_ao_error;
+  }
+  m.ao_occluders_all = a.ao_occluders == "all";
+  if (!a.height_range.empty()) {
+    needs(true, "--height-range", {MapKind::height});
+    const std::size_t colon = a.height_range.find(':');
+    const std::string lo = a.height_range.substr(0, colon), hi = colon == std::string::npos ? "" : a.height_range.substr(colon + 1);
+    std::size_t u1 = 0, u2 = 0;
+    double x = 0.0, y = 0.0;
+    try {
+      if (is_number(lo, false) && is_number(hi, false)) x = std::stod(lo, &u1), y = std::stod(hi, &u2);
+    } catch (const std::exception&) {
+      u1 = 0;
+    }
+    if (u1 == 0 || u1 != lo.size() || u2 != hi.size() || !std::isfinite(x) || !std::isfinite(y))
+      throw UsageError("--height-range takes A:B, two distances in scene units, got '" + printable(a.height_range) + "'");
+    if (!(x < y)) throw UsageError("--height-range " + a.height_range + ": A must be below B (A is written as 0, B as 1)");
+    m.height_range_given = true;
+    m.height_min = x, m.height_max = y;
+  }
+  return m;
 }
 
 // The library's options from the flags: translation only (validate_options checks them).
@@ -187,6 +282,7 @@ BakeOptions bake_options(const Args& a) {
     if (a.match != "names") throw UsageError("--match-suffixes applies with --match names");
     parse_match_suffixes(a.match_suffixes);  // a malformed list fails before the meshes load
   }
+  o.maps = map_options(a);
   return o;
 }
 
@@ -201,12 +297,17 @@ void check_outputs(const Args& a, int bits) {
   }
   std::vector<NamedFile> inputs{{"", a.low, "the low-poly"}, {"--cage", a.cage, "the cage"}};
   for (const std::string& h : a.highs) inputs.push_back({"", h, "the high-poly"});
-  check_output_files(inputs, {{"--output", a.output, "the map"},
-                              {"--miss-mask", a.miss_mask, "the miss mask"},
-                              {"--suspect-mask", a.suspect_mask, "the suspect mask"},
-                              {"--save-cage", a.save_cage, "the cage"},
-                              {"--report", a.report, "the report"}});
-  check_output_format(a.output, bits);
+  const std::vector<MapKind> maps = parse_maps(a.maps);
+  check_map_outputs(a.output, maps,
+                    {{"--miss-mask", a.miss_mask}, {"--suspect-mask", a.suspect_mask}, {"--save-cage", a.save_cage}, {"--report", a.report}});
+  std::vector<NamedFile> outputs;
+  for (MapKind k : maps) outputs.push_back({"--output", map_path(a.output, k), "the " + std::string(map_name(k)) + " map"});
+  outputs.insert(outputs.end(), {{"--miss-mask", a.miss_mask, "the miss mask"},
+                                 {"--suspect-mask", a.suspect_mask, "the suspect mask"},
+                                 {"--save-cage", a.save_cage, "the cage"},
+                                 {"--report", a.report, "the report"}});
+  check_output_files(inputs, outputs);
+  check_output_format(map_path(a.output, maps.front()), bits);
   if (!a.compression.empty() && image_io_detail::lower_extension(a.output) != ".exr")
     throw UsageError("--compression " + a.compression + " applies to EXR output, not " + a.output);
   if (a.dither && bits != 8)
@@ -220,6 +321,10 @@ void finish_args(Args& a, const CLI::App& app) {
   a.front_given = app.count("--front") > 0;
   a.rear_given = app.count("--rear") > 0;
   a.max_error_given = app.count("--max-error") > 0;
+  a.ao_distance_given = app.count("--ao-distance") > 0;
+  a.max_ao_error_given = app.count("--max-ao-error") > 0;
+  a.thickness_distance_given = app.count("--thickness-distance") > 0;
+  a.curvature_scale_given = app.count("--curvature-scale") > 0;
 }
 
 }  // namespace nmbake

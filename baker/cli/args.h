@@ -39,6 +39,13 @@ struct Args {
   bool allow_mismatch = false;                 // --allow-mismatch: bake LOW and HIGH whose boxes do not match (pair_checks.h)
   bool allow_overlap = false;                  // --allow-overlap: bake UVs stacked three or more deep
   std::string match = "none", match_suffixes;  // --match, --match-suffixes
+  // The texture set (core/maps.h): --maps, and the options of the maps' definitions; *_given set
+  // after parsing.
+  std::string maps = "normal";
+  std::string ao_rays = "64";  // a count, or "auto"
+  double ao_distance = 0.0, max_ao_error = 0.0, thickness_distance = 0.0, curvature_scale = 0.0;
+  bool ao_distance_given = false, max_ao_error_given = false, thickness_distance_given = false, curvature_scale_given = false;
+  std::string ao_occluders = "group", height_range;
 };
 
 // The command line's options on `app`, with their help text.

@@ -5,6 +5,7 @@
 #include <optional>
 #include <tuple>
 
+#include "cli/map_outputs.h"
 #include "cli/outputs.h"
 #include "cli/pair_checks.h"
 #include "cli/report.h"
@@ -74,30 +75,56 @@ ErrorEstimate estimate_error(const Mesh& low, const BakeOptions& o, const BakeRe
   return estimate;
 }
 
-// A map and its masks, and the files they go to (one set, or one per UDIM tile).
+// A map set and its masks, and the files they go to (one set, or one per UDIM tile): the normal
+// map's (empty when --maps leaves it out) and each other map's, as result->maps.
 struct MapFiles {
   const BakeResult* result;
   std::string map, miss_mask, suspect_mask;
+  std::vector<std::string> extra;
 };
 
-std::vector<MapFiles> map_files(const Args& a, const BakeResult& r, const UdimBake* udim) {
-  if (!udim) return {{&r, a.output, a.miss_mask, a.suspect_mask}};
-  std::vector<MapFiles> files;
+std::vector<MapFiles> map_files(const Args& a, const BakeOptions& o, const BakeResult& r, const UdimBake* udim) {
   auto tile_path = [](const std::string& pattern, int n) { return pattern.empty() ? pattern : udim_path(pattern, n); };
-  for (const TileBake& t : udim->tiles)
-    files.push_back({&t.result, udim_path(a.output, t.tile.number), tile_path(a.miss_mask, t.tile.number),
-                     tile_path(a.suspect_mask, t.tile.number)});
+  const auto set = [&](const BakeResult& result, int tile) {
+    const auto path = [&](MapKind k) { return tile ? udim_path(map_path(a.output, k), tile) : map_path(a.output, k); };
+    MapFiles f{&result, o.maps.wants(MapKind::normal) ? path(MapKind::normal) : "", tile_path(a.miss_mask, tile),
+               tile_path(a.suspect_mask, tile), {}};
+    if (!tile) f.miss_mask = a.miss_mask, f.suspect_mask = a.suspect_mask;
+    for (const BakedMap& m : result.maps) f.extra.push_back(path(m.kind));
+    return f;
+  };
+  if (!udim) return {set(r, 0)};
+  std::vector<MapFiles> files;
+  for (const TileBake& t : udim->tiles) files.push_back(set(t.result, t.tile.number));
   return files;
+}
+
+// The file metadata of a map other than the normal map.
+std::vector<std::pair<std::string, std::string>> extra_metadata(const BakeOptions& o, const BakedMap& m) {
+  std::vector<std::pair<std::string, std::string>> md = m.metadata;
+  if (m.kind == MapKind::bent_normal || m.kind == MapKind::object_normal) {
+    const NormalSpace space = m.kind == MapKind::object_normal ? NormalSpace::object : o.space;
+    md.push_back({"nmbake:space", to_string(space)});
+    if (space == NormalSpace::tangent) {
+      md.push_back({"nmbake:green", o.green_down ? "down" : "up"});
+      md.push_back({"nmbake:tangent_basis", "mikktspace"});
+    }
+  }
+  md.push_back({"nmbake:version", NMBAKE_VERSION});
+  md.push_back({"ImageDescription", std::string(map_name(m.kind)) + " map, baked by nmbake"});
+  return md;
 }
 
 // The UDIM tiles' files may not be inputs or each other (checked with the pattern before the bake).
 void check_tile_files(const Args& a, const std::vector<MapFiles>& files) {
   std::vector<NamedFile> inputs{{"", a.low, "the low-poly"}, {"--cage", a.cage, "the cage"}}, outputs;
   for (const std::string& h : a.highs) inputs.push_back({"", h, "the high-poly"});
-  for (const MapFiles& f : files)
+  for (const MapFiles& f : files) {
     for (const auto& [option, path] :
          {std::pair{"--output", &f.map}, std::pair{"--miss-mask", &f.miss_mask}, std::pair{"--suspect-mask", &f.suspect_mask}})
       outputs.push_back({option, *path, "a UDIM tile"});
+    for (const std::string& path : f.extra) outputs.push_back({"--output", path, "a UDIM tile"});
+  }
   check_output_files(inputs, outputs);
 }
 
@@ -110,6 +137,7 @@ void write_outputs(const JobEnv& env, OutputSet& outputs, const Args& a, const B
   WriteOptions wo;
   wo.bits = bits;
   wo.metadata = {
+      {"nmbake:map", "normal"},
       {"nmbake:space", to_string(o.space)},
       {"nmbake:green", o.green_down ? "down" : "up"},
       {"nmbake:tangent_basis", "mikktspace"},
@@ -121,12 +149,24 @@ void write_outputs(const JobEnv& env, OutputSet& outputs, const Args& a, const B
   wo.compression = a.compression;
   wo.dither = a.dither;
   wo.threads = o.threads;
-  const std::vector<MapFiles> files = map_files(a, r, udim);
+  const std::vector<MapFiles> files = map_files(a, o, r, udim);
   if (udim) check_tile_files(a, files);
   for (const MapFiles& f : files) {
     check_signal();
-    wo.temp_path = outputs.add(f.map);
-    write_image(f.map, f.result->map, wo);
+    if (!f.map.empty()) {
+      wo.temp_path = outputs.add(f.map);
+      write_image(f.map, f.result->map, wo);
+    }
+    for (std::size_t i = 0; i < f.extra.size(); ++i) {
+      const BakedMap& m = f.result->maps[i];
+      if (m.image.pixels.empty()) continue;  // skipped (a warning says why)
+      check_signal();
+      WriteOptions mo = wo;
+      mo.metadata = extra_metadata(o, m);
+      mo.dither = wo.dither && !map_is_flat(m.kind);  // an ID's colour is exact
+      mo.temp_path = outputs.add(f.extra[i]);
+      write_image(f.extra[i], m.image, mo);
+    }
     for (const auto& [path, image] :
          {std::pair{&f.miss_mask, &f.result->miss_mask}, std::pair{&f.suspect_mask, &f.result->suspect_mask}}) {
       if (path->empty()) continue;
@@ -151,11 +191,90 @@ void write_outputs(const JobEnv& env, OutputSet& outputs, const Args& a, const B
   }
 }
 
+// The report's "maps": per map of --maps, its file (the pattern with <UDIM>) and what it was
+// encoded with; the ranges, distances and ID colours are the same in every UDIM tile, the standard
+// errors are combined (mean over the covered texels, the largest tile's p95).
+nlohmann::json maps_report(const Args& a, const BakeOptions& o, const BakeResult& r, const UdimBake* udim) {
+  nlohmann::json maps = nlohmann::json::array();
+  std::vector<const BakeResult*> parts;
+  if (udim)
+    for (const TileBake& t : udim->tiles) parts.push_back(&t.result);
+  else
+    parts.push_back(&r);
+  std::size_t extra = 0;
+  for (MapKind kind : o.maps.maps) {
+    nlohmann::json j = {{"map", map_name(kind)}, {"file", map_path(a.output, kind)}};
+    if (kind == MapKind::normal || parts.empty() || extra >= parts.front()->maps.size()) {
+      maps.push_back(j);
+      continue;
+    }
+    const BakedMap& m = parts.front()->maps[extra];
+    if (!m.skipped.empty()) j["skipped"] = m.skipped;
+    switch (kind) {
+      case MapKind::ao:
+      case MapKind::bent_normal:
+        j["ao_distance"] = m.distance;
+        j["rays_per_texel"] = o.maps.ao_rays_auto ? nlohmann::json("auto") : nlohmann::json(o.maps.ao_rays);
+        break;
+      case MapKind::thickness:
+        j["thickness_distance"] = m.distance;
+        j["rays_per_texel"] = o.maps.ao_rays;
+        break;
+      case MapKind::height:
+        j["height_range"] = {m.range_min, m.range_max};
+        j["height_range_given"] = o.maps.height_range_given;
+        break;
+      case MapKind::curvature:
+        j["curvature_scale"] = m.range_max;
+        j["curvature_scale_given"] = o.maps.curvature_scale > 0.0;
+        break;
+      case MapKind::position:
+        j["box"] = {{"min", {m.box_min.x, m.box_min.y, m.box_min.z}}, {"max", {m.box_max.x, m.box_max.y, m.box_max.z}}};
+        break;
+      case MapKind::object_id:
+      case MapKind::material_id: {
+        nlohmann::json colors = nlohmann::json::object();
+        for (const auto& [name, c] : m.colors)
+          colors[name] = {int(std::lround(c.r * 255.0f)), int(std::lround(c.g * 255.0f)), int(std::lround(c.b * 255.0f))};
+        j["colors"] = colors;
+        break;
+      }
+      default:
+        break;
+    }
+    if (m.error_mean >= 0.0) {
+      double sum = 0.0, texels = 0.0, p95 = 0.0;
+      for (const BakeResult* p : parts) {
+        const double n = double(p->stats.trace.texels_covered);
+        sum += p->maps[extra].error_mean * n, texels += n;
+        p95 = std::max(p95, p->maps[extra].error_p95);
+      }
+      j["standard_error"] = {{"mean", texels > 0.0 ? sum / texels : 0.0}, {"p95", p95}};
+    }
+    maps.push_back(j);
+    ++extra;
+  }
+  return maps;
+}
+
+// The texture set's warnings: a map not written, a map in fewer bits than it needs.
+std::vector<std::string> map_warnings(const BakeResult& r, int bits) {
+  std::vector<std::string> out;
+  for (const BakedMap& m : r.maps) {
+    if (!m.skipped.empty()) out.push_back("warning: " + m.skipped + ": the " + map_name(m.kind) + " map is not written");
+    if (bits == 8 && (m.kind == MapKind::height || m.kind == MapKind::position))
+      out.push_back(std::string("warning: the ") + map_name(m.kind) +
+                    " map in 8 bits steps visibly (256 levels); a .tif (16-bit) or .exr (float) output keeps it smooth");
+  }
+  return out;
+}
+
 // The job's report, written to --report and handed to the batch.
 void report_job(const JobEnv& env, OutputSet& outputs, const Args& a, const BakeOptions& o, const RunInfo& run,
-                const BakeStats& s, const ErrorEstimate* estimate) {
+                const BakeResult& r, const UdimBake* udim, const ErrorEstimate* estimate) {
   if (a.report.empty() && !env.report) return;
-  nlohmann::json report = make_report(o, s, run);
+  nlohmann::json report = make_report(o, r.stats, run);
+  report["maps"] = maps_report(a, o, r, udim);
   if (estimate)
     report["error_estimate"] = {{"mean_deg", estimate->mean_deg},
                                 {"p95_deg", estimate->p95_deg},
@@ -373,13 +492,14 @@ void bake_job(const Args& a, const JobEnv& env) {
   else env.progress.finish();
   warnings.add(bake_warnings(s, run.high_topology, a.low, a.high, uv_tiles_note(low, a, o.width, o.height),
                              {boxes.mismatched(), &overlap}));
+  warnings.add(map_warnings(udim ? (udim->tiles.empty() ? r : udim->tiles.front().result) : r, bits));
   warnings.check_strict();
   run.warnings = warnings.all();
   run.seconds_total = std::chrono::duration<double>(Clock::now() - env.start).count();
   run.peak_memory_bytes = peak_memory_bytes();
   run.threads_used = unsigned(worker_threads(a.threads));
   *env.doing = "writing the report";
-  report_job(env, outputs, a, o, run, s, a.estimate_error ? &estimate : nullptr);
+  report_job(env, outputs, a, o, run, r, udim ? &*udim : nullptr, a.estimate_error ? &estimate : nullptr);
   outputs.commit(env.interrupted);
   if (!a.quiet) print_summary(a, o, run, s, bits);
 }

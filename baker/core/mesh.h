@@ -45,6 +45,16 @@ struct Mesh {
   std::vector<Object> objects;
   std::vector<std::uint32_t> triangle_object;
 
+  // TEMP (lead): the helper's fields.
+  std::vector<std::string> materials;
+  std::vector<std::uint32_t> triangle_material;
+  std::vector<glm::vec4> colors;
+  std::vector<std::uint32_t> color_index;
+  std::uint32_t material_of(std::size_t tri) const { return triangle_material.empty() ? 0u : triangle_material[tri]; }
+  std::size_t material_count() const { return materials.size(); }
+  bool has_colors() const { return !color_index.empty(); }
+  glm::vec4 corner_color(std::size_t tri, int corner) const { return colors[color_index[3 * tri + corner]]; }
+
   std::size_t triangle_count() const { return position_index.size() / 3; }
   bool has_normals() const { return !normal_index.empty(); }
   bool has_uvs() const { return !uv_index.empty(); }

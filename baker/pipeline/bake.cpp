@@ -17,6 +17,7 @@
 #include "core/parallel.h"
 #include "pipeline/bvh.h"
 #include "pipeline/distances.h"
+#include "pipeline/map_set.h"
 #include "core/memory_budget.h"
 #include "pipeline/pad.h"
 #include "pipeline/prepare.h"
@@ -134,8 +135,14 @@ std::uint64_t estimate_bake_bytes(const BakeOptions& o) {
   // map (3 floats) + coverage (1 byte) + padding transform (one int) + optional miss mask.
   std::uint64_t per_texel =
       12 + 1 + (o.padding > 0 ? 4 : 0) + (o.miss_mask ? 4 : 0) + (o.suspect_mask ? 4 : 0) + (o.samples > 1 ? 1 : 0);
+  for (MapKind k : o.maps.maps)  // each extra map's floats (and ao's, thickness's error)
+    if (k != MapKind::normal) per_texel += 4u * std::uint64_t(map_channels(k)) + (k == MapKind::ao || k == MapKind::thickness ? 4 : 0);
   return texels * per_texel;
 }
+
+// Secondary rays (AO, bent normals, thickness) meet triangles no primary ray reaches: the BVH then
+// holds every triangle.
+static bool culls_far(const BakeOptions& opt) { return opt.cull_far && !opt.maps.wants_rays(); }
 
 void announce_stage(const BakeOptions& opt, const char* stage) {
   if (opt.on_stage) opt.on_stage(stage);
@@ -150,7 +157,7 @@ BvhSource select_and_build(const Mesh& high, const ReachMode& mode, const BakeOp
   const KeptBvh* const reuse = find_kept_bvh(cache, s, content);
   const bool keep = cache && !cache->kept;
   const double margin = mode.probing ? mode.reach * 1.01 + 1e-6 * s.diagonal : ray_margin(s, mode.any_cage, opt.front, opt.rear);
-  in.selection = reuse ? reuse->selection : select_high(s, high, opt.cull_far && !keep ? margin : -1.0, threads);
+  in.selection = reuse ? reuse->selection : select_high(s, high, culls_far(opt) && !keep ? margin : -1.0, threads);
   const std::size_t count = in.selection.count(high);
   announce_stage(opt, "building the BVH");
   stage = "building the BVH of " + std::to_string(count) + " high-poly triangles";
@@ -198,7 +205,7 @@ void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const Ba
   measure_reach(mode, low, opt, threads, in.s, in.scene, result);
   st.distances.seconds = seconds_since(t0);
 
-  if (opt.cull_far && mode.probing && source == BvhSource::built) {
+  if (culls_far(opt) && mode.probing && source == BvhSource::built) {
     t0 = Clock::now();
     stage = "building the BVH of the reachable high-poly triangles";
     narrow_and_rebuild(high, mode, opt, threads, result, in);
@@ -275,8 +282,17 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     auto t0 = Clock::now();
     const double cpu0 = process_cpu_seconds();
     const TileBins bins = bin_triangles(low, opt.width, opt.height, trace_tile_side(opt));
+    MapInputs map_in;
+    MapTargets map_out;
+    const bool extra = opt.maps.wants_extra();
+    if (extra) {
+      map_in = make_map_inputs(opt, in.s, in.scene, in.selection, high);
+      map_out = allocate_map_targets(opt.maps, opt.width, opt.height);
+    }
     outputs.wait();
-    trace_and_shade(in.s, in.scene, bins, in.rays, opt, threads, {result.map, result.coverage, result.miss_mask, disagree}, st);
+    trace_and_shade(in.s, in.scene, bins, in.rays, opt, threads,
+                    {result.map, result.coverage, result.miss_mask, disagree, extra ? &map_in : nullptr, extra ? &map_out : nullptr},
+                    st);
     st.trace.seconds = seconds_since(t0);
     st.trace.cpu_seconds = process_cpu_seconds() - cpu0;
 
@@ -284,6 +300,9 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     stage = "padding (" + texels + ")";
     t0 = Clock::now();
     pad_map(opt, disagree, threads, result);
+    if (extra)
+      result.maps = finish_maps(opt, in.s, high, map_in, map_ranges(opt, in.s, {&map_out}, {&result.coverage}), map_out,
+                                result.coverage, threads);
     st.pad.seconds = seconds_since(t0);
     if (opt.keep_trace) result.trace_inputs = kept;
     return result;

@@ -17,6 +17,7 @@
 
 #include "core/errors.h"
 #include "core/image.h"
+#include "core/maps.h"
 #include "core/mesh.h"
 #include "core/tangent_frames.h"
 
@@ -116,6 +117,9 @@ struct BakeOptions {
   BvhCache* bvh_cache = nullptr;
   // Keep what the trace read in BakeResult::trace_inputs (UdimBake's), for the error estimate.
   bool keep_trace = false;
+  // The maps to bake and their definitions' options (core/maps.h). The normal map is always
+  // traced (BakeResult::map); every other map asked for comes in BakeResult::maps.
+  MapOptions maps;
   // Called from the calling thread with the fraction done in [0,1]; return false to cancel
   // (bake_normal_map then throws Cancelled).
   std::function<bool(double)> progress;
@@ -236,6 +240,27 @@ struct BakeStats {
 
 struct TraceInputs;  // bake_stages.h: the prepared scene, its BVH and the rays' set-up
 
+// One map of the texture set other than the normal map (BakeOptions::maps), ready to write.
+struct BakedMap {
+  MapKind kind = MapKind::ao;
+  Image image;  // map_channels(kind) channels, values in [0, 1] as written, padded like the normal map
+  // Written into the file: "nmbake:map" (the map's name) and its ranges ("nmbake:height_range",
+  // "nmbake:position_box", "nmbake:curvature_scale", "nmbake:ao_distance", "nmbake:thickness_distance").
+  std::vector<std::pair<std::string, std::string>> metadata;
+  // height: the distances mapped to 0 and 1; curvature: -scale and +scale (1 / scene units);
+  // position: unused (box_min, box_max). File coordinates for the box.
+  double range_min = 0.0, range_max = 0.0;
+  glm::dvec3 box_min{0.0}, box_max{0.0};
+  double distance = 0.0;  // ao, bent-normal: the AO distance; thickness: its distance (scene units)
+  std::vector<std::pair<std::string, glm::vec3>> colors;  // ID maps: per name its colour (0-1, 8-bit steps)
+  // ao, thickness: the standard error of the covered texels' values, mean and 95th percentile;
+  // -1 for the other maps.
+  double error_mean = -1.0, error_p95 = -1.0;
+  Image error;  // ao, thickness: per texel the standard error of its value (1 channel, covered texels; else 0)
+  // Not written, and why (vertex-color of a high-poly without colours): `image` is then empty.
+  std::string skipped;
+};
+
 struct BakeResult {
   Image map;                           // RGB, encoded c = n * 0.5 + 0.5
   Image miss_mask;                     // 1 channel, share of missed samples (only with options.miss_mask)
@@ -251,6 +276,8 @@ struct BakeResult {
   // Per low-poly position, how far out rays search beyond a cage that a neighbouring part limits
   // (LocalDistances::search); empty where vertex_rear is.
   std::vector<float> vertex_search;
+  // Every map of BakeOptions::maps but the normal map, in the order asked.
+  std::vector<BakedMap> maps;
   // With BakeOptions::keep_trace, what the trace read (for estimate_bake_error, error_estimate.h);
   // it reads the low-poly and the high-poly given, which must outlive it unchanged. Else null.
   std::shared_ptr<const TraceInputs> trace_inputs;

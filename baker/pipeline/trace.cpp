@@ -4,9 +4,11 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <numeric>
 
 #include "pipeline/adaptive_levels.h"
+#include "pipeline/texel_maps.h"
 #include "pipeline/trace_stats.h"
 #include "pipeline/workers.h"
 #include "trace/shade_batch.h"
@@ -59,6 +61,7 @@ struct Shared {
   bool prefer = false;    // the rule looks at the rays' preferred parts (back faces skipped)
   bool by_texel = false;  // cast texel by texel even without a rule (trace_and_shade's by_texel)
   RayGroups groups;       // with --match: per low-poly triangle and BVH triangle
+  const MapInputs* maps = nullptr;  // the extra maps (TraceTargets::maps), or null: none
   std::vector<ThreadStats> stats;
   // Hit distances summed per tile, then over tiles in order: the mean does not depend on which
   // thread took which tile.
@@ -128,6 +131,10 @@ class TileTracer {
     // Every default-policy ray without a cage starts at 0 and reaches front + rear (sample_rays'
     // too); a cage's rays have each their own reach, made with them.
     if (kernel_rays_ && !sh.setup.cage) std::fill(rays_.tfar(), rays_.tfar() + rays_.size(), sh.setup.front + sh.setup.rear);
+    if (sh.maps) {
+      maps_ = std::make_unique<TexelMaps>(*sh.maps, tile_texels_);
+      sample_dist_.resize(slot_count_);
+    }
   }
 
   // trace_texels: texels[order[i]] for first[k] <= i < first[k + 1] lie in one tile, traced alone
@@ -184,6 +191,7 @@ class TileTracer {
 
   void trace_tile(std::size_t tile) {
     const TileRect rect = rect_of(tile);
+    pass_level_ = 0;
     sh_.tile_dsum[tile] = trace_pass(tile, rect, sh_.offsets, nullptr);
     std::size_t last_full = sh_.offsets.size();  // samples a texel of the last pass has when fully covered
     for (std::size_t level = 0; level < sh_.levels.size(); ++level) {
@@ -191,7 +199,10 @@ class TileTracer {
       // The marked texels again with every sample of the level; the others keep their sums so far.
       first_acc_ = acc_;
       first_miss_ = miss_count_;
+      if (maps_) maps_->keep();
+      pass_level_ = int(level) + 1;
       sh_.tile_dsum[tile] += trace_pass(tile, rect, sh_.levels[level].offsets, refine_.data());
+      if (maps_) maps_->restore_unrefined(refine_.data());
       for (std::size_t i = 0; i < tile_texels_; ++i) {
         if (refine_[i]) continue;
         for (int c = 0; c < 4; ++c) acc_[std::size_t(c) * tile_texels_ + i] = first_acc_[std::size_t(c) * tile_texels_ + i];
@@ -219,6 +230,12 @@ class TileTracer {
     ts_.rays += ray_count;
     const double dsum = count_hits(sample_count);
     shade(sample_count);
+    if (maps_) {
+      const bool one_ray = sh_.rays_per_sample == 1;
+      maps_->shade({sample_tri_.data(), sb_, sample_texel_.data(), one_ray ? hits_.triangle : chosen_tri_.data(),
+                    one_ray ? hits_.u : chosen_u_.data(), one_ray ? hits_.v : chosen_v_.data(), sample_dist_.data(), sample_count},
+                   rect.x0, rect.y0, side_, sh_.opt.width, pass_level_, offsets.size());
+    }
     return dsum;
   }
 
@@ -422,6 +439,7 @@ class TileTracer {
     for (std::size_t r = 0; r < sample_count; ++r) {
       double dist = 0.0;
       const std::size_t h = chosen_hit(hits_, r * per, signed_base_.data(), sh_.setup.closest, &dist);
+      if (maps_) sample_dist_[r] = dist;
       if (per != 1) {
         chosen_[r] = std::uint32_t(h);
         chosen_tri_[r] = hits_.triangle[h];
@@ -505,6 +523,7 @@ class TileTracer {
             out.disagree[std::size_t(ty0 + y) * std::size_t(W) + std::size_t(tx0 + x)] = 1;
         }
     const bool flip_y = sh_.opt.space == NormalSpace::tangent && sh_.opt.green_down;
+    if (maps_) maps_->write(*out.maps, tx0, ty0, tw, th, side_, W);
     for (int y = 0; y < th; ++y) {
       const std::size_t first = std::size_t(y) * std::size_t(side_),
                         gi = std::size_t(ty0 + y) * std::size_t(W) + std::size_t(tx0);
@@ -551,6 +570,9 @@ class TileTracer {
   std::vector<double> first_acc_;          // adaptive: the sums so far while a refining pass runs
   std::vector<std::uint32_t> first_miss_;
   std::vector<std::uint32_t> texel_start_, order_;  // cast_order
+  std::unique_ptr<TexelMaps> maps_;                 // the extra maps, or null
+  std::vector<double> sample_dist_;                 // with maps_: per covered sample, count_hits' signed distance
+  int pass_level_ = 0;                              // the pass under way: 0 the first, then the refining levels
 };
 
 // The trace's hit rule (trace_rule), its match groups and whether it looks at preferred parts;
@@ -592,6 +614,10 @@ void trace_and_shade(const Prepared& s, const HighScene& scene, const TileBins& 
   raycast::HitRule rule;
   set_rule(sh, st, rule);
   sh.by_texel = by_texel;
+  if (out.map_inputs) {
+    out.map_inputs->groups = &sh.groups;
+    sh.maps = out.map_inputs;
+  }
   sh.tile_dsum.assign(bins.count(), 0.0);
   // Tiles are taken from a shared counter, so the tracers that start cover them all.
   run_workers(

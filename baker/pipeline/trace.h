@@ -12,6 +12,7 @@
 #include "pipeline/bvh.h"
 #include "pipeline/prepare.h"
 #include "pipeline/rays.h"
+#include "pipeline/texel_maps.h"
 #include "pipeline/tiles.h"
 
 namespace nmbake {
@@ -24,6 +25,9 @@ struct TraceTargets {
   std::vector<std::uint8_t>& coverage;
   Image& miss_mask;
   std::vector<std::uint8_t>& disagree;
+  // The extra maps (texel_maps.h): what they read (its groups set here) and where they go; null: none.
+  MapInputs* map_inputs = nullptr;
+  MapTargets* maps = nullptr;
 };
 
 // Traces every tile of `bins`, applying the hit rule of `scene` unless st.distances.backfaces_skipped is

@@ -11,6 +11,7 @@
 #include "core/parallel.h"
 #include "core/rasterize.h"
 #include "pipeline/bake_stages.h"
+#include "pipeline/map_set.h"
 #include "pipeline/pad.h"
 #include "pipeline/tiles.h"
 #include "pipeline/trace.h"
@@ -201,6 +202,15 @@ UdimBake bake_udim_tiles(const Mesh& low, const Mesh& high, const Mesh* cage, co
     TraceInputs& in = *kept;
     prepare_trace(low, high, cage, opt, threads, in, shared, stage);
 
+    // The extra maps: what they read, once; where they go, per tile.
+    const bool extra = opt.maps.wants_extra();
+    MapInputs map_in;
+    std::vector<MapTargets> map_out(extra ? n : 0);
+    if (extra) {
+      map_in = make_map_inputs(opt, in.s, in.scene, in.selection, high);
+      for (MapTargets& t : map_out) t = allocate_map_targets(opt.maps, opt.width, opt.height);
+    }
+
     // Trace: every tile with the shared scene, its own bins. Progress runs over all tiles.
     announce_stage(opt, "tracing");
     BakeOptions tile_opt = opt;
@@ -224,17 +234,27 @@ UdimBake bake_udim_tiles(const Mesh& low, const Mesh& high, const Mesh* cage, co
         stage = tracing;
       }
       trace_and_shade(in.s, in.scene, bins, in.rays, tile_opt, threads,
-                      {tb.result.map, tb.result.coverage, tb.result.miss_mask, disagree[i]}, st);
+                      {tb.result.map, tb.result.coverage, tb.result.miss_mask, disagree[i], extra ? &map_in : nullptr,
+                       extra ? &map_out[i] : nullptr},
+                      st);
       st.trace.seconds = seconds_since(t0);
       st.trace.cpu_seconds = process_cpu_seconds() - cpu0;
     }
 
     announce_stage(opt, "padding");
+    MapRanges ranges;
+    if (extra) {
+      std::vector<const MapTargets*> raw;
+      std::vector<const std::vector<std::uint8_t>*> coverage;
+      for (std::size_t i = 0; i < n; ++i) raw.push_back(&map_out[i]), coverage.push_back(&out.tiles[i].result.coverage);
+      ranges = map_ranges(opt, in.s, raw, coverage);
+    }
     for (std::size_t i = 0; i < n; ++i) {
       TileBake& tb = out.tiles[i];
       stage = "padding UDIM tile " + std::to_string(tb.tile.number) + " (" + texels + ")";
       const auto t0 = Clock::now();
       pad_map(opt, disagree[i], threads, tb.result);
+      if (extra) tb.result.maps = finish_maps(opt, in.s, high, map_in, ranges, map_out[i], tb.result.coverage, threads);
       tb.result.stats.pad.seconds = seconds_since(t0);
       std::vector<std::uint8_t>().swap(disagree[i]);
     }

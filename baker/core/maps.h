@@ -1,0 +1,90 @@
+// The maps of a texture set (--maps): their names, what each needs, and the options of their
+// definitions (README, "Texture sets"). Every map is computed from the same primary hit per
+// sample as the normal map, so the maps of one bake line up texel for texel.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace nmbake {
+
+enum class MapKind : std::uint8_t {
+  normal,         // tangent or object space, as --space says (BakeResult::map)
+  object_normal,  // the high-poly normal in object space, encoded n * 0.5 + 0.5
+  ao,             // unoccluded share of cosine-weighted rays from the hit, 1 = open
+  bent_normal,    // mean unoccluded direction of the AO rays, encoded like the normal map
+  height,         // signed distance from the low-poly surface to the hit, mapped by the height range
+  thickness,      // mean of min(hit distance, D) / D of rays into the inverted normal, 1 = thick
+  curvature,      // the high-poly's mean curvature at the hit, 0.5 = flat, convex brighter
+  position,       // the hit, normalised to the high-poly's bounding box per axis (R = x, G = y, B = z)
+  object_id,      // one flat colour per high-poly object (from its name)
+  material_id,    // one flat colour per high-poly material (from its name)
+  vertex_color,   // the high-poly's interpolated vertex colours
+};
+constexpr int kMapKinds = 11;
+
+// "normal", "object-normal", "ao", "bent-normal", "height", "thickness", "curvature", "position",
+// "object-id", "material-id", "vertex-color".
+const char* map_name(MapKind kind);
+// Whether `name` is one of map_name's; sets `kind` when it is.
+bool parse_map_name(const std::string& name, MapKind& kind);
+// Every name, comma-separated, in MapKind order (for messages and --help).
+std::string map_name_list();
+// Channels of the map's image: 1 for ao, height, thickness, curvature; 3 for the others.
+int map_channels(MapKind kind);
+// Maps whose texel takes one sample's value (the most frequent among its hit samples), never a
+// mean: the ID maps.
+bool map_is_flat(MapKind kind);
+// Maps that cast secondary rays from the hit (ao, bent-normal, thickness).
+bool map_casts_rays(MapKind kind);
+
+constexpr int kDefaultAoRays = 64;
+constexpr int kMaxAoRays = 65536;
+
+struct MapOptions {
+  std::vector<MapKind> maps{MapKind::normal};  // in the order asked; each once
+  // AO and bent normals: a ray that meets the high-poly within this distance (scene units) is
+  // occluded; <= 0: automatic (kAutoAoDistance of the scene's diagonal).
+  double ao_distance = 0.0;
+  int ao_rays = kDefaultAoRays;  // rays per texel for ao, bent-normal and thickness
+  // --ao-rays auto: per texel, rays in rounds until the AO's standard error is below max_ao_error
+  // (at most ao_rays_max).
+  bool ao_rays_auto = false;
+  double max_ao_error = 0.01;
+  int ao_rays_max = 1024;
+  bool ao_occluders_all = false;  // with --match names: every object occludes, not only the group's
+  // Height: the distance mapped to 0 and to 1 (scene units); not given: the bake's own range,
+  // symmetric about 0.
+  bool height_range_given = false;
+  double height_min = 0.0, height_max = 0.0;
+  // Thickness: the distance that counts as thick (scene units); <= 0: automatic (kAutoThickness of
+  // the scene's diagonal).
+  double thickness_distance = 0.0;
+  // Curvature: the mean curvature (1/scene units) that reaches 0 or 1; <= 0: automatic (from the
+  // bake's distribution, reported).
+  double curvature_scale = 0.0;
+
+  bool wants(MapKind kind) const {
+    for (MapKind k : maps)
+      if (k == kind) return true;
+    return false;
+  }
+  // Any map beside the normal map (its own images, BakeResult::maps).
+  bool wants_extra() const {
+    for (MapKind k : maps)
+      if (k != MapKind::normal) return true;
+    return false;
+  }
+  bool wants_rays() const {
+    for (MapKind k : maps)
+      if (map_casts_rays(k)) return true;
+    return false;
+  }
+};
+
+// The automatic distances, as a share of the scene's bounding-box diagonal.
+constexpr double kAutoAoDistance = 0.1;
+constexpr double kAutoThickness = 0.1;
+
+}  // namespace nmbake

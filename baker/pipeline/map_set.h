@@ -1,0 +1,43 @@
+// The texture set's other maps around the trace: what they read, made before it
+// (make_map_inputs), and from the trace's raw values the encoded, padded maps (finish_maps).
+// Definitions and why: README, "Texture sets".
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "pipeline/bake.h"
+#include "pipeline/texel_maps.h"
+
+namespace nmbake {
+
+// The inputs of opt.maps's extra maps over the BVH `scene` of the triangles `selection` keeps.
+MapInputs make_map_inputs(const BakeOptions& opt, const Prepared& s, const HighScene& scene, const HighSelection& selection,
+                          const Mesh& high);
+
+// The ranges the raw values are mapped to [0, 1] by: height, opt.maps's range or the bake's own,
+// symmetric about 0 (0.5 is the low-poly surface); curvature, opt.maps's scale or the bake's own,
+// the mean plus one standard deviation of |curvature| over the covered texels (Unreal's automatic
+// range). Over every part of the bake (`raw[t]` with `coverage[t]`: the UDIM tiles share them).
+struct MapRanges {
+  double height_min = 0.0, height_max = 0.0, curvature_scale = 0.0;
+};
+MapRanges map_ranges(const BakeOptions& opt, const Prepared& s, const std::vector<const MapTargets*>& raw,
+                     const std::vector<const std::vector<std::uint8_t>*>& coverage);
+
+// The encoded maps of `raw` (MapTargets, trace order of opt.maps), padded over `coverage` as the
+// normal map is: height and curvature by `ranges`, position by the high-poly's bounding box, the
+// IDs by their names' colours.
+std::vector<BakedMap> finish_maps(const BakeOptions& opt, const Prepared& s, const Mesh& high, const MapInputs& in,
+                                  const MapRanges& ranges, MapTargets& raw, const std::vector<std::uint8_t>& coverage,
+                                  int threads);
+
+// The colour of an ID map's name: from a hash of the name alone (stable across runs and scenes),
+// saturated enough to tell apart, in 8-bit steps. Names whose colours collide in one bake are
+// told apart by id_colors.
+glm::vec3 id_color(const std::string& name);
+// Per name, its colour: id_color, or where two names of `names` would share one, the later name
+// (in sorted order) rehashed until it differs.
+std::vector<glm::vec3> id_colors(const std::vector<std::string>& names);
+
+}  // namespace nmbake

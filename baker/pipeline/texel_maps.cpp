@@ -1,0 +1,396 @@
+#include "pipeline/texel_maps.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/hemisphere.h"
+#include "core/tangent_frames.h"
+#include "raycast.h"
+
+namespace nmbake {
+
+namespace {
+
+constexpr std::size_t kRayBatch = 4096;  // secondary rays cast together
+
+// What a covered texel whose samples all miss gets: open, thick, flat, on the low-poly surface
+// (height 0, position the low-poly point), no colour, no ID.
+constexpr double kMissAo = 1.0, kMissThickness = 1.0;
+
+// Slots of a texel's sums, each `width` doubles per texel.
+enum Slot {
+  s_object_normal,  // 3: sum of unit normals, every sample (a miss: the low-poly's)
+  s_bent,           // 3: sum of unit bent normals in the output space, every sample
+  s_height,         // 1: sum of hit distances
+  s_position,       // 3: sum of hit points (a miss: the low-poly point, kept apart below)
+  s_curvature,      // 1
+  s_color,          // 3
+  s_ao,             // 2: unoccluded rays, rays
+  s_thickness,      // 3: sum of min(t, D) / D, sum of its squares, rays
+  s_object_id,      // 1: the index taken
+  s_material_id,    // 1
+  s_hits,           // 1: samples that hit
+  s_samples,        // 1: samples
+  s_miss_position,  // 3: sum of low-poly points of the samples that miss
+  kSlots
+};
+constexpr int kSlotWidth[kSlots] = {3, 3, 1, 3, 1, 3, 2, 3, 1, 1, 1, 1, 3};
+
+Slot slot_of(MapKind k) {
+  switch (k) {
+    case MapKind::object_normal: return s_object_normal;
+    case MapKind::bent_normal: return s_bent;
+    case MapKind::height: return s_height;
+    case MapKind::position: return s_position;
+    case MapKind::curvature: return s_curvature;
+    case MapKind::vertex_color: return s_color;
+    case MapKind::ao: return s_ao;
+    case MapKind::thickness: return s_thickness;
+    case MapKind::object_id: return s_object_id;
+    case MapKind::material_id: return s_material_id;
+    default: return kSlots;
+  }
+}
+
+// A 64-bit key for a texel's sample's secondary rays.
+std::uint64_t ray_key(std::size_t texel, int level, std::size_t sample, int stream) {
+  return ((std::uint64_t(texel) * 8u + std::uint64_t(level)) * 65536u + std::uint64_t(sample)) * 4u + std::uint64_t(stream);
+}
+
+// The most frequent of ids[0..n) (ties: the smallest); -1 when n is 0.
+double most_frequent(std::vector<std::int64_t>& ids) {
+  if (ids.empty()) return -1.0;
+  std::sort(ids.begin(), ids.end());
+  std::int64_t best = ids[0];
+  std::size_t best_run = 0;
+  for (std::size_t i = 0; i < ids.size();) {
+    std::size_t j = i;
+    while (j < ids.size() && ids[j] == ids[i]) ++j;
+    if (j - i > best_run) best = ids[i], best_run = j - i;
+    i = j;
+  }
+  return double(best);
+}
+
+}  // namespace
+
+MapTargets allocate_map_targets(const MapOptions& maps, int width, int height) {
+  MapTargets out;
+  for (MapKind k : maps.maps) out.raw.push_back(k == MapKind::normal ? Image() : Image(width, height, map_channels(k), 0.0f));
+  if (maps.wants(MapKind::ao)) out.ao_error = Image(width, height, 1, 0.0f);
+  if (maps.wants(MapKind::thickness)) out.thickness_error = Image(width, height, 1, 0.0f);
+  return out;
+}
+
+struct TexelMaps::Impl {
+  const MapInputs& in;
+  std::size_t texels;
+  int offset[kSlots];  // first double of each slot in a texel's sums, -1: not kept
+  int stride = 0;      // doubles per texel
+  std::vector<double> sums, kept;
+  bool rays_ao = false, rays_thickness = false, ids = false;
+  // Per sample of the pass: hit point and unit normal, and the secondary rays' sums.
+  std::vector<glm::dvec3> hit_point, hit_normal, bent_sum;
+  std::vector<std::uint32_t> open_rays, thick_rays_cast;
+  std::vector<std::int64_t> object_id, material_id;
+  raycast::RayArrays rays{kRayBatch};
+  std::vector<std::uint32_t> ray_sample, ray_group;
+  std::vector<std::uint8_t> ray_is_thickness;
+  std::vector<double> thick_sum, thick_sq;
+  std::vector<std::uint32_t> seen;
+  std::vector<std::int64_t> vote;
+
+  Impl(const MapInputs& in_, std::size_t tile_texels) : in(in_), texels(tile_texels) {
+    std::fill(offset, offset + kSlots, -1);
+    const auto use = [&](Slot s) {
+      if (offset[s] >= 0) return;
+      offset[s] = stride;
+      stride += kSlotWidth[s];
+    };
+    for (MapKind k : in.maps->maps) {
+      const Slot s = slot_of(k);
+      if (s == kSlots) continue;
+      use(s);
+      if (k == MapKind::position) use(s_miss_position);
+    }
+    use(s_hits);
+    use(s_samples);
+    sums.assign(std::size_t(stride) * texels, 0.0);
+    rays_ao = in.maps->wants(MapKind::ao) || in.maps->wants(MapKind::bent_normal);
+    rays_thickness = in.maps->wants(MapKind::thickness);
+    ids = in.maps->wants(MapKind::object_id) || in.maps->wants(MapKind::material_id);
+    ray_sample.resize(kRayBatch);
+    ray_is_thickness.resize(kRayBatch);
+    if (in.groups && in.groups->active()) ray_group.resize(kRayBatch);
+  }
+
+  double* at(std::size_t texel, Slot s) { return &sums[texel * std::size_t(stride) + std::size_t(offset[s])]; }
+  const double* at(std::size_t texel, Slot s) const { return &sums[texel * std::size_t(stride) + std::size_t(offset[s])]; }
+  bool has(Slot s) const { return offset[s] >= 0; }
+
+  std::uint32_t source_tri(std::uint32_t t) const { return in.source ? in.source[t] : t; }
+
+  // Casts the queued rays and adds their results to their samples.
+  void flush(std::size_t n) {
+    if (n == 0) return;
+    raycast::RayBatch batch = rays.rays();
+    batch.group = ray_group.empty() ? nullptr : ray_group.data();
+    raycast::HitRule rule;
+    rule.skip_backfaces = false;
+    rule.group = in.groups && in.groups->active() && !in.maps->ao_occluders_all ? in.groups->high.data() : nullptr;
+    in.scene->scene->intersect(batch, rays.hits(), n, rule.group ? &rule : nullptr);
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t r = ray_sample[i];
+      const raycast::Hit h = rays.hit(i);
+      if (ray_is_thickness[i]) {
+        const double d = h.hit() ? std::min(1.0, double(h.t) / in.thickness_distance) : 1.0;
+        thick_sum[r] += d;
+        thick_sq[r] += d * d;
+        ++thick_rays_cast[r];
+      } else if (!h.hit()) {
+        const raycast::Ray ray = rays.ray(i);
+        ++open_rays[r];
+        bent_sum[r] += glm::dvec3(ray.direction);
+      }
+    }
+  }
+};
+
+TexelMaps::TexelMaps(const MapInputs& in, std::size_t tile_texels) : impl_(std::make_unique<Impl>(in, tile_texels)) {}
+TexelMaps::~TexelMaps() = default;
+
+void TexelMaps::keep() { impl_->kept = impl_->sums; }
+
+void TexelMaps::restore_unrefined(const std::uint8_t* refine) {
+  Impl& m = *impl_;
+  const std::size_t w = std::size_t(m.stride);
+  for (std::size_t i = 0; i < m.texels; ++i)
+    if (!refine[i]) std::copy(m.kept.begin() + std::ptrdiff_t(i * w), m.kept.begin() + std::ptrdiff_t((i + 1) * w), m.sums.begin() + std::ptrdiff_t(i * w));
+}
+
+void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, int width, int level, std::size_t per_texel) {
+  Impl& m = *impl_;
+  const MapInputs& in = m.in;
+  const Prepared& s = *in.s;
+  const HighScene& sc = *in.scene;
+  const std::size_t n = smp.count;
+  std::fill(m.sums.begin(), m.sums.end(), 0.0);
+  m.hit_point.assign(n, glm::dvec3(0.0));
+  m.hit_normal.assign(n, glm::dvec3(0.0));
+  m.bent_sum.assign(n, glm::dvec3(0.0));
+  m.open_rays.assign(n, 0);
+  m.thick_rays_cast.assign(n, 0);
+  m.thick_sum.assign(n, 0.0);
+  m.thick_sq.assign(n, 0.0);
+  if (m.ids) m.object_id.assign(n, -1), m.material_id.assign(n, -1);
+  m.seen.assign(m.texels, 0);
+  const int rays_per_texel = in.maps->ao_rays;
+  const std::size_t per_sample = std::max<std::size_t>(1, (std::size_t(rays_per_texel) + per_texel - 1) / per_texel);
+  std::size_t queued = 0;
+
+  for (std::size_t r = 0; r < n; ++r) {
+    const std::size_t i = smp.texel[r];
+    const std::size_t tri = std::size_t(smp.low_tri[r]);
+    const double b[3] = {smp.b[0][r], smp.b[1][r], smp.b[2][r]};
+    const std::uint32_t appearance = m.seen[i]++;
+    *m.at(i, s_samples) += 1.0;
+    const LowTriangle& lt = s.low_tris[tri];
+    const glm::dvec3 low_p = b[0] * lt.p[0] + b[1] * lt.p[1] + b[2] * lt.p[2];
+    glm::dvec3 low_n = b[0] * lt.n[0] + b[1] * lt.n[1] + b[2] * lt.n[2];
+    const double low_len = glm::length(low_n);
+    low_n = low_len > 0.0 ? low_n / low_len : glm::dvec3(0, 0, 1);
+    const std::uint32_t ht = smp.hit_tri[r];
+    if (ht == raycast::no_hit) {
+      if (m.has(s_object_normal))
+        for (int c = 0; c < 3; ++c) m.at(i, s_object_normal)[c] += low_n[c];
+      if (m.has(s_miss_position))
+        for (int c = 0; c < 3; ++c) m.at(i, s_miss_position)[c] += low_p[c];
+      continue;
+    }
+    // The hit: point and normal interpolated with its barycentrics; the face normal where the
+    // corner normals cancel.
+    const double w[3] = {1.0 - double(smp.u[r]) - double(smp.v[r]), double(smp.u[r]), double(smp.v[r])};
+    glm::dvec3 q[3], x(0.0), nh(0.0);
+    for (int c = 0; c < 3; ++c) {
+      q[c] = glm::dvec3(sc.positions[sc.index[3 * std::size_t(ht) + std::size_t(c)]]);
+      x += w[c] * q[c];
+      nh += w[c] * glm::dvec3(sc.normals[3 * std::size_t(ht) + std::size_t(c)]);
+    }
+    const glm::dvec3 face = glm::cross(q[1] - q[0], q[2] - q[0]);
+    double len = glm::length(nh);
+    if (!(len > 1e-12)) nh = face, len = glm::length(nh);
+    nh = len > 0.0 ? nh / len : low_n;
+    m.hit_point[r] = x;
+    m.hit_normal[r] = nh;
+    *m.at(i, s_hits) += 1.0;
+    if (m.has(s_object_normal))
+      for (int c = 0; c < 3; ++c) m.at(i, s_object_normal)[c] += nh[c];
+    if (m.has(s_height)) *m.at(i, s_height) += smp.dist[r];
+    if (m.has(s_position))
+      for (int c = 0; c < 3; ++c) m.at(i, s_position)[c] += x[c];
+    const std::uint32_t src = m.source_tri(ht);
+    if (m.has(s_curvature)) {
+      double k = 0.0;
+      for (int c = 0; c < 3; ++c) k += w[c] * double(in.curvature[sc.index[3 * std::size_t(ht) + std::size_t(c)]]);
+      *m.at(i, s_curvature) += k;
+    }
+    if (m.has(s_color) && in.high->has_colors())
+      for (int c = 0; c < 3; ++c) {
+        const glm::dvec3 col(in.high->corner_color(src, c));
+        for (int k = 0; k < 3; ++k) m.at(i, s_color)[k] += w[c] * col[k];
+      }
+    if (m.ids) {
+      m.object_id[r] = in.object ? std::int64_t(in.object[ht]) : 0;
+      m.material_id[r] = in.material.empty() ? 0 : std::int64_t(in.material[src]);
+    }
+    // Secondary rays from just off the surface, on the side the rays go to.
+    if (!m.rays_ao && !m.rays_thickness) continue;
+    const double face_len = glm::length(face);
+    glm::dvec3 ng = face_len > 0.0 ? face / face_len : nh;
+    if (glm::dot(ng, nh) < 0.0) ng = -ng;
+    const std::uint32_t group = m.ray_group.empty() ? 0u : in.groups->low[tri];
+    const std::size_t texel = std::size_t(tile_y0 + int(i / std::size_t(side))) * std::size_t(width) +
+                              std::size_t(tile_x0 + int(i % std::size_t(side)));
+    for (int kind = 0; kind < 2; ++kind) {
+      const bool thick = kind == 1;
+      if (thick ? !m.rays_thickness : !m.rays_ao) continue;
+      SampleStream stream(ray_key(texel, level, appearance, kind));
+      const glm::dvec3 axis = thick ? -nh : nh;
+      const glm::dvec3 org = x + (thick ? -in.epsilon : in.epsilon) * ng;
+      for (std::size_t j = 0; j < per_sample; ++j) {
+        const double u1 = stream.next(), u2 = stream.next();
+        const glm::dvec3 d = cosine_direction(axis, u1, u2);
+        raycast::Ray ray;
+        ray.origin = glm::vec3(org);
+        ray.direction = glm::vec3(d);
+        ray.tnear = 0.0f;
+        ray.tfar = float(thick ? in.thickness_distance : in.ao_distance);
+        m.rays.set(queued, ray);
+        m.ray_sample[queued] = std::uint32_t(r);
+        m.ray_is_thickness[queued] = thick;
+        if (!m.ray_group.empty()) m.ray_group[queued] = group;
+        if (++queued == kRayBatch) m.flush(queued), queued = 0;
+      }
+    }
+  }
+  m.flush(queued);
+
+  // Per sample: AO, bent normal and thickness into its texel, in sample order.
+  for (std::size_t r = 0; r < n; ++r) {
+    const std::size_t i = smp.texel[r];
+    const bool hit = smp.hit_tri[r] != raycast::no_hit;
+    const std::size_t tri = std::size_t(smp.low_tri[r]);
+    const double b[3] = {smp.b[0][r], smp.b[1][r], smp.b[2][r]};
+    if (m.has(s_ao) && hit) {
+      m.at(i, s_ao)[0] += double(m.open_rays[r]);
+      m.at(i, s_ao)[1] += double(per_sample);
+    }
+    if (m.has(s_thickness) && hit) {
+      m.at(i, s_thickness)[0] += m.thick_sum[r];
+      m.at(i, s_thickness)[1] += m.thick_sq[r];
+      m.at(i, s_thickness)[2] += double(m.thick_rays_cast[r]);
+    }
+    if (m.has(s_bent)) {
+      const PixelFrame frame = interpolate_frame(s.low_tris[tri].n, s.low_tris[tri].t, b, in.bitangent);
+      glm::dvec3 dir = hit ? m.bent_sum[r] : glm::dvec3(0.0);
+      if (!(glm::dot(dir, dir) > 0.0)) dir = hit ? m.hit_normal[r] : glm::dvec3(0.0);
+      glm::dvec3 v;
+      if (in.space == NormalSpace::tangent)
+        v = glm::dot(dir, dir) > 0.0 ? encode_tangent_normal(frame, dir) : glm::dvec3(0, 0, 1);
+      else {
+        if (!(glm::dot(dir, dir) > 0.0)) dir = frame.n;
+        const double l = glm::length(dir);
+        v = l > 0.0 ? dir / l : glm::dvec3(0, 0, 1);
+      }
+      for (int c = 0; c < 3; ++c) m.at(i, s_bent)[c] += v[c];
+    }
+  }
+
+  // The ID maps: per texel the index most of its hit samples take.
+  if (m.ids) {
+    for (int which = 0; which < 2; ++which) {
+      const Slot slot = which == 0 ? s_object_id : s_material_id;
+      if (!m.has(slot)) continue;
+      const std::vector<std::int64_t>& id = which == 0 ? m.object_id : m.material_id;
+      // Samples grouped by texel, in sample order (a counting sort).
+      std::vector<std::uint32_t> start(m.texels + 1, 0), order(n);
+      for (std::size_t r = 0; r < n; ++r) ++start[std::size_t(smp.texel[r]) + 1];
+      for (std::size_t t = 1; t <= m.texels; ++t) start[t] += start[t - 1];
+      std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+      for (std::size_t r = 0; r < n; ++r) order[fill[smp.texel[r]]++] = std::uint32_t(r);
+      for (std::size_t t = 0; t < m.texels; ++t) {
+        if (start[t] == start[t + 1]) continue;
+        m.vote.clear();
+        for (std::uint32_t k = start[t]; k < start[t + 1]; ++k)
+          if (id[order[k]] >= 0) m.vote.push_back(id[order[k]]);
+        *m.at(t, slot) = most_frequent(m.vote);
+      }
+    }
+  }
+}
+
+void TexelMaps::write(MapTargets& out, int x0, int y0, int w, int h, int side, int width) const {
+  const Impl& m = *impl_;
+  const MapOptions& maps = *m.in.maps;
+  const bool flip_y = m.in.space == NormalSpace::tangent && m.in.green_down;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = std::size_t(y) * std::size_t(side) + std::size_t(x);
+      const double samples = *m.at(i, s_samples);
+      if (samples <= 0.0) continue;
+      const double hits = *m.at(i, s_hits);
+      const std::size_t g = std::size_t(y0 + y) * std::size_t(width) + std::size_t(x0 + x);
+      for (std::size_t k = 0; k < maps.maps.size(); ++k) {
+        const MapKind kind = maps.maps[k];
+        if (kind == MapKind::normal) continue;
+        const Slot slot = slot_of(kind);
+        if (slot == kSlots) continue;
+        Image& img = out.raw[k];
+        float* px = &img.pixels[g * std::size_t(img.channels)];
+        const double* v = m.at(i, slot);
+        switch (kind) {
+          case MapKind::object_normal:
+          case MapKind::bent_normal: {
+            const double len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+            glm::dvec3 n = len > 0.0 ? glm::dvec3(v[0], v[1], v[2]) / len : glm::dvec3(0, 0, 1);
+            if (kind == MapKind::bent_normal && flip_y) n.y = -n.y;
+            for (int c = 0; c < 3; ++c) px[c] = float(n[c]);
+            break;
+          }
+          case MapKind::height:
+          case MapKind::curvature:
+            px[0] = float(hits > 0.0 ? v[0] / hits : 0.0);
+            break;
+          case MapKind::position: {
+            const double* miss = m.at(i, s_miss_position);
+            for (int c = 0; c < 3; ++c) px[c] = float(hits > 0.0 ? v[c] / hits : miss[c] / samples);
+            break;
+          }
+          case MapKind::vertex_color:
+            for (int c = 0; c < 3; ++c) px[c] = float(hits > 0.0 ? v[c] / hits : 0.0);
+            break;
+          case MapKind::ao: {
+            const double rays = v[1], p = rays > 0.0 ? v[0] / rays : kMissAo;
+            px[0] = float(p);
+            out.ao_error.pixels[g] = float(rays > 1.0 ? std::sqrt(p * (1.0 - p) / (rays - 1.0)) : 0.0);
+            break;
+          }
+          case MapKind::thickness: {
+            const double rays = v[2], mean = rays > 0.0 ? v[0] / rays : kMissThickness;
+            px[0] = float(mean);
+            const double var = rays > 1.0 ? std::max(0.0, (v[1] - rays * mean * mean) / (rays - 1.0)) : 0.0;
+            out.thickness_error.pixels[g] = float(rays > 1.0 ? std::sqrt(var / rays) : 0.0);
+            break;
+          }
+          case MapKind::object_id:
+          case MapKind::material_id:
+            for (int c = 0; c < 3; ++c) px[c] = float(v[0]);
+            break;
+          default:
+            break;
+        }
+      }
+    }
+}
+
+}  // namespace nmbake
