@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <map>
 #include <random>
 #include <utility>
@@ -231,6 +232,18 @@ TEST(Curvature, DegenerateFacesAndIsolatedVerticesStayFinite) {
   EXPECT_GE(st.duplicate_faces, 1u);
   EXPECT_GE(st.unvalued_vertices, 1u);
   for (std::size_t i = 0; i < h.size(); ++i) EXPECT_NEAR(h[i], 0.0, 1e-6) << "vertex " << i;
+}
+
+TEST(Curvature, NonFiniteCornersAreIgnored) {
+  // A grid with one vertex moved to NaN and another to infinity: their faces count for nothing,
+  // the vertices themselves get 0, and the rest of the flat grid stays 0.
+  Mesh m = make_grid(6, 6);
+  m.positions[10].z = std::numeric_limits<float>::quiet_NaN();
+  m.positions[30].x = std::numeric_limits<float>::infinity();
+  CurvatureStats st;
+  const std::vector<float> h = vertex_mean_curvature(m, CurvatureOptions{2}, &st);
+  EXPECT_EQ(st.degenerate_faces, 12u);  // six faces around each, neither on the grid's border
+  for (std::size_t i = 0; i < h.size(); ++i) EXPECT_EQ(h[i], 0.0f) << "vertex " << i;
 }
 
 TEST(Curvature, NeedleAndCapTrianglesStayBounded) {
