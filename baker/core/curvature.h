@@ -20,7 +20,8 @@ namespace nmbake {
 struct CurvatureOptions {
   // Passes of area-weighted averaging over the welded mesh, for noisy scans and sculpts; 0 = none.
   // Each pass gives every vertex the area-weighted mean of its faces' values (a face's value: the
-  // mean of its corners'), so n passes reach n rings of neighbours. A constant field is kept.
+  // mean of its corners'), so n passes reach n rings of neighbours (a reach in rings, not in scene
+  // units: a denser mesh needs more passes for the same width). A constant field is kept. Negative: 0.
   int smoothing = 0;
 };
 
