@@ -277,6 +277,37 @@ TEST(MapsIds, TwoMaterialsGiveTwoFlatColours) {
   EXPECT_EQ(id_color("paint"), id_color("paint"));  // from the name alone
 }
 
+// Curvature from the high-poly's geometry: a plane 0.5; a sphere uniform and above it; the inside
+// of a cylinder below it.
+TEST(MapsCurvature, PlaneSphereAndTheInsideOfACylinder) {
+  const Mesh plane = test::make_grid(8, 8);
+  const BakeResult flat = bake_normal_map(plane, plane, nullptr, options(16, {MapKind::curvature}, 0.1f, 0.1f));
+  for (float v : baked(flat, MapKind::curvature).image.pixels) EXPECT_EQ(v, 0.5f);
+
+  const Mesh sphere = uv_sphere(64, 32, {0, 0, 0});
+  BakeOptions o = options(64, {MapKind::curvature}, 0.05f, 0.05f);
+  o.maps.curvature_scale = 2.0;  // mean curvature 1 (radius 1): 0.75
+  const BakeResult round = bake_normal_map(sphere, sphere, nullptr, o);
+  const Image& k = baked(round, MapKind::curvature).image;
+  for (int y = 8; y < 56; ++y)  // away from the poles' fans
+    for (int x = 0; x < 64; ++x) EXPECT_NEAR(k.pixels[std::size_t(y) * 64 + std::size_t(x)], 0.75, 0.01) << x << "," << y;
+
+  // A cylinder of radius 1 seen from inside (wound and lit inwards): mean curvature -1/2.
+  Mesh tube = uv_sphere(64, 8, {0, 0, 0});
+  for (std::size_t i = 0; i < tube.positions.size(); ++i) {
+    const double a = std::atan2(tube.positions[i].y, tube.positions[i].x);
+    const float z = 2.0f * (tube.uvs[i].y - 0.5f);
+    tube.positions[i] = {float(std::cos(a)), float(std::sin(a)), z};
+    tube.normals[i] = {float(-std::cos(a)), float(-std::sin(a)), 0.0f};
+  }
+  for (std::size_t t = 0; t < tube.triangle_count(); ++t) std::swap(tube.position_index[3 * t + 1], tube.position_index[3 * t + 2]);
+  tube.normal_index = tube.uv_index = tube.position_index;
+  const BakeResult inside = bake_normal_map(tube, tube, nullptr, o);
+  const Image& c = baked(inside, MapKind::curvature).image;
+  for (int y = 16; y < 48; ++y)
+    for (int x = 0; x < 64; ++x) EXPECT_NEAR(c.pixels[std::size_t(y) * 64 + std::size_t(x)], 0.5 - 0.125, 0.01) << x << "," << y;
+}
+
 // Every map the same whatever the thread count.
 TEST(MapsThreads, IdenticalAcrossThreadCounts) {
   const Mesh low = test::make_torus(24, 12), high = test::make_torus(96, 48);
