@@ -155,8 +155,8 @@ struct OutOfMemory : std::bad_alloc {
 
 enum class BuildQuality { low, medium, high };
 
-// Options of Scene::occluded.
-struct OcclusionOptions {
+// Options of the secondary rays' queries (Scene::occluded, Scene::first_hit_distance).
+struct SecondaryRayOptions {
   // Per triangle, its group (as HitRule::group), or null: one group. With groups, ray i sees only
   // the triangles of group RayBatch::group[i] (every ray group 0 when RayBatch::group is null).
   const std::uint32_t* group = nullptr;
@@ -185,14 +185,26 @@ class Scene {
   Hit intersect(const Ray& ray, const HitRule& rule, bool outward = false, std::uint8_t* flags = nullptr, float prefer_lo = 0.0f,
                 float prefer_hi = std::numeric_limits<float>::infinity(), std::uint32_t group = 0) const;
 
-  // Occlusion (ambient occlusion's rays): occluded[i] = 1 when some triangle of ray i's group, of
-  // either facing, crosses the ray at a t with tnear < t < tfar, else 0 (t in units of
+  // The secondary rays of a bake's texel maps: many rays from each of many nearby points, in all
+  // directions (ambient occlusion, bent normals, thickness). Both calls trace them as incoherent
+  // streams, which is fastest given thousands of rays a call (a tile's worth; bench_occlusion).
+  // Of RayBatch only the eight ray arrays and `group` are read (`coherent`, `order`, `outward` and
+  // the preferred part are not). Both are thread-safe.
+  //
+  // Occlusion (ambient occlusion, bent normals): occluded[i] = 1 when some triangle of ray i's
+  // group, of either facing, crosses the ray at a t with tnear < t < tfar, else 0 (t in units of
   // |direction|). Ties: a ray that meets a triangle only on its boundary (an edge or corner, or the
   // rim of a mesh with holes), or at t within rounding of tnear or tfar, may go either way; a ray
-  // through an edge two triangles share counts as occluded (Embree's watertight test). Of RayBatch
-  // only the eight ray arrays and `group` are read (`coherent`, `order`, `outward` and the
-  // preferred part are not). `occluded` holds `count` bytes. Thread-safe.
-  void occluded(const RayBatch& rays, std::uint8_t* occluded, std::size_t count, const OcclusionOptions& options = {}) const;
+  // through an edge or vertex two triangles share counts as occluded (Embree's robust test; the
+  // tests check it on a grid). A ray with tnear > tfar is not occluded. `occluded`: `count` bytes.
+  void occluded(const RayBatch& rays, std::uint8_t* occluded, std::size_t count, const SecondaryRayOptions& options = {}) const;
+  // Thickness: t[i] = the distance of ray i's first crossing of a triangle of its group, of either
+  // facing, in (tnear, tfar), or tfar when there is none: min(distance, tfar). The same distance as
+  // intersect() gives without a rule, or under HitRule{.skip_backfaces = false} with groups (up to
+  // the last bit: Embree's stream and packet paths round alike but are not promised to), at about
+  // twice intersect()'s speed under that rule. A ray with tnear > tfar gets its tfar. `t`: `count`
+  // floats.
+  void first_hit_distance(const RayBatch& rays, float* t, std::size_t count, const SecondaryRayOptions& options = {}) const;
 
   std::size_t triangle_count() const;
 
