@@ -287,9 +287,9 @@ double run_lane(const Lane& lane, const Rays& r, std::uint8_t* out, int threads,
 
 // Thickness's rays (inverted normals, from just under the surface): the first hit's distance by
 // rtcIntersect1 per ray (default scene), by Scene::intersect without a rule, under a rule that
-// keeps back faces (skip_backfaces = false) and under that rule with groups (all 0), and by
-// Scene::first_hit_distance with and without groups. Distances compared to the bare loop's within
-// 1e-5 (relative): the default scene rounds differently from the robust one.
+// keeps back faces (skip_backfaces = false) and under that rule with groups (all 0). Distances
+// compared to the bare loop's within 1e-5 (relative): the default scene rounds differently from
+// the robust one.
 void thickness(const Mesh& high, const Args& args, RTCScene bare, const raycast::Scene& scene, std::size_t chunk) {
   double diagonal = 0;
   const Rays r = make_rays(high, args, true, diagonal);
@@ -332,17 +332,6 @@ void thickness(const Mesh& high, const Args& args, RTCScene bare, const raycast:
   rows.push_back({"Scene::intersect, no rule", with(nullptr, false), 1e30, {}});
   rows.push_back({"Scene::intersect, HitRule{skip_backfaces = false}", with(&keep, false), 1e30, {}});
   rows.push_back({"Scene::intersect, that rule with groups (all 0)", with(&grouped, true), 1e30, {}});
-  auto distance = [&](bool groups) -> Cast {
-    return [&, groups](std::size_t first, std::size_t n) {
-      raycast::RayBatch b = r.batch(first);
-      raycast::SecondaryRayOptions o;
-      if (groups) b.group = ray_group.data() + first, o.group = tri_group.data();
-      scene.first_hit_distance(b, t.data() + first, n, o);
-      for (std::size_t k = first; k < first + n; ++k) tri[k] = t[k] < r.tfar[k] ? 0u : raycast::no_hit;
-    };
-  };
-  rows.push_back({"Scene::first_hit_distance", distance(false), 1e30, {}});
-  rows.push_back({"Scene::first_hit_distance, groups (all 0)", distance(true), 1e30, {}});
   for (int round = 0; round < args.rounds; ++round)
     for (Row& row : rows) {
       std::atomic<std::size_t> next{0};

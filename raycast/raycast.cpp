@@ -443,8 +443,8 @@ void Scene::intersect(const RayBatch& rays, const HitBatch& hits, std::size_t co
 
 namespace {
 
-// The fields of an Embree ray stream (RTCRayNp) that Scene's secondary rays do not carry, for a
-// block of up to `size` rays: Embree writes tfar (and, intersecting, the hit), reads the rest.
+// The fields of an Embree ray stream (RTCRayNp) that a RayBatch does not carry, for a block of up
+// to `size` rays: Embree writes tfar, reads the rest.
 struct StreamBlock {
   static constexpr std::size_t size = 1024;
   alignas(64) float tfar[size], time[size];
@@ -482,9 +482,10 @@ struct StreamBlock {
 void Scene::occluded(const RayBatch& rays, std::uint8_t* occluded, std::size_t count, const SecondaryRayOptions& options) const {
   // One incoherent stream of arrays per block (rtcOccludedNp): Embree sorts the block's rays by
   // the octant of their direction and traces each octant's rays (up to 64) together, which on
-  // AO's rays beat every other entry point (bench_occlusion --variants, suz_L4 x4, one core:
-  // about 1.5 times rtcOccluded8's rays per second, incoherent, 1.4 times rtcOccluded1's, 3 times
-  // packets under the coherent flag, octant-sorted or not; rtcOccluded1M about the same).
+  // AO's rays beat every other entry point (bench_occlusion --variants, suz_L4 x4, one core: 1.35
+  // times rtcOccluded8's rays per second (incoherent), 1.45 times rtcOccluded1's in the same
+  // robust scene, 2 to 2.7 times packets of 8 or 16 under the coherent flag, octant-sorted or
+  // not; rtcOccluded1M the same within noise).
   StreamBlock block;
   GroupContext gc(options.group);
   gc.context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
@@ -496,33 +497,6 @@ void Scene::occluded(const RayBatch& rays, std::uint8_t* occluded, std::size_t c
     rtcOccludedNp(impl_->scene, &gc.context, &r, unsigned(n));
     // Embree sets tfar to -inf when occluded; a ray it skips (tnear > tfar) keeps its own.
     for (std::size_t k = 0; k < n; ++k) occluded[base + k] = block.tfar[k] == minus_inf && rays.tfar[base + k] != minus_inf;
-  }
-}
-
-void Scene::first_hit_distance(const RayBatch& rays, float* t, std::size_t count, const SecondaryRayOptions& options) const {
-  // As occluded(): incoherent streams (rtcIntersectNp). Embree sets tfar to the hit's t, or leaves
-  // it when there is none.
-  StreamBlock block;
-  alignas(64) float ng[3][StreamBlock::size], u[StreamBlock::size], v[StreamBlock::size];
-  alignas(64) unsigned prim[StreamBlock::size], geom[StreamBlock::size], inst[StreamBlock::size];
-  GroupContext gc(options.group);
-  gc.context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
-  for (std::size_t base = 0; base < count; base += StreamBlock::size) {
-    const std::size_t n = std::min(StreamBlock::size, count - base);
-    RTCRayHitNp rh;
-    rh.ray = block.rays(rays, base, n);
-    for (std::size_t k = 0; k < n; ++k) geom[k] = inst[k] = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.Ng_x = ng[0];
-    rh.hit.Ng_y = ng[1];
-    rh.hit.Ng_z = ng[2];
-    rh.hit.u = u;
-    rh.hit.v = v;
-    rh.hit.primID = prim;
-    rh.hit.geomID = geom;
-    rh.hit.instID[0] = inst;
-    gc.ray_group = rays.group ? rays.group + base : nullptr;
-    rtcIntersectNp(impl_->scene, &gc.context, &rh, unsigned(n));
-    std::memcpy(t + base, block.tfar, n * sizeof(float));
   }
 }
 
