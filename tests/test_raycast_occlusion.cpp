@@ -174,6 +174,10 @@ void expect_matches_reference(const Soup& s, const std::vector<raycast::Ray>& ra
   raycast::SecondaryRayOptions options;
   options.group = triangle_group;
   const std::vector<std::uint8_t> got = occluded(scene, rays, options, ray_group.empty() ? nullptr : ray_group.data());
+  // The project's brute-force ReferenceIntersector (nearest hit in [tnear, tfar], one group) agrees
+  // with the verdicts off ties too.
+  const raycast::ReferenceIntersector project_reference(s.positions.data(), s.positions.size() / 3, s.indices.data(),
+                                                        s.triangles());
   int ties = 0, hits = 0;
   for (std::size_t i = 0; i < rays.size(); ++i) {
     ASSERT_LE(got[i], 1) << "ray " << i;
@@ -183,6 +187,9 @@ void expect_matches_reference(const Soup& s, const std::vector<raycast::Ray>& ra
       continue;
     }
     EXPECT_EQ(got[i], v.occlusion == Verdict::blocked ? 1 : 0) << "ray " << i;
+    if (!triangle_group) {
+      EXPECT_EQ(got[i], project_reference.intersect(rays[i]).hit() ? 1 : 0) << "ray " << i;
+    }
     hits += got[i];
   }
   EXPECT_LE(ties, int(rays.size()) / 200) << "too many ties for the comparison to mean much";
