@@ -196,6 +196,28 @@ bool one_octant(const RTCRayHit8& rh) {
   return true;
 }
 
+// The context of Scene::occluded under groups: its filter rejects the triangles of other groups.
+// A ray's id is its index in the block being traced.
+struct GroupContext {
+  RTCIntersectContext context;  // first: the filter receives a pointer to it
+  const std::uint32_t* triangle_group;
+  const std::uint32_t* ray_group = nullptr;  // the block's rays' groups, or null: all 0
+
+  explicit GroupContext(const std::uint32_t* tg) : triangle_group(tg) {
+    rtcInitIntersectContext(&context);
+    context.filter = tg ? &filter : nullptr;
+  }
+  static void filter(const RTCFilterFunctionNArguments* args) {
+    const GroupContext& gc = *reinterpret_cast<const GroupContext*>(args->context);
+    const unsigned n = args->N;
+    for (unsigned i = 0; i < n; ++i) {
+      if (args->valid[i] != -1) continue;
+      const std::uint32_t group = gc.ray_group ? gc.ray_group[RTCRayN_id(args->ray, n, i)] : 0u;
+      if (gc.triangle_group[RTCHitN_primID(args->hit, n, i)] != group) args->valid[i] = 0;
+    }
+  }
+};
+
 }  // namespace
 
 RayArrays::RayArrays(std::size_t count) : count_(count), fields_(11 * count), triangle_(count, no_hit), flags_(count, 0) {}
@@ -416,6 +438,65 @@ void Scene::intersect(const RayBatch& rays, const HitBatch& hits, std::size_t co
         hits.v[i] = rh.hit.v[k];
       }
     }
+  }
+}
+
+namespace {
+
+// The fields of an Embree ray stream (RTCRayNp) that a RayBatch does not carry, for a block of up
+// to `size` rays: Embree writes tfar, reads the rest.
+struct StreamBlock {
+  static constexpr std::size_t size = 1024;
+  alignas(64) float tfar[size], time[size];
+  alignas(64) unsigned mask[size], id[size], flags[size];
+  StreamBlock() {
+    for (std::size_t k = 0; k < size; ++k) {
+      time[k] = 0.0f;
+      mask[k] = 0xffffffffu;
+      id[k] = unsigned(k);  // for the group filter
+      flags[k] = 0;
+    }
+  }
+  // Rays base .. base + n - 1 of `rays`, tfar copied here.
+  RTCRayNp rays(const RayBatch& rays, std::size_t base, std::size_t n) {
+    std::memcpy(tfar, rays.tfar + base, n * sizeof(float));
+    RTCRayNp r;  // Embree only reads through the const_casts
+    r.org_x = const_cast<float*>(rays.org_x + base);
+    r.org_y = const_cast<float*>(rays.org_y + base);
+    r.org_z = const_cast<float*>(rays.org_z + base);
+    r.dir_x = const_cast<float*>(rays.dir_x + base);
+    r.dir_y = const_cast<float*>(rays.dir_y + base);
+    r.dir_z = const_cast<float*>(rays.dir_z + base);
+    r.tnear = const_cast<float*>(rays.tnear + base);
+    r.tfar = tfar;
+    r.time = time;
+    r.mask = mask;
+    r.id = id;
+    r.flags = flags;
+    return r;
+  }
+};
+
+}  // namespace
+
+void Scene::occluded(const RayBatch& rays, std::uint8_t* occluded, std::size_t count, const SecondaryRayOptions& options) const {
+  // One incoherent stream of arrays per block (rtcOccludedNp): Embree sorts the block's rays by
+  // the octant of their direction and traces each octant's rays (up to 64) together, which on
+  // AO's rays beat every other entry point (bench_occlusion --variants, suz_L4 x4, one core: 1.35
+  // times rtcOccluded8's rays per second (incoherent), 1.45 times rtcOccluded1's in the same
+  // robust scene, 2 to 2.7 times packets of 8 or 16 under the coherent flag, octant-sorted or
+  // not; rtcOccluded1M the same within noise).
+  StreamBlock block;
+  GroupContext gc(options.group);
+  gc.context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+  constexpr float minus_inf = -std::numeric_limits<float>::infinity();
+  for (std::size_t base = 0; base < count; base += StreamBlock::size) {
+    const std::size_t n = std::min(StreamBlock::size, count - base);
+    RTCRayNp r = block.rays(rays, base, n);
+    gc.ray_group = rays.group ? rays.group + base : nullptr;
+    rtcOccludedNp(impl_->scene, &gc.context, &r, unsigned(n));
+    // Embree sets tfar to -inf when occluded; a ray it skips (tnear > tfar) keeps its own.
+    for (std::size_t k = 0; k < n; ++k) occluded[base + k] = block.tfar[k] == minus_inf && rays.tfar[base + k] != minus_inf;
   }
 }
 

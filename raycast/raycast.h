@@ -155,6 +155,13 @@ struct OutOfMemory : std::bad_alloc {
 
 enum class BuildQuality { low, medium, high };
 
+// Options of Scene::occluded.
+struct SecondaryRayOptions {
+  // Per triangle, its group (as HitRule::group), or null: one group. With groups, ray i sees only
+  // the triangles of group RayBatch::group[i] (every ray group 0 when RayBatch::group is null).
+  const std::uint32_t* group = nullptr;
+};
+
 class Scene {
  public:
   // positions: vertex_count xyz triples; indices: triangle_count index triples. Copied, unless
@@ -177,6 +184,26 @@ class Scene {
   // Single rays under a rule (`outward` as in RayBatch); `flags` receives the HitFlags when not null.
   Hit intersect(const Ray& ray, const HitRule& rule, bool outward = false, std::uint8_t* flags = nullptr, float prefer_lo = 0.0f,
                 float prefer_hi = std::numeric_limits<float>::infinity(), std::uint32_t group = 0) const;
+
+  // The secondary rays of a bake's texel maps: many rays from each of many nearby points, in all
+  // directions (ambient occlusion, bent normals, thickness).
+  //
+  // Occlusion (ambient occlusion, bent normals), traced as incoherent streams, the fastest way
+  // given thousands of rays a call (a tile's worth; bench_occlusion): occluded[i] = 1 when some
+  // triangle of ray i's group, of either facing, crosses the ray at a t with tnear < t < tfar,
+  // else 0 (t in units of |direction|). Ties: a ray that meets a triangle only on its boundary (an edge or corner, or the
+  // rim of a mesh with holes), or at t within rounding of tnear or tfar, may go either way; a ray
+  // through an edge or vertex two triangles share counts as occluded (Embree's robust test; the
+  // tests check it on a grid). A ray with tnear > tfar is not occluded. Of RayBatch only the eight
+  // ray arrays and `group` are read (`coherent`, `order`, `outward` and the preferred part are
+  // not). `occluded`: `count` bytes. Thread-safe.
+  //
+  // Thickness (the first crossing's distance, either facing): intersect(RayBatch, ...) without a
+  // rule gives it, and with groups under HitRule{.skip_backfaces = false, .group = ...} (no facing,
+  // no corner normals), RayBatch::group per ray; a miss stands for tfar (thickness's min(distance,
+  // D) with tfar = D). A stream entry point for it (rtcIntersectNp) measured no faster than
+  // intersect's packets (bench_occlusion --variants), so there is none.
+  void occluded(const RayBatch& rays, std::uint8_t* occluded, std::size_t count, const SecondaryRayOptions& options = {}) const;
 
   std::size_t triangle_count() const;
 

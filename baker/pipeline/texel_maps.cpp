@@ -52,10 +52,13 @@ Slot slot_of(MapKind k) {
   }
 }
 
-// A 64-bit key for a texel's sample's secondary rays.
-std::uint64_t ray_key(std::size_t texel, int level, std::size_t sample, int stream) {
-  return ((std::uint64_t(texel) * 8u + std::uint64_t(level)) * 65536u + std::uint64_t(sample)) * 4u + std::uint64_t(stream);
-}
+// Secondary rays queued for one cast: per ray its sample, and with match groups its group.
+struct RayQueue {
+  raycast::RayArrays rays{kRayBatch};
+  std::vector<std::uint32_t> sample = std::vector<std::uint32_t>(kRayBatch), group;
+  std::vector<std::uint8_t> occluded = std::vector<std::uint8_t>(kRayBatch);
+  std::size_t n = 0;
+};
 
 // The most frequent of ids[0..n) (ties: the smallest); -1 when n is 0.
 double most_frequent(std::vector<std::int64_t>& ids) {
@@ -93,9 +96,7 @@ struct TexelMaps::Impl {
   std::vector<glm::dvec3> hit_point, hit_normal, bent_sum;
   std::vector<std::uint32_t> open_rays, thick_rays_cast;
   std::vector<std::int64_t> object_id, material_id;
-  raycast::RayArrays rays{kRayBatch};
-  std::vector<std::uint32_t> ray_sample, ray_group;
-  std::vector<std::uint8_t> ray_is_thickness;
+  RayQueue queue[2];  // AO's (occlusion only), thickness's (first hits)
   std::vector<double> thick_sum, thick_sq;
   std::vector<std::uint32_t> seen;
   std::vector<std::int64_t> vote;
@@ -119,9 +120,8 @@ struct TexelMaps::Impl {
     rays_ao = in.maps->wants(MapKind::ao) || in.maps->wants(MapKind::bent_normal);
     rays_thickness = in.maps->wants(MapKind::thickness);
     ids = in.maps->wants(MapKind::object_id) || in.maps->wants(MapKind::material_id);
-    ray_sample.resize(kRayBatch);
-    ray_is_thickness.resize(kRayBatch);
-    if (in.groups && in.groups->active()) ray_group.resize(kRayBatch);
+    if (in.groups && in.groups->active())
+      for (RayQueue& q : queue) q.group.resize(kRayBatch);
   }
 
   double* at(std::size_t texel, Slot s) { return &sums[texel * std::size_t(stride) + std::size_t(offset[s])]; }
@@ -130,29 +130,39 @@ struct TexelMaps::Impl {
 
   std::uint32_t source_tri(std::uint32_t t) const { return in.source ? in.source[t] : t; }
 
-  // Casts the queued rays and adds their results to their samples.
-  void flush(std::size_t n) {
-    if (n == 0) return;
-    raycast::RayBatch batch = rays.rays();
-    batch.group = ray_group.empty() ? nullptr : ray_group.data();
-    raycast::HitRule rule;
-    rule.skip_backfaces = false;
-    rule.group = in.groups && in.groups->active() && !in.maps->ao_occluders_all ? in.groups->high.data() : nullptr;
-    in.scene->scene->intersect(batch, rays.hits(), n, rule.group ? &rule : nullptr);
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::size_t r = ray_sample[i];
-      const raycast::Hit h = rays.hit(i);
-      if (ray_is_thickness[i]) {
+  // Casts queue `k`'s rays (0: AO's, occlusion; 1: thickness's, first hits of either facing) and
+  // adds their results to their samples, in queue order.
+  void flush(int k) {
+    RayQueue& q = queue[k];
+    if (q.n == 0) return;
+    raycast::RayBatch batch = q.rays.rays();
+    batch.group = q.group.empty() ? nullptr : q.group.data();
+    const std::uint32_t* groups = in.groups && in.groups->active() && !in.maps->ao_occluders_all ? in.groups->high.data() : nullptr;
+    if (k == 0) {
+      raycast::SecondaryRayOptions so;
+      so.group = groups;
+      in.scene->scene->occluded(batch, q.occluded.data(), q.n, so);
+      for (std::size_t i = 0; i < q.n; ++i) {
+        if (q.occluded[i]) continue;
+        const std::size_t r = q.sample[i];
+        ++open_rays[r];
+        bent_sum[r] += glm::dvec3(q.rays.direction(0)[i], q.rays.direction(1)[i], q.rays.direction(2)[i]);
+      }
+    } else {
+      raycast::HitRule rule;
+      rule.skip_backfaces = false;
+      rule.group = groups;
+      in.scene->scene->intersect(batch, q.rays.hits(), q.n, groups ? &rule : nullptr);
+      for (std::size_t i = 0; i < q.n; ++i) {
+        const std::size_t r = q.sample[i];
+        const raycast::Hit h = q.rays.hit(i);
         const double d = h.hit() ? std::min(1.0, double(h.t) / in.thickness_distance) : 1.0;
         thick_sum[r] += d;
         thick_sq[r] += d * d;
         ++thick_rays_cast[r];
-      } else if (!h.hit()) {
-        const raycast::Ray ray = rays.ray(i);
-        ++open_rays[r];
-        bent_sum[r] += glm::dvec3(ray.direction);
       }
     }
+    q.n = 0;
   }
 };
 
@@ -186,7 +196,6 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
   m.seen.assign(m.texels, 0);
   const int rays_per_texel = in.maps->ao_rays;
   const std::size_t per_sample = std::max<std::size_t>(1, (std::size_t(rays_per_texel) + per_texel - 1) / per_texel);
-  std::size_t queued = 0;
 
   for (std::size_t r = 0; r < n; ++r) {
     const std::size_t i = smp.texel[r];
@@ -248,13 +257,14 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
     const double face_len = glm::length(face);
     glm::dvec3 ng = face_len > 0.0 ? face / face_len : nh;
     if (glm::dot(ng, nh) < 0.0) ng = -ng;
-    const std::uint32_t group = m.ray_group.empty() ? 0u : in.groups->low[tri];
+    const std::uint32_t group = m.queue[0].group.empty() ? 0u : in.groups->low[tri];
     const std::size_t texel = std::size_t(tile_y0 + int(i / std::size_t(side))) * std::size_t(width) +
                               std::size_t(tile_x0 + int(i % std::size_t(side)));
     for (int kind = 0; kind < 2; ++kind) {
       const bool thick = kind == 1;
       if (thick ? !m.rays_thickness : !m.rays_ao) continue;
-      SampleStream stream(ray_key(texel, level, appearance, kind));
+      SampleStream stream(sample_key(texel, std::uint64_t(level) << 32 | appearance, std::uint64_t(kind)));
+      RayQueue& queue = m.queue[kind];
       const glm::dvec3 axis = thick ? -nh : nh;
       const glm::dvec3 org = x + (thick ? -in.epsilon : in.epsilon) * ng;
       for (std::size_t j = 0; j < per_sample; ++j) {
@@ -265,15 +275,15 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
         ray.direction = glm::vec3(d);
         ray.tnear = 0.0f;
         ray.tfar = float(thick ? in.thickness_distance : in.ao_distance);
-        m.rays.set(queued, ray);
-        m.ray_sample[queued] = std::uint32_t(r);
-        m.ray_is_thickness[queued] = thick;
-        if (!m.ray_group.empty()) m.ray_group[queued] = group;
-        if (++queued == kRayBatch) m.flush(queued), queued = 0;
+        queue.rays.set(queue.n, ray);
+        queue.sample[queue.n] = std::uint32_t(r);
+        if (!queue.group.empty()) queue.group[queue.n] = group;
+        if (++queue.n == kRayBatch) m.flush(kind);
       }
     }
   }
-  m.flush(queued);
+  m.flush(0);
+  m.flush(1);
 
   // Per sample: AO, bent normal and thickness into its texel, in sample order.
   for (std::size_t r = 0; r < n; ++r) {
