@@ -13,6 +13,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -382,6 +383,29 @@ TEST(MeshIoMaterials, GltfPartialColoursAreDroppedAndNonFiniteRefused) {
   expect_error(dir + "/nan_color.glb", {"vertex 3", "non-finite colour"});
 }
 
+// glTF primitives: one of an unnamed material, one of a named one, one without a material (Assimp
+// gives it an unnamed material of its own, after the file's).
+TEST(MeshIoMaterials, GltfUnnamedMaterialsAndPrimitivesWithoutOne) {
+  const std::string buffer = "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA";
+  const std::string head =
+      R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
+      R"("buffers":[{"byteLength":36,"uri":")" +
+      buffer +
+      R"("}],"bufferViews":[{"buffer":0,"byteLength":36}],)"
+      R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],)";
+  const std::string three =
+      head + R"("materials":[{},{"name":"named"}],"meshes":[{"primitives":[{"attributes":{"POSITION":0},"material":0},)"
+             R"({"attributes":{"POSITION":0},"material":1},{"attributes":{"POSITION":0}}]}]})";
+  const Mesh m = load_mesh_from_memory("three.gltf", three);
+  ASSERT_EQ(m.triangle_count(), 3u);
+  EXPECT_EQ(triangle_materials(m), (std::vector<std::string>{"material 0", "named", ""}));
+  // A file without materials has none, though Assimp gives its primitives one.
+  const std::string none = head + R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}]})";
+  const Mesh n = load_mesh_from_memory("none.gltf", none);
+  EXPECT_EQ(n.triangle_count(), 1u);
+  EXPECT_EQ(n.material_count(), 0u);
+}
+
 // merge_meshes ------------------------------------------------------------------------------------------
 
 TEST(MeshIoMaterials, MergeUnitesMaterialsByNameAndKeepsColoursOfAll) {
@@ -418,6 +442,77 @@ TEST(MeshIoMaterials, MergeUnitesMaterialsByNameAndKeepsColoursOfAll) {
   const Mesh cc = merge_meshes({c, c});
   EXPECT_EQ(cc.materials, (std::vector<std::string>{"red"}));
   EXPECT_TRUE(cc.triangle_material.empty());
+}
+
+// Hostile input -------------------------------------------------------------------------------------
+
+// What load_mesh promises of the new arrays (mesh.h), on a mesh it returned.
+void expect_consistent(const Mesh& m, const std::string& what) {
+  const std::size_t tris = m.triangle_count();
+  if (m.has_colors()) {
+    ASSERT_EQ(m.color_index.size(), 3 * tris) << what;
+    for (std::uint32_t i : m.color_index) ASSERT_LT(i, m.colors.size()) << what;
+    for (const glm::vec4& c : m.colors)
+      for (int k = 0; k < 4; ++k) ASSERT_TRUE(c[k] >= 0.0f && c[k] <= 1.0f) << what << ": colour value " << c[k];
+  } else {
+    EXPECT_TRUE(m.colors.empty()) << what;
+  }
+  if (!m.triangle_material.empty()) {
+    ASSERT_EQ(m.triangle_material.size(), tris) << what;
+    ASSERT_GE(m.material_count(), 2u) << what;
+    for (std::uint32_t k : m.triangle_material) ASSERT_LT(k, m.material_count()) << what;
+  }
+  if (m.material_count() == 1) {
+    EXPECT_FALSE(m.materials[0].empty()) << what;
+  }
+}
+
+// Files with colours and materials with bytes overwritten, cut or repeated (fixed seed): each
+// loads with consistent arrays or is refused with an InputError, never anything else.
+TEST(MeshIoMaterials, MutatedFilesLoadConsistentOrAreRefused) {
+  const std::vector<Rgba> stored = {{255, 0, 0, 255}, {0, 51, 0, 153}, {0, 0, 255, 0}, {102, 102, 102, 255}};
+  const std::vector<Rgba> unit = {{1, 0, 0, 1}, {0, 0.2, 0, 0.6}, {0, 0, 1, 0}, {0.4, 0.4, 0.4, 1}};
+  const std::pair<std::string, std::string> seeds[] = {
+      {"m.obj",
+       "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 1 1 0 0 0 1 0.5\nv 0 1 0 1 1 1\nusemtl a\nf 1 2 3\nusemtl b\nf 1 3 4\n"
+       "usemtl a\nf 4 3 2 1\n"},
+      {"m.ply", quad_ply("ascii", "uchar", stored, true)},
+      {"m.ply", quad_ply("binary_little_endian", "uchar", stored, false)},
+      {"m.ply", quad_ply("binary_little_endian", "float", unit, true)},
+      {"m.ply", quad_ply("binary_big_endian", "ushort", stored, true)},
+  };
+  std::uint64_t state = 12111;
+  auto next = [&](std::uint64_t n) {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return (state >> 33) % n;
+  };
+  const char junk[] = {'0', '9', '-', '.', 'e', ' ', '\n', 'n', 'a', 'f', '#', '\0', '\xff', '\x7f', '3', '1'};
+  int loaded = 0, refused = 0;
+  for (const auto& [name, seed] : seeds)
+    for (int round = 0; round < 300; ++round) {
+      std::string bytes = seed;
+      for (std::uint64_t k = 1 + next(4); k-- > 0;) {
+        const std::size_t at = next(bytes.size());
+        switch (next(3)) {
+          case 0: bytes[at] = junk[next(sizeof junk)]; break;
+          case 1: bytes.resize(at); break;
+          default: bytes.insert(at, bytes.substr(at, next(16))); break;
+        }
+        if (bytes.empty()) bytes = "v";
+      }
+      const std::string what = name + " round " + std::to_string(round);
+      try {
+        MeshLoadInfo info;
+        const Mesh m = load_mesh_from_memory(name, bytes, {}, &info);
+        expect_consistent(m, what);
+        ++loaded;
+      } catch (const InputError&) {
+        ++refused;
+      }
+    }
+  std::printf("%d loaded, %d refused\n", loaded, refused);
+  EXPECT_GT(loaded, 50);
+  EXPECT_GT(refused, 50);
 }
 
 }  // namespace

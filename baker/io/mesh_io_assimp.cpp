@@ -10,8 +10,9 @@
 // per corner, so hard edges and seams are kept as in an OBJ file. Points and lines are left out.
 // Each node with meshes is an object named after the node (Mesh::objects); a node name met twice
 // is one object. Each mesh's material is named by its AI_MATKEY_NAME (Mesh::materials; meshes of one
-// name share it): Assimp's stand-in for a mesh without one ("DefaultMaterial") is "", a material
-// without a name "material N" (N its number in the scene). Vertex colours are the meshes' first
+// name share it): Assimp's stand-ins for a mesh without one (named "DefaultMaterial"; for glTF an
+// unnamed one after the file's own) are "", any other material without a name is "material N" (N
+// its number in the file). Vertex colours are the meshes' first
 // colour set (glTF COLOR_0), per corner like normals, kept when every mesh has them.
 #include <assimp/DefaultIOSystem.h>
 #include <assimp/DefaultLogger.hpp>
@@ -73,8 +74,8 @@ double unit_scale_to_metres(const aiScene& scene, const std::string& ext) {
 
 class SceneReader {
  public:
-  SceneReader(const std::string& path, const aiScene& scene, double scale, unsigned uv_set)
-      : path_(path), scene_(scene), scale_(scale), uv_set_(uv_set) {
+  SceneReader(const std::string& path, const aiScene& scene, double scale, unsigned uv_set, bool gltf)
+      : path_(path), scene_(scene), scale_(scale), uv_set_(uv_set), gltf_(gltf) {
     out_.unit_scale = scale;
     // Which attributes every mesh with faces has decides whether corners get UV or normal slots.
     bool any = false;
@@ -130,7 +131,8 @@ class SceneReader {
     if (k >= scene_.mNumMaterials || !scene_.mMaterials[k] || scene_.mMaterials[k]->Get(AI_MATKEY_NAME, name) != AI_SUCCESS)
       name.Clear();
     const std::string text(name.C_Str(), std::min<std::size_t>(name.length, 256));
-    if (text == AI_DEFAULT_MATERIAL_NAME) return "";
+    // Assimp's glTF reader adds an unnamed material after the file's own for primitives without one.
+    if (text == AI_DEFAULT_MATERIAL_NAME || (text.empty() && gltf_ && k + 1 == scene_.mNumMaterials)) return "";
     return text.empty() ? "material " + std::to_string(k) : text;
   }
 
@@ -201,6 +203,7 @@ class SceneReader {
   const aiScene& scene_;
   const double scale_;
   const unsigned uv_set_;
+  const bool gltf_;
   ParsedMesh out_;
   std::unordered_map<glm::dvec3, std::uint32_t, PositionHash> weld_;
 };
@@ -358,7 +361,7 @@ ParsedMesh parse_assimp(const std::string& path, const std::string& ext, std::st
       const std::string why = one_line(importer.GetErrorString(), kAssimpMessageMax);
       fail(path, "cannot read as ." + ext + (why.empty() ? std::string() : ": " + why));
     }
-    parsed = SceneReader(path, *scene, unit_scale_to_metres(*scene, ext), uv_set).read();
+    parsed = SceneReader(path, *scene, unit_scale_to_metres(*scene, ext), uv_set, ext == "gltf" || ext == "glb").read();
   });
   parsed.format = ext == "glb" || ext == "gltf" ? "gltf" : ext;
   return parsed;
