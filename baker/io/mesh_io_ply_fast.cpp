@@ -101,9 +101,10 @@ bool parse_fast(const Header& header, const Layout& layout, std::string_view dat
     if (vl.offset[kAlpha] < 0) value[kAlpha] = 1.0;  // opaque
     double scale[kAlpha + 1];
     for (int r = kX; r <= kAlpha; ++r) scale[r] = vl.offset[r] >= 0 ? color_scale(vl.type[r]) : 1.0;
+    const int last = layout.colors ? kAlpha : kV;  // the colour roles cost a plain file nothing
     for (std::size_t i = begin; i < end && !bad.load(std::memory_order_relaxed); ++i) {
       const char* at = vbytes + i * vl.stride;
-      for (int r = kX; r <= kAlpha; ++r)
+      for (int r = kX; r <= last; ++r)
         if (vl.offset[r] >= 0) value[r] = load_scalar(at + vl.offset[r], vl.type[r], false);
       const glm::dvec3 exact(value[kX], value[kY], value[kZ]);
       const glm::vec3 p(exact);
