@@ -45,25 +45,39 @@ struct Mesh {
   std::vector<Object> objects;
   std::vector<std::uint32_t> triangle_object;
 
-  // TEMP (lead): the helper's fields.
+  // The high-poly's materials (the material-id map): an OBJ file's `usemtl` names, a glTF, FBX or
+  // DAE mesh's material name (meshes of one material share it), in the order triangles first use
+  // them. A file that names no material has none (materials empty). In a file that names some, the
+  // triangles without one (faces before the first `usemtl`, a glTF primitive without a material)
+  // have the material named "". Materials of several files merged (merge_meshes) are one by name,
+  // the triangles of a file that names none having "".
+  // triangle_material[t] is triangle t's material, or empty when every triangle has material 0 (or
+  // there are none).
   std::vector<std::string> materials;
   std::vector<std::uint32_t> triangle_material;
+
+  // Vertex colours (the vertex-color map), RGBA in [0, 1] as the file stores them: no colour-space
+  // conversion (glTF's COLOR_0 is linear, PLY and OBJ colours are usually sRGB-encoded); integer
+  // values divided by their type's maximum (uchar by 255, ushort by 65535), floats as they are,
+  // both clamped to [0, 1]; alpha 1 where the file has none. Corner c of triangle t has
+  // colors[color_index[3t+c]]; color_index is empty when the mesh has no colours (merge_meshes
+  // keeps them only when every file has them).
   std::vector<glm::vec4> colors;
-  std::vector<std::uint32_t> color_index;
-  std::uint32_t material_of(std::size_t tri) const { return triangle_material.empty() ? 0u : triangle_material[tri]; }
-  std::size_t material_count() const { return materials.size(); }
-  bool has_colors() const { return !color_index.empty(); }
-  glm::vec4 corner_color(std::size_t tri, int corner) const { return colors[color_index[3 * tri + corner]]; }
+  std::vector<std::uint32_t> color_index;  // 3 per triangle, or empty
 
   std::size_t triangle_count() const { return position_index.size() / 3; }
   bool has_normals() const { return !normal_index.empty(); }
   bool has_uvs() const { return !uv_index.empty(); }
   std::uint32_t object_of(std::size_t tri) const { return triangle_object.empty() ? 0u : triangle_object[tri]; }
   std::size_t object_count() const { return objects.empty() ? 1 : objects.size(); }
+  bool has_colors() const { return !color_index.empty(); }
+  std::uint32_t material_of(std::size_t tri) const { return triangle_material.empty() ? 0u : triangle_material[tri]; }
+  std::size_t material_count() const { return materials.size(); }
 
   glm::vec3 corner_position(std::size_t tri, int corner) const { return positions[position_index[3 * tri + corner]]; }
   glm::vec2 corner_uv(std::size_t tri, int corner) const { return uvs[uv_index[3 * tri + corner]]; }
   glm::vec3 corner_normal(std::size_t tri, int corner) const { return normals[normal_index[3 * tri + corner]]; }
+  glm::vec4 corner_color(std::size_t tri, int corner) const { return colors[color_index[3 * tri + corner]]; }
 };
 
 // The mesh moved to another origin: the same points, positions re-expressed in double.
@@ -91,8 +105,13 @@ struct MeshLoadInfo {
   // had length ~0; normal_index (uv_index) is then empty and normals get computed later.
   bool normals_dropped = false;
   bool uvs_dropped = false;
-  std::size_t faces_without_normals = 0;     // counted when only some faces had normals
-  std::size_t faces_without_uvs = 0;         // counted when only some faces had UVs
+  std::size_t faces_without_normals = 0;  // counted when only some faces had normals
+  std::size_t faces_without_uvs = 0;      // counted when only some faces had UVs
+  // The file's vertex colours were discarded because only some vertices had them (an OBJ mixing
+  // `v x y z` and `v x y z r g b` lines; glTF, FBX or DAE meshes some of which have colours);
+  // color_index is then empty.
+  bool colors_dropped = false;
+  std::size_t vertices_without_colors = 0;   // counted when only some vertices had colours
   std::size_t degenerate_faces_dropped = 0;  // STL facets whose corners welded together (dropped)
   double largest_coordinate = 0.0;           // largest |x|, |y| or |z| a face uses, as in the file
   // The scale applied to the file's coordinates: an FBX file's unit to metres (0.01 for

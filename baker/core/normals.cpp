@@ -1,6 +1,8 @@
 #include "core/normals.h"
 
 #include <cmath>
+#include <string>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -53,17 +55,28 @@ bool ensure_normals(Mesh& mesh) {
   return true;
 }
 
+// Beyond normals.h's contract: materials are merged by name (Mesh::materials), vertex colours kept
+// only when every mesh has them, like UVs.
 Mesh merge_meshes(std::vector<Mesh> meshes) {
   if (meshes.size() == 1) return std::move(meshes.front());
   Mesh out;
   if (meshes.empty()) return out;
   out.source = meshes.front().source;
   out.origin = meshes.front().origin;
-  bool uvs = true;
+  bool uvs = true, colors = true, materials = false;
   for (Mesh& m : meshes) {
     ensure_normals(m);
     uvs = uvs && m.has_uvs();
+    colors = colors && m.has_colors();
+    materials = materials || m.material_count() > 0;
   }
+  // Materials by name; a file that names none gives its triangles the material "".
+  std::unordered_map<std::string, std::uint32_t> material_by_name;
+  auto material_number = [&](const std::string& name) {
+    const auto [it, added] = material_by_name.try_emplace(name, std::uint32_t(out.materials.size()));
+    if (added) out.materials.push_back(name);
+    return it->second;
+  };
   for (const Mesh& m : meshes) {
     const auto p0 = std::uint32_t(out.positions.size()), n0 = std::uint32_t(out.normals.size()),
                u0 = std::uint32_t(out.uvs.size());
@@ -80,8 +93,20 @@ Mesh merge_meshes(std::vector<Mesh> meshes) {
     if (m.objects.empty()) out.objects.push_back({m.source, m.source});
     out.objects.insert(out.objects.end(), m.objects.begin(), m.objects.end());
     for (std::size_t t = 0; t < m.triangle_count(); ++t) out.triangle_object.push_back(o0 + m.object_of(t));
+    if (colors) {
+      const auto c0 = std::uint32_t(out.colors.size());
+      out.colors.insert(out.colors.end(), m.colors.begin(), m.colors.end());
+      for (std::uint32_t i : m.color_index) out.color_index.push_back(c0 + i);
+    }
+    if (materials) {
+      std::vector<std::uint32_t> renumber;
+      for (const std::string& name : m.materials) renumber.push_back(material_number(name));
+      if (renumber.empty()) renumber.push_back(material_number(""));
+      for (std::size_t t = 0; t < m.triangle_count(); ++t) out.triangle_material.push_back(renumber[m.material_of(t)]);
+    }
   }
   if (out.objects.size() == 1) out.triangle_object.clear();
+  if (out.materials.size() == 1) out.triangle_material.clear();
   return out;
 }
 

@@ -181,6 +181,45 @@ void settle_objects(ParsedMesh& parsed, const std::string& path) {
   for (std::uint32_t& k : m.triangle_object) k = renumber[k];
 }
 
+// The materials as the bake reads them (Mesh::materials): only those some triangle has, in the
+// order of first use, none when no triangle has a named one, and triangle_material only when two or
+// more are left.
+void settle_materials(ParsedMesh& parsed) {
+  Mesh& m = parsed.mesh;
+  if (m.materials.empty()) return;
+  constexpr std::uint32_t kUnused = UINT32_MAX;
+  std::vector<std::uint32_t> renumber(m.materials.size(), kUnused);
+  std::vector<std::string> kept;
+  auto use = [&](std::uint32_t k) {
+    if (renumber[k] != kUnused) return;
+    renumber[k] = std::uint32_t(kept.size());
+    kept.push_back(m.materials[k]);
+  };
+  if (m.triangle_material.empty()) use(0);
+  for (std::uint32_t k : m.triangle_material) use(k);
+  m.materials = std::move(kept);
+  if (m.materials.size() == 1 && m.materials[0].empty()) m.materials.clear();
+  if (m.materials.size() <= 1) m.triangle_material.clear();
+  for (std::uint32_t& k : m.triangle_material) k = renumber[k];
+}
+
+// Keeps colours only when every vertex has them; colours per position get their corners' indices.
+void settle_colors(ParsedMesh& parsed, MeshLoadInfo& info) {
+  Mesh& m = parsed.mesh;
+  if (parsed.vertices_without_colors > 0) {
+    info.colors_dropped = true;
+    info.vertices_without_colors = parsed.vertices_without_colors;
+    m.colors.clear();
+  }
+  if (m.colors.empty()) {
+    m.colors.shrink_to_fit();
+    m.color_index.clear();
+    m.color_index.shrink_to_fit();
+  } else if (!parsed.corner_colors) {
+    m.color_index = m.position_index;
+  }
+}
+
 // Keeps UVs only when every face has them.
 void settle_uvs(ParsedMesh& parsed, const std::string& path, const LoadOptions& options, MeshLoadInfo& info) {
   Mesh& m = parsed.mesh;
@@ -295,6 +334,8 @@ Mesh finish_mesh(ParsedMesh parsed, const std::string& path, const LoadOptions& 
   settle_uvs(parsed, path, options, info);
   settle_normals(parsed, info);
   settle_objects(parsed, path);
+  settle_materials(parsed);
+  settle_colors(parsed, info);
   place(parsed, path, options, info);
   parsed.mesh.source = path;
   return std::move(parsed.mesh);

@@ -9,12 +9,17 @@
 // placing are welded (Assimp splits a vertex at every seam and hard edge), normals and UVs stay
 // per corner, so hard edges and seams are kept as in an OBJ file. Points and lines are left out.
 // Each node with meshes is an object named after the node (Mesh::objects); a node name met twice
-// is one object.
+// is one object. Each mesh's material is named by its AI_MATKEY_NAME (Mesh::materials; meshes of one
+// name share it): Assimp's stand-ins for a mesh without one (named "DefaultMaterial"; for glTF an
+// unnamed one after the file's own) are "", any other material without a name is "material N" (N
+// its number in the file). Vertex colours are the meshes' first
+// colour set (glTF COLOR_0), per corner like normals, kept when every mesh has them.
 #include <assimp/DefaultIOSystem.h>
 #include <assimp/DefaultLogger.hpp>
 #include <assimp/Importer.hpp>
 #include <assimp/LogStream.hpp>
 #include <assimp/config.h>
+#include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
@@ -69,19 +74,26 @@ double unit_scale_to_metres(const aiScene& scene, const std::string& ext) {
 
 class SceneReader {
  public:
-  SceneReader(const std::string& path, const aiScene& scene, double scale, unsigned uv_set)
-      : path_(path), scene_(scene), scale_(scale), uv_set_(uv_set) {
+  SceneReader(const std::string& path, const aiScene& scene, double scale, unsigned uv_set, bool gltf)
+      : path_(path), scene_(scene), scale_(scale), uv_set_(uv_set), gltf_(gltf) {
     out_.unit_scale = scale;
     // Which attributes every mesh with faces has decides whether corners get UV or normal slots.
     bool any = false;
+    std::size_t meshes = 0, colored = 0, uncolored_vertices = 0;
     for (unsigned i = 0; i < scene.mNumMeshes; ++i) {
       const aiMesh& m = *scene.mMeshes[i];
       if (!(m.mPrimitiveTypes & (aiPrimitiveType_TRIANGLE | aiPrimitiveType_POLYGON))) continue;
       any = true;
       out_.corner_uvs = out_.corner_uvs && m.HasTextureCoords(uv_set_);
       out_.corner_normals = out_.corner_normals && m.HasNormals();
+      colored += m.HasVertexColors(0) ? 1 : 0;
+      if (!m.HasVertexColors(0)) uncolored_vertices += m.mNumVertices;
+      ++meshes;
     }
     if (!any) out_.corner_uvs = out_.corner_normals = false;
+    out_.corner_colors = any && colored == meshes;
+    // Some meshes with colours, some without: load_mesh drops them all and reports it.
+    if (colored > 0 && colored < meshes) out_.vertices_without_colors = uncolored_vertices;
   }
 
   ParsedMesh read() {
@@ -112,14 +124,28 @@ class SceneReader {
     }
   }
 
+  // The name of mesh `m`'s material (Mesh::materials).
+  std::string material_name(const aiMesh& m) const {
+    const unsigned k = m.mMaterialIndex;
+    aiString name;
+    if (k >= scene_.mNumMaterials || !scene_.mMaterials[k] || scene_.mMaterials[k]->Get(AI_MATKEY_NAME, name) != AI_SUCCESS)
+      name.Clear();
+    const std::string text(name.C_Str(), std::min<std::size_t>(name.length, 256));
+    // Assimp's glTF reader adds an unnamed material after the file's own for primitives without one.
+    if (text == AI_DEFAULT_MATERIAL_NAME || (text.empty() && gltf_ && k + 1 == scene_.mNumMaterials)) return "";
+    return text.empty() ? "material " + std::to_string(k) : text;
+  }
+
   void add_mesh(const aiMesh& m, const glm::dmat4& world) {
     if (!(m.mPrimitiveTypes & (aiPrimitiveType_TRIANGLE | aiPrimitiveType_POLYGON))) return;
     const std::string name = "mesh " + quote(m.mName.C_Str());
+    start_material(out_, material_name(m));
     const glm::dmat3 normal_matrix = glm::transpose(glm::inverse(glm::dmat3(world)));
     const bool mirrored = glm::determinant(glm::dmat3(world)) < 0.0;
     std::vector<std::uint32_t> position(m.mNumVertices);
     const std::uint32_t normal_base = std::uint32_t(out_.mesh.normals.size());
     const std::uint32_t uv_base = std::uint32_t(out_.mesh.uvs.size());
+    const std::uint32_t color_base = std::uint32_t(out_.mesh.colors.size());
     for (unsigned v = 0; v < m.mNumVertices; ++v) {
       const aiVector3D& a = m.mVertices[v];
       const glm::dvec3 p = glm::dvec3(world * glm::dvec4(a.x, a.y, a.z, 1.0));
@@ -143,6 +169,12 @@ class SceneReader {
           fail(path_, name + ": vertex " + std::to_string(v) + " has a non-finite texture coordinate");
         out_.mesh.uvs.emplace_back(t.x, t.y);
       }
+      if (out_.corner_colors) {
+        const aiColor4D& c = m.mColors[0][v];
+        if (!std::isfinite(c.r) || !std::isfinite(c.g) || !std::isfinite(c.b) || !std::isfinite(c.a))
+          fail(path_, name + ": vertex " + std::to_string(v) + " has a non-finite colour");
+        out_.mesh.colors.emplace_back(unit_color(c.r), unit_color(c.g), unit_color(c.b), unit_color(c.a));
+      }
     }
     std::vector<Corner> corners;
     for (unsigned f = 0; f < m.mNumFaces; ++f) {
@@ -155,7 +187,7 @@ class SceneReader {
         if (k >= m.mNumVertices)
           fail(path_, name + ": face " + std::to_string(f) + " uses vertex " + std::to_string(k) + " of " +
                           std::to_string(m.mNumVertices));
-        corners.push_back({position[k], uv_base + k, normal_base + k});
+        corners.push_back({position[k], uv_base + k, normal_base + k, color_base + k});
       }
       if (mirrored) std::reverse(corners.begin() + 1, corners.end());
       add_polygon(out_, corners.data(), corners.size(), std::uint32_t(out_.file_faces - 1));
@@ -171,6 +203,7 @@ class SceneReader {
   const aiScene& scene_;
   const double scale_;
   const unsigned uv_set_;
+  const bool gltf_;
   ParsedMesh out_;
   std::unordered_map<glm::dvec3, std::uint32_t, PositionHash> weld_;
 };
@@ -328,7 +361,7 @@ ParsedMesh parse_assimp(const std::string& path, const std::string& ext, std::st
       const std::string why = one_line(importer.GetErrorString(), kAssimpMessageMax);
       fail(path, "cannot read as ." + ext + (why.empty() ? std::string() : ": " + why));
     }
-    parsed = SceneReader(path, *scene, unit_scale_to_metres(*scene, ext), uv_set).read();
+    parsed = SceneReader(path, *scene, unit_scale_to_metres(*scene, ext), uv_set, ext == "gltf" || ext == "glb").read();
   });
   parsed.format = ext == "glb" || ext == "gltf" ? "gltf" : ext;
   return parsed;

@@ -25,7 +25,9 @@ namespace nmbake::mesh_io_detail {
 
 // A reader's result. Every corner gets a slot in normal_index and uv_index (0 for a face that has
 // none), so that per-corner arrays stay aligned; load_mesh() clears them when they are unusable.
-// A reader that knows up front the file has no UVs (normals) turns the slots off.
+// A reader that knows up front the file has no UVs (normals) turns the slots off. Colours come one
+// per position (OBJ, PLY: load_mesh() makes color_index from position_index) or, with
+// corner_colors, per corner like normals (Assimp); mesh.colors empty: none.
 struct ParsedMesh {
   Mesh mesh;
   // The positions as the file has them, in double, from readers whose values may carry more than
@@ -33,8 +35,10 @@ struct ParsedMesh {
   std::vector<glm::dvec3> exact_positions;
   bool corner_uvs = true;
   bool corner_normals = true;
-  std::string format;      // see MeshLoadInfo::format
-  bool fast_path = false;  // the PLY reader's fast path read it (mesh_io_ply_types.h)
+  bool corner_colors = false;               // color_index gets the corners' colour slot
+  std::size_t vertices_without_colors = 0;  // beside vertices with colours: colours are dropped
+  std::string format;                       // see MeshLoadInfo::format
+  bool fast_path = false;                   // the PLY reader's fast path read it (mesh_io_ply_types.h)
   std::size_t file_faces = 0;
   std::size_t faces = 0;  // faces that became triangles
   std::size_t polygons_triangulated = 0;
@@ -47,6 +51,10 @@ struct ParsedMesh {
   std::uint32_t object = 0;
   bool per_triangle_objects = false;  // mesh.triangle_object is being filled
   std::unordered_map<std::string, std::uint32_t> object_by_name;
+  // The material triangles are added to (Mesh::materials), as for objects.
+  std::uint32_t material = 0;
+  bool per_triangle_materials = false;  // mesh.triangle_material is being filled
+  std::unordered_map<std::string, std::uint32_t> material_by_name;
 };
 
 // Triangles added from now on belong to the object `name` (met again: the same object). A name
@@ -71,6 +79,28 @@ inline void start_object(ParsedMesh& out, const std::string& name) {
   out.object = it->second;
 }
 
+// Triangles added from now on have the material `name` (met again: the same material). Material 0
+// is "", the material of the triangles before the first name; load_mesh() drops the materials no
+// triangle uses and numbers the others in the order of first use (settle_materials).
+inline void start_material(ParsedMesh& out, const std::string& name) {
+  Mesh& m = out.mesh;
+  if (m.materials.empty()) {
+    m.materials.push_back({});
+    out.material_by_name.emplace(std::string(), 0);
+  }
+  const auto [it, added] = out.material_by_name.try_emplace(name, std::uint32_t(m.materials.size()));
+  if (added) m.materials.push_back(name);
+  if (!out.per_triangle_materials && it->second != 0) {
+    out.per_triangle_materials = true;
+    m.triangle_material.assign(m.source_face.size(), 0);
+  }
+  out.material = it->second;
+}
+
+// A colour value as Mesh::colors holds it: `value` over `max` (the integer type's largest value,
+// 1 for floats), clamped to [0, 1]. The caller has refused non-finite values.
+inline float unit_color(double value, double max = 1.0) { return static_cast<float>(std::clamp(value / max, 0.0, 1.0)); }
+
 // Throws InputError("<path>: <problem>").
 [[noreturn]] inline void fail(const std::string& path, const std::string& problem) { throw InputError(path + ": " + problem); }
 
@@ -89,8 +119,9 @@ bool assimp_reads(const std::string& ext);
 // True when the size matches a binary STL's facet count (84 + 50 bytes per facet).
 bool is_binary_stl(std::string_view bytes);
 
-// (position, uv, normal) indices of one corner.
-using Corner = std::array<std::uint32_t, 3>;
+// (position, uv, normal, colour) indices of one corner; the colour slot is read only with
+// ParsedMesh::corner_colors.
+using Corner = std::array<std::uint32_t, 4>;
 
 // Polygons with more corners than this are not fanned (below).
 constexpr std::size_t kMaxFanCorners = 64;
@@ -108,9 +139,11 @@ inline void add_polygon(ParsedMesh& out, const Corner* corners, std::size_t n, s
       m.position_index.push_back(corners[k][0]);
       if (out.corner_uvs) m.uv_index.push_back(corners[k][1]);
       if (out.corner_normals) m.normal_index.push_back(corners[k][2]);
+      if (out.corner_colors) m.color_index.push_back(corners[k][3]);
     }
     m.source_face.push_back(face);
     if (out.per_triangle_objects) m.triangle_object.push_back(out.object);
+    if (out.per_triangle_materials) m.triangle_material.push_back(out.material);
   };
   if (n <= kMaxFanCorners) {
     for (std::size_t i = 1; i + 1 < n; ++i) triangle(0, i, i + 1);

@@ -1,11 +1,13 @@
-// Wavefront OBJ reader: v, vt, vn and f lines, and objects by o (or, in a file without o, by g);
-// every other statement (s, usemtl, mtllib, l, p, free-form curves, ...) is ignored. One pass over the text in memory, no
-// iostreams.
+// Wavefront OBJ reader: v, vt, vn and f lines, objects by o (or, in a file without o, by g) and
+// materials by usemtl; every other statement (s, mtllib, l, p, free-form curves, ...) is ignored.
+// One pass over the text in memory, no iostreams.
 //
 // Accepted: v, v/vt, v//vn, v/vt/vn corners; negative (relative) indices; tabs and repeated
 // spaces; CRLF; a last line without newline; '\' line continuation; '#' comments; extra values
-// after x y z (w, or the r g b colour extension). Positive indices may refer forward, as most
-// exporters' readers allow; they are checked against the totals at the end.
+// after x y z: w (4 numbers), or the vertex colour extension "x y z r g b" (6 numbers, as MeshLab,
+// ZBrush and Meshroom write it) and "x y z r g b a" (7), colours taken as they are (0..1). Other
+// extra values are ignored. Positive indices may refer forward, as most exporters' readers allow;
+// they are checked against the totals at the end.
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -31,12 +33,23 @@ std::size_t attribute_count(const Mesh& m, Attribute attribute) {
   return 0;
 }
 
+// The rest of the line from `pos`, trimmed and cut to 256 bytes: an o, g or usemtl name.
+std::string statement_name(std::string_view line, std::size_t pos) {
+  std::string_view name = line.substr(std::min(pos, line.size()));
+  while (!name.empty() && is_space(name.front())) name.remove_prefix(1);
+  while (!name.empty() && is_space(name.back())) name.remove_suffix(1);
+  return std::string(name.substr(0, 256));
+}
+
 class ObjParser {
  public:
   ObjParser(const std::string& path, ParsedMesh& out) : path_(path), out_(out) {}
 
   void parse_line(std::string_view line, std::size_t line_number);
   void check_forward_references() const;
+  // Colours for every vertex, or none; a vertex without one among some with counts in
+  // ParsedMesh::vertices_without_colors (load_mesh drops them all then).
+  void finish_colors();
 
  private:
   [[noreturn]] void fail_line(const std::string& problem) const { fail(path_, "line " + std::to_string(line_) + ": " + problem); }
@@ -54,6 +67,7 @@ class ObjParser {
   std::uint32_t face_number_ = 0;  // 0-based count of f statements so far
   std::vector<Corner> corners_;
   bool named_by_o_ = false;  // an `o` was met: `g` no longer names objects
+  std::size_t vertices_with_colors_ = 0;
 
   // The largest positive index seen per attribute and its line, checked once the totals are known.
   long long max_index_[3] = {0, 0, 0};
@@ -88,6 +102,28 @@ void ObjParser::parse_vertex(std::string_view line, std::size_t pos) {
   if (positions.size() >= UINT32_MAX) fail_line("more than 2^32-1 vertices");
   positions.push_back(p);
   out_.exact_positions.push_back(exact);
+
+  // What follows x y z: w, r g b or r g b a; anything else is no colour (and ignored, as before).
+  double extra[4];
+  int extras = 0;
+  for (std::string_view token = next_token(line, pos); !token.empty() && token[0] != '#'; token = next_token(line, pos))
+    if (extras == 4 || !parse_real(token, extra[extras++])) return;
+  if (extras != 3 && extras != 4) return;
+  glm::vec4 color(1.0f);
+  for (int i = 0; i < extras; ++i) {
+    if (!std::isfinite(extra[i])) fail_line("vertex " + std::to_string(positions.size()) + " has a non-finite colour");
+    color[i] = unit_color(extra[i]);
+  }
+  auto& colors = out_.mesh.colors;
+  colors.resize(positions.size() - 1, glm::vec4(1.0f));  // vertices before without colours: placeholders
+  colors.push_back(color);
+  ++vertices_with_colors_;
+}
+
+void ObjParser::finish_colors() {
+  if (vertices_with_colors_ == 0) return;
+  out_.mesh.colors.resize(out_.mesh.positions.size(), glm::vec4(1.0f));
+  out_.vertices_without_colors = out_.mesh.positions.size() - vertices_with_colors_;
 }
 
 void ObjParser::parse_uv(std::string_view line, std::size_t pos) {
@@ -153,7 +189,7 @@ void ObjParser::parse_face(std::string_view line, std::size_t pos) {
       start = i + 1;
     }
     if (parts[0].empty()) fail_line("face corner " + quote(token) + " has no vertex index");
-    Corner corner{0, 0, 0};
+    Corner corner{0, 0, 0, 0};
     corner[kPosition] = resolve_index(parts[0], kPosition);
     if (part_count > 1 && !parts[1].empty()) {
       corner[kUv] = resolve_index(parts[1], kUv);
@@ -199,10 +235,10 @@ void ObjParser::parse_line(std::string_view line, std::size_t line_number) {
   } else if (keyword == "o" || (keyword == "g" && !named_by_o_)) {
     // Objects by `o`; in a file without `o` (Maya, 3ds Max), by group.
     named_by_o_ = named_by_o_ || keyword == "o";
-    std::string_view name = line.substr(std::min(pos, line.size()));
-    while (!name.empty() && is_space(name.front())) name.remove_prefix(1);
-    while (!name.empty() && is_space(name.back())) name.remove_suffix(1);
-    if (!name.empty()) start_object(out_, std::string(name.substr(0, 256)));
+    const std::string name = statement_name(line, pos);
+    if (!name.empty()) start_object(out_, name);
+  } else if (keyword == "usemtl") {
+    start_material(out_, statement_name(line, pos));  // a bare `usemtl`: no material ("")
   }
 }
 
@@ -261,6 +297,7 @@ ParsedMesh parse_obj(const std::string& path, std::string_view text) {
     parser.parse_line(line, first_line);
   }
   parser.check_forward_references();
+  parser.finish_colors();
   return out;
 }
 

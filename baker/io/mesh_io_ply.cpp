@@ -1,6 +1,8 @@
 // Stanford PLY reader: ascii, binary_little_endian and binary_big_endian, every scalar type under
-// both its old (char, uchar, ...) and its sized (int8, uint8, ...) name. Reads x y z, nx ny nz and a
-// UV pair (s/t, u/v, texture_u/texture_v or texture_s/texture_t) from "vertex", the index list
+// both its old (char, uchar, ...) and its sized (int8, uint8, ...) name. Reads x y z, nx ny nz, a
+// UV pair (s/t, u/v, texture_u/texture_v or texture_s/texture_t) and a colour (red green blue
+// [alpha], or diffuse_red ... [diffuse_alpha], of any type: ply_types.h color_scale) from
+// "vertex", the index list
 // (vertex_indices or vertex_index) and an optional per-corner "texcoord" list from "face"; every
 // other property and element, lists included, is skipped.
 //
@@ -146,6 +148,15 @@ Role vertex_role(const std::string& name, const Element& vertex) {
   if (name == "nx") return kNx;
   if (name == "ny") return kNy;
   if (name == "nz") return kNz;
+  // The first complete colour in this order wins; alpha only beside it.
+  static const char* const colors[][4] = {{"red", "green", "blue", "alpha"},
+                                          {"diffuse_red", "diffuse_green", "diffuse_blue", "diffuse_alpha"}};
+  for (const auto& color : colors) {
+    if (!has(color[0]) || !has(color[1]) || !has(color[2])) continue;
+    for (int k = 0; k < 4; ++k)
+      if (name == color[k]) return Role(kRed + k);
+    break;
+  }
   // The first complete UV pair in this order wins.
   static const char* const pairs[][2] = {{"s", "t"}, {"u", "v"}, {"texture_u", "texture_v"}, {"texture_s", "texture_t"}};
   for (const auto& pair : pairs) {
@@ -241,12 +252,12 @@ Layout assign_roles(const std::string& path, Header& header) {
   Layout layout;
   for (Element& e : header.elements) {
     if (e.name == "vertex" && !layout.vertex) {
-      bool x = false, y = false, z = false, nx = false, ny = false, nz = false, u = false;
+      bool x = false, y = false, z = false, nx = false, ny = false, nz = false, u = false, red = false;
       for (Property& p : e.properties) {
         if (p.is_list) continue;
         p.role = vertex_role(p.name, e);
         x |= p.role == kX, y |= p.role == kY, z |= p.role == kZ;
-        nx |= p.role == kNx, ny |= p.role == kNy, nz |= p.role == kNz, u |= p.role == kU;
+        nx |= p.role == kNx, ny |= p.role == kNy, nz |= p.role == kNz, u |= p.role == kU, red |= p.role == kRed;
       }
       if (!x || !y || !z) fail(path, "vertex element lacks an x, y or z property");
       layout.normals = nx && ny && nz;
@@ -254,6 +265,7 @@ Layout assign_roles(const std::string& path, Header& header) {
         for (Property& p : e.properties)
           if (p.role == kNx || p.role == kNy || p.role == kNz) p.role = kNone;
       layout.vertex_uvs = u;
+      layout.colors = red;  // vertex_role gives colour roles only to a complete red, green, blue
       layout.vertex = &e;
     } else if (e.name == "face" && !layout.face) {
       for (Property& p : e.properties) {
@@ -279,6 +291,8 @@ void read_vertex(DataReader& reader, const Element& e, const Layout& layout, std
   glm::dvec3 exact(0);  // in double: a mesh far from the origin is re-centred before rounding to float
   glm::vec3 n(0);
   glm::vec2 uv(0);
+  glm::vec4 color(1);
+  bool finite_color = true;
   for (const Property& prop : e.properties) {
     if (prop.is_list) {
       reader.skip(prop.type, reader.read_list_count(prop));
@@ -299,6 +313,13 @@ void read_vertex(DataReader& reader, const Element& e, const Layout& layout, std
       case kNz: n.z = value; break;
       case kU: uv.x = value; break;
       case kV: uv.y = value; break;
+      case kRed:
+      case kGreen:
+      case kBlue:
+      case kAlpha:
+        finite_color = finite_color && std::isfinite(exact_value);
+        color[prop.role - kRed] = unit_color(exact_value, color_scale(prop.type));
+        break;
       default: break;
     }
   }
@@ -306,10 +327,12 @@ void read_vertex(DataReader& reader, const Element& e, const Layout& layout, std
   if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) reader.fail_here("has a non-finite coordinate");
   if (!std::isfinite(n.x) || !std::isfinite(n.y) || !std::isfinite(n.z)) reader.fail_here("has a non-finite normal");
   if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) reader.fail_here("has a non-finite texture coordinate");
+  if (!finite_color) reader.fail_here("has a non-finite colour");
   m.positions[i] = p;
   out.exact_positions[i] = exact;
   if (layout.normals) m.normals[i] = n;
   if (layout.vertex_uvs) m.uvs[i] = uv;
+  if (layout.colors) m.colors[i] = color;
 }
 
 class FaceReader {
@@ -344,7 +367,7 @@ class FaceReader {
       if (v < 0 || v >= double(vertex_count_) || v != std::floor(v))
         reader.fail_here("refers to vertex " + number_text(v) + " but the file has " + std::to_string(vertex_count_));
       auto index = static_cast<std::uint32_t>(v);
-      corners_.push_back({index, index, index});
+      corners_.push_back({index, index, index, index});
     }
   }
 
@@ -415,6 +438,7 @@ ParsedMesh parse_ply(const std::string& path, std::string_view bytes, bool fast)
   out.exact_positions.resize(vertex.count);
   if (layout.normals) m.normals.resize(vertex.count);
   if (layout.vertex_uvs) m.uvs.resize(vertex.count);
+  if (layout.colors) m.colors.resize(vertex.count);
   out.corner_uvs = layout.vertex_uvs || layout.face_texcoords;
   out.corner_normals = layout.normals;
   reserve_triangles(out, header, *layout.face, data_bytes);

@@ -20,14 +20,15 @@ constexpr std::size_t kChunk = std::size_t(1) << 16;  // vertices or faces per c
 // Where each vertex value is: offset in the vertex's bytes and type; offset -1: absent.
 struct VertexLayout {
   std::size_t stride = 0;
-  long offset[9] = {-1, -1, -1, -1, -1, -1, -1, -1, -1};  // by Role kX .. kV
-  Scalar type[9] = {};
+  long offset[kAlpha + 1] = {};  // by Role kX .. kAlpha; -1 for every role (vertex_layout)
+  Scalar type[kAlpha + 1] = {};
 };
 
 bool vertex_layout(const Element& e, VertexLayout& v) {
+  for (long& offset : v.offset) offset = -1;
   for (const Property& p : e.properties) {
     if (p.is_list) return false;
-    if (p.role >= kX && p.role <= kV) {
+    if (p.role >= kX && p.role <= kAlpha) {
       v.offset[p.role] = long(v.stride);
       v.type[p.role] = p.type;
     }
@@ -85,6 +86,7 @@ bool parse_fast(const Header& header, const Layout& layout, std::string_view dat
         m.positions.resize(vc);
         if (layout.normals) m.normals.resize(vc);
         if (layout.vertex_uvs) m.uvs.resize(vc);
+        if (layout.colors) m.colors.resize(vc);
         m.source_face.resize(fc);
       },
   };
@@ -95,10 +97,14 @@ bool parse_fast(const Header& header, const Layout& layout, std::string_view dat
   std::atomic<bool> bad{false};
   const char* vbytes = data.data();
   parallel_chunks(0, std::size_t(vc), kChunk, [&](std::size_t begin, std::size_t end) {
-    double value[9] = {};
+    double value[kAlpha + 1] = {};
+    if (vl.offset[kAlpha] < 0) value[kAlpha] = 1.0;  // opaque
+    double scale[kAlpha + 1];
+    for (int r = kX; r <= kAlpha; ++r) scale[r] = vl.offset[r] >= 0 ? color_scale(vl.type[r]) : 1.0;
+    const int last = layout.colors ? kAlpha : kV;  // the colour roles cost a plain file nothing
     for (std::size_t i = begin; i < end && !bad.load(std::memory_order_relaxed); ++i) {
       const char* at = vbytes + i * vl.stride;
-      for (int r = kX; r <= kV; ++r)
+      for (int r = kX; r <= last; ++r)
         if (vl.offset[r] >= 0) value[r] = load_scalar(at + vl.offset[r], vl.type[r], false);
       const glm::dvec3 exact(value[kX], value[kY], value[kZ]);
       const glm::vec3 p(exact);
@@ -113,6 +119,17 @@ bool parse_fast(const Header& header, const Layout& layout, std::string_view dat
       out.exact_positions[i] = exact;
       if (layout.normals) m.normals[i] = n;
       if (layout.vertex_uvs) m.uvs[i] = uv;
+      if (layout.colors) {
+        glm::vec4 color;
+        for (int k = 0; k < 4; ++k) {
+          if (!std::isfinite(value[kRed + k])) {
+            bad = true;
+            return;
+          }
+          color[k] = unit_color(value[kRed + k], scale[kRed + k]);
+        }
+        m.colors[i] = color;
+      }
     }
   });
   const char* fbytes = vbytes + vertex_bytes;

@@ -18,7 +18,7 @@ enum class Scalar { int8, uint8, int16, uint16, int32, uint32, float32, float64 
 enum class Encoding { ascii, binary_little_endian, binary_big_endian };
 
 // What a property is for us; kNone is read past.
-enum Role { kNone, kX, kY, kZ, kNx, kNy, kNz, kU, kV, kIndices, kTexcoords };
+enum Role { kNone, kX, kY, kZ, kNx, kNy, kNz, kU, kV, kRed, kGreen, kBlue, kAlpha, kIndices, kTexcoords };
 
 struct Property {
   std::string name;
@@ -54,6 +54,22 @@ inline unsigned scalar_size(Scalar t) {
   return 0;
 }
 
+// What a colour value of type t is divided by to bring it to [0, 1] (Mesh::colors): the type's
+// largest value for integers (uchar 255, ushort 65535), 1 for floats.
+inline double color_scale(Scalar t) {
+  switch (t) {
+    case Scalar::int8: return 127.0;
+    case Scalar::uint8: return 255.0;
+    case Scalar::int16: return 32767.0;
+    case Scalar::uint16: return 65535.0;
+    case Scalar::int32: return 2147483647.0;
+    case Scalar::uint32: return 4294967295.0;
+    case Scalar::float32:
+    case Scalar::float64: return 1.0;
+  }
+  return 1.0;
+}
+
 constexpr bool kHostLittleEndian = __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__;
 
 template <typename T>
@@ -86,6 +102,7 @@ struct Layout {
   const Element* face = nullptr;
   bool normals = false;
   bool vertex_uvs = false;
+  bool colors = false;          // red, green and blue (alpha optional) on the vertices
   bool face_texcoords = false;  // per-corner UVs on the faces; they win over vertex_uvs
 };
 
