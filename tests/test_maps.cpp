@@ -308,6 +308,26 @@ TEST(MapsCurvature, PlaneSphereAndTheInsideOfACylinder) {
     for (int x = 0; x < 64; ++x) EXPECT_NEAR(c.pixels[std::size_t(y) * 64 + std::size_t(x)], 0.5 - 0.125, 0.01) << x << "," << y;
 }
 
+// Vertex colours interpolated at the hit; a high-poly without them: the map is not made.
+TEST(MapsVertexColor, InterpolatedAtTheHit) {
+  Mesh high = test::make_grid(8, 8);
+  for (const glm::vec3& p : high.positions) high.colors.push_back({(p.x + 1.0f) / 2.0f, (p.y + 1.0f) / 2.0f, 0.25f, 1.0f});
+  high.color_index = high.position_index;
+  const Mesh low = test::make_grid(2, 2);
+  const BakeResult r = bake_normal_map(low, high, nullptr, options(16, {MapKind::vertex_color}, 0.1f, 0.1f));
+  const Image& c = baked(r, MapKind::vertex_color).image;
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x) {
+      const float* p = &c.pixels[3 * (std::size_t(y) * 16 + std::size_t(x))];
+      EXPECT_NEAR(p[0], (x + 0.5) / 16.0, 1e-5);
+      EXPECT_NEAR(p[1], 1.0 - (y + 0.5) / 16.0, 1e-5);
+      EXPECT_NEAR(p[2], 0.25, 1e-6);
+    }
+  const BakeResult none = bake_normal_map(low, test::make_grid(8, 8), nullptr, options(16, {MapKind::vertex_color}, 0.1f, 0.1f));
+  EXPECT_FALSE(baked(none, MapKind::vertex_color).skipped.empty());
+  EXPECT_TRUE(baked(none, MapKind::vertex_color).image.pixels.empty());
+}
+
 // Every map the same whatever the thread count.
 TEST(MapsThreads, IdenticalAcrossThreadCounts) {
   const Mesh low = test::make_torus(24, 12), high = test::make_torus(96, 48);

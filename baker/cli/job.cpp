@@ -329,6 +329,8 @@ MeshLoadInfo combined_info(const std::vector<MeshLoadInfo>& infos) {
     all.faces_without_normals += f.faces_without_normals;
     all.faces_without_uvs += f.faces_without_uvs;
     all.degenerate_faces_dropped += f.degenerate_faces_dropped;
+    all.colors_dropped = all.colors_dropped || f.colors_dropped;
+    all.vertices_without_colors += f.vertices_without_colors;
     all.largest_coordinate = std::max(all.largest_coordinate, f.largest_coordinate);
     if (f.unit_scale != all.unit_scale) all.unit_scale = 0.0;  // mixed: high_files gives each
   }
@@ -441,7 +443,12 @@ void bake_job(const Args& a, const JobEnv& env) {
     if (const auto swapped = swap_warning(low.triangle_count(), high.triangle_count(), high.has_uvs(), a.low, a.high))
       warnings.add({*swapped});
     warnings.add(load_warnings(run.low_info, a.low));
-    for (std::size_t i = 0; i < a.highs.size(); ++i) warnings.add(load_warnings(run.high_infos[i], a.highs[i]));
+    for (std::size_t i = 0; i < a.highs.size(); ++i) {
+      warnings.add(load_warnings(run.high_infos[i], a.highs[i]));
+      if (o.maps.wants(MapKind::vertex_color) && run.high_infos[i].colors_dropped)
+        warnings.add({"warning: " + a.highs[i] + ": " + std::to_string(run.high_infos[i].vertices_without_colors) +
+                      " vertices have no colour: all the file's vertex colours were dropped"});
+    }
     if (cage_mesh) warnings.add(load_warnings(run.cage_info, a.cage));
     warnings.add(match_warnings(run.match, run.low_objects, run.high_objects, a.low, a.high));
   });

@@ -60,6 +60,20 @@ void check_loaded(const Mesh& m) {
       if (!finite(m.uvs[m.uv_index[i]])) broken("used UV not finite", i);
     }
   }
+  if (m.has_colors()) {
+    if (m.color_index.size() != 3 * tris) broken("color_index is not 3 per triangle", m.color_index.size());
+    for (std::size_t i = 0; i < m.color_index.size(); ++i) {
+      if (m.color_index[i] >= m.colors.size()) broken("color index out of range", i);
+      const glm::vec4 c = m.colors[m.color_index[i]];
+      if (!(c.r >= 0 && c.r <= 1 && c.g >= 0 && c.g <= 1 && c.b >= 0 && c.b <= 1 && c.a >= 0 && c.a <= 1))
+        broken("used colour outside [0, 1]", i);
+    }
+  }
+  if (!m.triangle_material.empty()) {
+    if (m.triangle_material.size() != tris) broken("triangle_material is not 1 per triangle", m.triangle_material.size());
+    for (std::size_t t = 0; t < tris; ++t)
+      if (m.triangle_material[t] >= m.materials.size()) broken("material out of range", t);
+  }
 }
 
 // The first stages of a bake on the loaded mesh: never NaN (normals.h, tangent_frames.h).
