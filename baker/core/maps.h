@@ -49,7 +49,7 @@ struct MapOptions {
   double ao_distance = 0.0;
   int ao_rays = kDefaultAoRays;  // rays per texel for ao, bent-normal and thickness
   // --ao-rays auto: per texel, rays in rounds until the AO's standard error is below max_ao_error
-  // (at most ao_rays_max).
+  // (at most ao_rays_max). Not built yet: validate_options refuses it.
   bool ao_rays_auto = false;
   double max_ao_error = 0.01;
   int ao_rays_max = 1024;

@@ -256,6 +256,19 @@ void validate_options(const BakeOptions& o) {
     if (!(d < kMaxDistance))
       throw UsageError(std::string(name) + " must be a distance >= 0 in scene units");  // NaN, infinite, huge
   if (o.space == NormalSpace::object && o.green_down) throw UsageError("--green down applies to tangent-space maps only");
+  const MapOptions& m = o.maps;
+  if (m.maps.empty()) throw UsageError("--maps names no map");
+  for (std::size_t i = 0; i < m.maps.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (m.maps[i] == m.maps[j]) throw UsageError(std::string("--maps: ") + map_name(m.maps[i]) + " is given twice");
+  if (m.ao_rays < 1 || m.ao_rays > kMaxAoRays)
+    throw UsageError("--ao-rays must be between 1 and " + std::to_string(kMaxAoRays) + ", got " + std::to_string(m.ao_rays));
+  if (m.ao_rays_auto) throw UsageError("--ao-rays auto is not available yet in this version; give a number of rays");
+  for (const auto& [d, name] : {std::pair{m.ao_distance, "--ao-distance"}, std::pair{m.thickness_distance, "--thickness-distance"},
+                                std::pair{m.curvature_scale, "--curvature-scale"}})
+    if (!(d >= 0.0 && d < kMaxDistance)) throw UsageError(std::string(name) + " must be above 0 (0: automatic)");
+  if (m.height_range_given && !(std::isfinite(m.height_min) && std::isfinite(m.height_max) && m.height_min < m.height_max))
+    throw UsageError("--height-range A:B needs finite A below B");
 }
 
 // The stages in order (README "Layout"): prepare, select, BVH, distances (and a narrower
