@@ -113,8 +113,9 @@ TEST(MapsAo, AtTheBottomOfARoundWell) {
   const int sides = 256;
   for (int k = 0; k < sides; ++k) {
     const double a0 = 2 * kPi * k / sides, a1 = 2 * kPi * (k + 1) / sides;
-    const glm::vec3 p0(float(r * std::cos(a0)), float(r * std::sin(a0)), 0.0f), p1(float(r * std::cos(a1)), float(r * std::sin(a1)), 0.0f);
-    high.tri({0, 0, 0}, p0, p1);                                                         // the floor, facing up
+    const glm::vec3 p0(float(r * std::cos(a0)), float(r * std::sin(a0)), 0.0f),
+        p1(float(r * std::cos(a1)), float(r * std::sin(a1)), 0.0f);
+    high.tri({0, 0, 0}, p0, p1);                                                        // the floor, facing up
     high.quad(p1, p0, p0 + glm::vec3(0, 0, float(h)), p1 + glm::vec3(0, 0, float(h)));  // the wall, facing in
   }
   const Mesh low = test::make_grid(1, 1, -0.02f, 0.02f, -0.02f, 0.02f);
@@ -185,7 +186,7 @@ TEST(MapsAo, ConvexObjectOnAGroundPlane) {
 TEST(MapsThickness, OfASlab) {
   const double t = 0.2, d = 0.5;
   Builder high("slab");
-  high.quad({-5, -5, 0}, {5, -5, 0}, {5, 5, 0}, {-5, 5, 0});                                // top, facing up
+  high.quad({-5, -5, 0}, {5, -5, 0}, {5, 5, 0}, {-5, 5, 0});                                  // top, facing up
   high.quad({-5, -5, float(-t)}, {-5, 5, float(-t)}, {5, 5, float(-t)}, {5, -5, float(-t)});  // bottom, facing down
   const Mesh low = test::make_grid(4, 4, -1, 1, -1, 1);
   BakeOptions o = options(32, {MapKind::thickness});
@@ -300,7 +301,8 @@ TEST(MapsCurvature, PlaneSphereAndTheInsideOfACylinder) {
     tube.positions[i] = {float(std::cos(a)), float(std::sin(a)), z};
     tube.normals[i] = {float(-std::cos(a)), float(-std::sin(a)), 0.0f};
   }
-  for (std::size_t t = 0; t < tube.triangle_count(); ++t) std::swap(tube.position_index[3 * t + 1], tube.position_index[3 * t + 2]);
+  for (std::size_t t = 0; t < tube.triangle_count(); ++t)
+    std::swap(tube.position_index[3 * t + 1], tube.position_index[3 * t + 2]);
   tube.normal_index = tube.uv_index = tube.position_index;
   const BakeResult inside = bake_normal_map(tube, tube, nullptr, o);
   const Image& c = baked(inside, MapKind::curvature).image;
@@ -331,8 +333,9 @@ TEST(MapsVertexColor, InterpolatedAtTheHit) {
 // Every map the same whatever the thread count.
 TEST(MapsThreads, IdenticalAcrossThreadCounts) {
   const Mesh low = test::make_torus(24, 12), high = test::make_torus(96, 48);
-  BakeOptions o = options(48, {MapKind::normal, MapKind::ao, MapKind::bent_normal, MapKind::height, MapKind::thickness,
-                               MapKind::position, MapKind::object_id},
+  BakeOptions o = options(48,
+                          {MapKind::normal, MapKind::ao, MapKind::bent_normal, MapKind::height, MapKind::thickness,
+                           MapKind::position, MapKind::object_id},
                           -1.0f, -1.0f);
   o.samples = 4;
   o.maps.ao_rays = 16;

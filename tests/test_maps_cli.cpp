@@ -15,8 +15,8 @@ namespace fs = std::filesystem;
 std::string sample_args() { return test::sample_low() + " " + test::sample_high() + " --size 64 --threads 2"; }
 
 TEST(MapsCli, EveryMapToItsFileWithItsMetadataAndReport) {
-  const test::CliRun r = test::run_nmbake(sample_args() +
-                                          " --maps normal,ao,height,object-id --ao-rays 8 -o 't_<MAP>.png' --report r.json");
+  const test::CliRun r =
+      test::run_nmbake(sample_args() + " --maps normal,ao,height,object-id --ao-rays 8 -o 't_<MAP>.png' --report r.json");
   ASSERT_EQ(r.code, 0) << r.err;
   for (const char* name : {"normal", "ao", "height", "object-id"})
     EXPECT_TRUE(test::exists(r.dir + "/t_" + name + ".png")) << name;
@@ -64,7 +64,8 @@ TEST(MapsCli, RefusalsWriteNothing) {
     EXPECT_TRUE(test::contains(r.err, c.says)) << c.args << ": " << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
     std::size_t files = 0;
-    for (const auto& e : fs::directory_iterator(r.dir)) files += e.path().filename() != "out.txt" && e.path().filename() != "err.txt";
+    for (const auto& e : fs::directory_iterator(r.dir))
+      files += e.path().filename() != "out.txt" && e.path().filename() != "err.txt";
     EXPECT_EQ(files, 0u) << c.args;
   }
 }

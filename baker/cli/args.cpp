@@ -148,7 +148,8 @@ void add_options(CLI::App& app, Args& a) {
   app.add_option("--ao-rays", a.ao_rays,
                  "Rays per texel for ao, bent-normal and thickness, 1-65536 (default 64; auto, rays until a standard error, "
                  "is not available yet)");
-  app.add_option("--max-ao-error", a.max_ao_error, "With --ao-rays auto (not available yet): the standard error a texel's AO stops at");
+  app.add_option("--max-ao-error", a.max_ao_error,
+                 "With --ao-rays auto (not available yet): the standard error a texel's AO stops at");
   app.add_option("--ao-distance", a.ao_distance,
                  "ao, bent-normal: a ray meeting the high-poly within D scene units is occluded (default 0.1 x the scene's "
                  "diagonal)");
@@ -223,7 +224,8 @@ MapOptions map_options(const Args& a) {
   if (!a.height_range.empty()) {
     needs(true, "--height-range", {MapKind::height});
     const std::size_t colon = a.height_range.find(':');
-    const std::string lo = a.height_range.substr(0, colon), hi = colon == std::string::npos ? "" : a.height_range.substr(colon + 1);
+    const std::string lo = a.height_range.substr(0, colon),
+                      hi = colon == std::string::npos ? "" : a.height_range.substr(colon + 1);
     std::size_t u1 = 0, u2 = 0;
     double x = 0.0, y = 0.0;
     try {
@@ -298,10 +300,13 @@ void check_outputs(const Args& a, int bits) {
   std::vector<NamedFile> inputs{{"", a.low, "the low-poly"}, {"--cage", a.cage, "the cage"}};
   for (const std::string& h : a.highs) inputs.push_back({"", h, "the high-poly"});
   const std::vector<MapKind> maps = parse_maps(a.maps);
-  check_map_outputs(a.output, maps,
-                    {{"--miss-mask", a.miss_mask}, {"--suspect-mask", a.suspect_mask}, {"--save-cage", a.save_cage}, {"--report", a.report}});
+  check_map_outputs(
+      a.output, maps,
+      {{"--miss-mask", a.miss_mask}, {"--suspect-mask", a.suspect_mask}, {"--save-cage", a.save_cage}, {"--report", a.report}});
   std::vector<NamedFile> outputs;
-  for (MapKind k : maps) outputs.push_back({"--output", map_path(a.output, k), "the " + std::string(map_name(k)) + " map"});
+  for (MapKind k : maps)  // "the map" when it is the one map
+    outputs.push_back(
+        {"--output", map_path(a.output, k), maps.size() == 1 ? "the map" : "the " + std::string(map_name(k)) + " map"});
   outputs.insert(outputs.end(), {{"--miss-mask", a.miss_mask, "the miss mask"},
                                  {"--suspect-mask", a.suspect_mask, "the suspect mask"},
                                  {"--save-cage", a.save_cage, "the cage"},

@@ -87,8 +87,11 @@ std::vector<MapFiles> map_files(const Args& a, const BakeOptions& o, const BakeR
   auto tile_path = [](const std::string& pattern, int n) { return pattern.empty() ? pattern : udim_path(pattern, n); };
   const auto set = [&](const BakeResult& result, int tile) {
     const auto path = [&](MapKind k) { return tile ? udim_path(map_path(a.output, k), tile) : map_path(a.output, k); };
-    MapFiles f{&result, o.maps.wants(MapKind::normal) ? path(MapKind::normal) : "", tile_path(a.miss_mask, tile),
-               tile_path(a.suspect_mask, tile), {}};
+    MapFiles f{&result,
+               o.maps.wants(MapKind::normal) ? path(MapKind::normal) : "",
+               tile_path(a.miss_mask, tile),
+               tile_path(a.suspect_mask, tile),
+               {}};
     if (!tile) f.miss_mask = a.miss_mask, f.suspect_mask = a.suspect_mask;
     for (const BakedMap& m : result.maps) f.extra.push_back(path(m.kind));
     return f;
@@ -199,8 +202,7 @@ nlohmann::json maps_report(const Args& a, const BakeOptions& o, const BakeResult
   std::vector<const BakeResult*> parts;
   if (udim)
     for (const TileBake& t : udim->tiles) parts.push_back(&t.result);
-  else
-    parts.push_back(&r);
+  else parts.push_back(&r);
   std::size_t extra = 0;
   for (MapKind kind : o.maps.maps) {
     nlohmann::json j = {{"map", map_name(kind)}, {"file", map_path(a.output, kind)}};
@@ -239,8 +241,7 @@ nlohmann::json maps_report(const Args& a, const BakeOptions& o, const BakeResult
         j["colors"] = colors;
         break;
       }
-      default:
-        break;
+      default: break;
     }
     if (m.error_mean >= 0.0) {
       double sum = 0.0, texels = 0.0, p95 = 0.0;

@@ -3,8 +3,8 @@
 namespace nmbake {
 
 namespace {
-constexpr const char* kNames[kMapKinds] = {"normal",   "object-normal", "ao",        "bent-normal", "height",      "thickness",
-                                           "curvature", "position",     "object-id", "material-id", "vertex-color"};
+constexpr const char* kNames[kMapKinds] = {"normal",    "object-normal", "ao",        "bent-normal", "height",      "thickness",
+                                           "curvature", "position",      "object-id", "material-id", "vertex-color"};
 }
 
 const char* map_name(MapKind kind) { return kNames[int(kind)]; }
@@ -29,10 +29,8 @@ int map_channels(MapKind kind) {
     case MapKind::ao:
     case MapKind::height:
     case MapKind::thickness:
-    case MapKind::curvature:
-      return 1;
-    default:
-      return 3;
+    case MapKind::curvature: return 1;
+    default: return 3;
   }
 }
 

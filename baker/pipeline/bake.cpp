@@ -136,7 +136,8 @@ std::uint64_t estimate_bake_bytes(const BakeOptions& o) {
   std::uint64_t per_texel =
       12 + 1 + (o.padding > 0 ? 4 : 0) + (o.miss_mask ? 4 : 0) + (o.suspect_mask ? 4 : 0) + (o.samples > 1 ? 1 : 0);
   for (MapKind k : o.maps.maps)  // each extra map's floats (and ao's, thickness's error)
-    if (k != MapKind::normal) per_texel += 4u * std::uint64_t(map_channels(k)) + (k == MapKind::ao || k == MapKind::thickness ? 4 : 0);
+    if (k != MapKind::normal)
+      per_texel += 4u * std::uint64_t(map_channels(k)) + (k == MapKind::ao || k == MapKind::thickness ? 4 : 0);
   return texels * per_texel;
 }
 
@@ -264,8 +265,9 @@ void validate_options(const BakeOptions& o) {
   if (m.ao_rays < 1 || m.ao_rays > kMaxAoRays)
     throw UsageError("--ao-rays must be between 1 and " + std::to_string(kMaxAoRays) + ", got " + std::to_string(m.ao_rays));
   if (m.ao_rays_auto) throw UsageError("--ao-rays auto is not available yet in this version; give a number of rays");
-  for (const auto& [d, name] : {std::pair{m.ao_distance, "--ao-distance"}, std::pair{m.thickness_distance, "--thickness-distance"},
-                                std::pair{m.curvature_scale, "--curvature-scale"}})
+  for (const auto& [d, name] :
+       {std::pair{m.ao_distance, "--ao-distance"}, std::pair{m.thickness_distance, "--thickness-distance"},
+        std::pair{m.curvature_scale, "--curvature-scale"}})
     if (!(d >= 0.0 && d < kMaxDistance)) throw UsageError(std::string(name) + " must be above 0 (0: automatic)");
   if (m.height_range_given && !(std::isfinite(m.height_min) && std::isfinite(m.height_max) && m.height_min < m.height_max))
     throw UsageError("--height-range A:B needs finite A below B");
@@ -303,9 +305,9 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
       map_out = allocate_map_targets(opt.maps, opt.width, opt.height);
     }
     outputs.wait();
-    trace_and_shade(in.s, in.scene, bins, in.rays, opt, threads,
-                    {result.map, result.coverage, result.miss_mask, disagree, extra ? &map_in : nullptr, extra ? &map_out : nullptr},
-                    st);
+    trace_and_shade(
+        in.s, in.scene, bins, in.rays, opt, threads,
+        {result.map, result.coverage, result.miss_mask, disagree, extra ? &map_in : nullptr, extra ? &map_out : nullptr}, st);
     st.trace.seconds = seconds_since(t0);
     st.trace.cpu_seconds = process_cpu_seconds() - cpu0;
 

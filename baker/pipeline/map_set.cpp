@@ -240,8 +240,7 @@ std::vector<BakedMap> finish_maps(const BakeOptions& opt, const Prepared& s, con
           img = Image();
         }
         break;
-      default:
-        break;
+      default: break;
     }
     if (!img.pixels.empty()) pad_islands(img, coverage, opt.padding, threads);
     m.image = std::move(img);

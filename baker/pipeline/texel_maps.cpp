@@ -137,7 +137,8 @@ struct TexelMaps::Impl {
     if (q.n == 0) return;
     raycast::RayBatch batch = q.rays.rays();
     batch.group = q.group.empty() ? nullptr : q.group.data();
-    const std::uint32_t* groups = in.groups && in.groups->active() && !in.maps->ao_occluders_all ? in.groups->high.data() : nullptr;
+    const std::uint32_t* groups =
+        in.groups && in.groups->active() && !in.maps->ao_occluders_all ? in.groups->high.data() : nullptr;
     if (k == 0) {
       raycast::SecondaryRayOptions so;
       so.group = groups;
@@ -175,7 +176,9 @@ void TexelMaps::restore_unrefined(const std::uint8_t* refine) {
   Impl& m = *impl_;
   const std::size_t w = std::size_t(m.stride);
   for (std::size_t i = 0; i < m.texels; ++i)
-    if (!refine[i]) std::copy(m.kept.begin() + std::ptrdiff_t(i * w), m.kept.begin() + std::ptrdiff_t((i + 1) * w), m.sums.begin() + std::ptrdiff_t(i * w));
+    if (!refine[i])
+      std::copy(m.kept.begin() + std::ptrdiff_t(i * w), m.kept.begin() + std::ptrdiff_t((i + 1) * w),
+                m.sums.begin() + std::ptrdiff_t(i * w));
 }
 
 void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, int width, int level, std::size_t per_texel) {
@@ -368,9 +371,7 @@ void TexelMaps::write(MapTargets& out, int x0, int y0, int w, int h, int side, i
             break;
           }
           case MapKind::height:
-          case MapKind::curvature:
-            px[0] = float(hits > 0.0 ? v[0] / hits : 0.0);
-            break;
+          case MapKind::curvature: px[0] = float(hits > 0.0 ? v[0] / hits : 0.0); break;
           case MapKind::position: {
             const double* miss = m.at(i, s_miss_position);
             for (int c = 0; c < 3; ++c) px[c] = float(hits > 0.0 ? v[c] / hits : miss[c] / samples);
@@ -396,8 +397,7 @@ void TexelMaps::write(MapTargets& out, int x0, int y0, int w, int h, int side, i
           case MapKind::material_id:
             for (int c = 0; c < 3; ++c) px[c] = float(v[0]);
             break;
-          default:
-            break;
+          default: break;
         }
       }
     }

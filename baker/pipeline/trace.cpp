@@ -58,9 +58,9 @@ struct Shared {
   bool batched = false;     // tangent space, per-pixel bitangent: shade_batch.h shades most samples
   bool per_object = false;  // several objects: hits counted per object
   const raycast::HitRule* hit_rule = nullptr;
-  bool prefer = false;    // the rule looks at the rays' preferred parts (back faces skipped)
-  bool by_texel = false;  // cast texel by texel even without a rule (trace_and_shade's by_texel)
-  RayGroups groups;       // with --match: per low-poly triangle and BVH triangle
+  bool prefer = false;              // the rule looks at the rays' preferred parts (back faces skipped)
+  bool by_texel = false;            // cast texel by texel even without a rule (trace_and_shade's by_texel)
+  RayGroups groups;                 // with --match: per low-poly triangle and BVH triangle
   const MapInputs* maps = nullptr;  // the extra maps (TraceTargets::maps), or null: none
   std::vector<ThreadStats> stats;
   // Hit distances summed per tile, then over tiles in order: the mean does not depend on which
@@ -232,9 +232,10 @@ class TileTracer {
     shade(sample_count);
     if (maps_) {
       const bool one_ray = sh_.rays_per_sample == 1;
-      maps_->shade({sample_tri_.data(), sb_, sample_texel_.data(), one_ray ? hits_.triangle : chosen_tri_.data(),
-                    one_ray ? hits_.u : chosen_u_.data(), one_ray ? hits_.v : chosen_v_.data(), sample_dist_.data(), sample_count},
-                   rect.x0, rect.y0, side_, sh_.opt.width, pass_level_, offsets.size());
+      maps_->shade(
+          {sample_tri_.data(), sb_, sample_texel_.data(), one_ray ? hits_.triangle : chosen_tri_.data(),
+           one_ray ? hits_.u : chosen_u_.data(), one_ray ? hits_.v : chosen_v_.data(), sample_dist_.data(), sample_count},
+          rect.x0, rect.y0, side_, sh_.opt.width, pass_level_, offsets.size());
     }
     return dsum;
   }
