@@ -62,8 +62,12 @@ void distance_1d(const double* f, int n, double* d, int* arg, int* v, double* z)
 }  // namespace
 
 std::size_t pad_islands(Image& image, const std::vector<std::uint8_t>& covered, int padding, int threads) {
-  if (padding <= 0) return 0;
-  const int w = image.width, h = image.height;
+  return pad_islands(std::vector<Image*>{&image}, covered, padding, threads);
+}
+
+std::size_t pad_islands(const std::vector<Image*>& images, const std::vector<std::uint8_t>& covered, int padding, int threads) {
+  if (padding <= 0 || images.empty()) return 0;
+  const int w = images.front()->width, h = images.front()->height;
   const std::size_t n = std::size_t(w) * h;
   // Nothing to fill from, or nothing to fill: skip the distance transform.
   const std::size_t covered_count =
@@ -125,9 +129,11 @@ std::size_t pad_islands(Image& image, const std::vector<std::uint8_t>& covered, 
       for (int x = 0; x < w; ++x) {
         if (covered[std::size_t(y) * w + x] || arg[x] < 0 || d[x] > limit) continue;
         const int sx = arg[x], sy = gy[std::size_t(y) * w + sx];
-        const float* src = image.at(sx, sy);
-        float* dst = image.at(x, y);
-        for (int c = 0; c < image.channels; ++c) dst[c] = src[c];
+        for (Image* image : images) {
+          const float* src = image->at(sx, sy);
+          float* dst = image->at(x, y);
+          for (int c = 0; c < image->channels; ++c) dst[c] = src[c];
+        }
         ++filled[std::size_t(part)];
       }
     }

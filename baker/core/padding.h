@@ -16,5 +16,8 @@ namespace nmbake {
 // deterministically. Returns the number of texels filled. `threads` share the work (0 = all cores);
 // the result does not depend on it.
 std::size_t pad_islands(Image& image, const std::vector<std::uint8_t>& covered, int padding, int threads = 0);
+// The same for several images of one size (the maps of a texture set), the nearest texels found once.
+std::size_t pad_islands(const std::vector<Image*>& images, const std::vector<std::uint8_t>& covered, int padding,
+                        int threads = 0);
 
 }  // namespace nmbake

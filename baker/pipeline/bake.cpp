@@ -287,7 +287,16 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     BakeResult result;
     BakeStats& st = result.stats;
     std::vector<std::uint8_t> disagree;  // per texel: its samples disagree (suspect), with several samples
-    OutputAllocation outputs([&opt, &result, &disagree] { allocate_outputs(opt, result, disagree); });
+    const bool extra = opt.maps.wants_extra();
+    // The other maps' raw values and the curvature, made while the stages before the trace run.
+    MapTargets map_out;
+    std::vector<float> curvature;
+    OutputAllocation outputs([&opt, &result, &disagree, &map_out, &curvature, &high, extra] {
+      allocate_outputs(opt, result, disagree);
+      if (!extra) return;
+      map_out = allocate_map_targets(opt.maps, opt.width, opt.height);
+      curvature = map_curvature(opt, high);
+    });
     const auto kept = std::make_shared<TraceInputs>();
     TraceInputs& in = *kept;
     prepare_trace(low, high, cage, opt, threads, in, result, stage);
@@ -297,14 +306,9 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     auto t0 = Clock::now();
     const double cpu0 = process_cpu_seconds();
     const TileBins bins = bin_triangles(low, opt.width, opt.height, trace_tile_side(opt));
-    MapInputs map_in;
-    MapTargets map_out;
-    const bool extra = opt.maps.wants_extra();
-    if (extra) {
-      map_in = make_map_inputs(opt, in.s, in.scene, in.selection, high);
-      map_out = allocate_map_targets(opt.maps, opt.width, opt.height);
-    }
     outputs.wait();
+    MapInputs map_in;
+    if (extra) map_in = make_map_inputs(opt, in.s, in.scene, in.selection, high, std::move(curvature));
     trace_and_shade(
         in.s, in.scene, bins, in.rays, opt, threads,
         {result.map, result.coverage, result.miss_mask, disagree, extra ? &map_in : nullptr, extra ? &map_out : nullptr}, st);

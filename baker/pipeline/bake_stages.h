@@ -110,8 +110,8 @@ class OutputAllocation {
   }
   OutputAllocation(const OutputAllocation&) = delete;
   OutputAllocation& operator=(const OutputAllocation&) = delete;
-  void wait() {
-    thread_.join();
+  void wait() {  // again: returns at once (or throws the same error)
+    if (thread_.joinable()) thread_.join();
     if (error_) std::rethrow_exception(error_);
   }
 

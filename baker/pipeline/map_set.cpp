@@ -104,17 +104,24 @@ std::vector<glm::vec3> id_colors(const std::vector<std::string>& names) {
   return out;
 }
 
+std::vector<float> map_curvature(const BakeOptions& opt, const Mesh& high) {
+  return opt.maps.wants(MapKind::curvature) ? vertex_mean_curvature(high) : std::vector<float>();
+}
+
 MapInputs make_map_inputs(const BakeOptions& opt, const Prepared& s, const HighScene& scene, const HighSelection& selection,
-                          const Mesh& high) {
+                          const Mesh& high, std::vector<float> curvature) {
   MapInputs in;
+  in.curvature = std::move(curvature);
   in.maps = &opt.maps;
   in.s = &s;
   in.scene = &scene;
   in.high = &high;
   in.source = selection.kept.empty() ? nullptr : selection.kept.data();
   in.object = scene.object;
-  if (opt.maps.wants(MapKind::material_id) && !high.triangle_material.empty()) in.material = high.triangle_material;
-  if (opt.maps.wants(MapKind::curvature)) in.curvature = vertex_mean_curvature(high);
+  if (opt.maps.wants(MapKind::material_id) && !high.triangle_material.empty()) {  // per BVH triangle, as `object`
+    in.material.resize(scene.triangles);
+    for (std::size_t t = 0; t < scene.triangles; ++t) in.material[t] = high.triangle_material[in.source ? in.source[t] : t];
+  }
   in.ao_distance = opt.maps.ao_distance > 0.0 ? opt.maps.ao_distance : kAutoAoDistance * s.diagonal;
   in.thickness_distance = opt.maps.thickness_distance > 0.0 ? opt.maps.thickness_distance : kAutoThickness * s.diagonal;
   in.epsilon = 1e-5 * s.diagonal;
@@ -242,10 +249,13 @@ std::vector<BakedMap> finish_maps(const BakeOptions& opt, const Prepared& s, con
         break;
       default: break;
     }
-    if (!img.pixels.empty()) pad_islands(img, coverage, opt.padding, threads);
     m.image = std::move(img);
     out.push_back(std::move(m));
   }
+  std::vector<Image*> images;  // padded together: the nearest covered texels found once
+  for (BakedMap& m : out)
+    if (!m.image.pixels.empty()) images.push_back(&m.image);
+  pad_islands(images, coverage, opt.padding, threads);
   return out;
 }
 

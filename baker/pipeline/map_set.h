@@ -11,9 +11,14 @@
 
 namespace nmbake {
 
-// The inputs of opt.maps's extra maps over the BVH `scene` of the triangles `selection` keeps.
+// The high-poly's mean curvature per position (core/curvature.h) when opt.maps asks for the
+// curvature map, else empty: it reads the mesh alone, so it runs beside the stages before the trace.
+std::vector<float> map_curvature(const BakeOptions& opt, const Mesh& high);
+
+// The inputs of opt.maps's extra maps over the BVH `scene` of the triangles `selection` keeps,
+// with the curvature of map_curvature.
 MapInputs make_map_inputs(const BakeOptions& opt, const Prepared& s, const HighScene& scene, const HighSelection& selection,
-                          const Mesh& high);
+                          const Mesh& high, std::vector<float> curvature);
 
 // The ranges the raw values are mapped to [0, 1] by: height, opt.maps's range or the bake's own,
 // symmetric about 0 (0.5 is the low-poly surface); curvature, opt.maps's scale or the bake's own,

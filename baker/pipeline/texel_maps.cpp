@@ -12,6 +12,7 @@ namespace nmbake {
 namespace {
 
 constexpr std::size_t kRayBatch = 4096;  // secondary rays cast together
+constexpr std::size_t kAhead = 8;        // samples ahead whose hit data is fetched early
 
 // What a covered texel whose samples all miss gets: open, thick, flat, on the low-poly surface
 // (height 0, position the low-poly point), no colour, no ID.
@@ -100,6 +101,8 @@ struct TexelMaps::Impl {
   std::vector<double> thick_sum, thick_sq;
   std::vector<std::uint32_t> seen;
   std::vector<std::int64_t> vote;
+  std::vector<std::uint32_t> start, order, fill;   // the ID vote's counting sort
+  bool needs_point = false, needs_normal = false;  // the hit's point / normal is read
 
   Impl(const MapInputs& in_, std::size_t tile_texels) : in(in_), texels(tile_texels) {
     std::fill(offset, offset + kSlots, -1);
@@ -120,6 +123,8 @@ struct TexelMaps::Impl {
     rays_ao = in.maps->wants(MapKind::ao) || in.maps->wants(MapKind::bent_normal);
     rays_thickness = in.maps->wants(MapKind::thickness);
     ids = in.maps->wants(MapKind::object_id) || in.maps->wants(MapKind::material_id);
+    needs_point = has(s_position) || rays_ao || rays_thickness;
+    needs_normal = has(s_object_normal) || has(s_bent) || rays_ao || rays_thickness;
     if (in.groups && in.groups->active())
       for (RayQueue& q : queue) q.group.resize(kRayBatch);
   }
@@ -207,31 +212,50 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
     const std::uint32_t appearance = m.seen[i]++;
     *m.at(i, s_samples) += 1.0;
     const LowTriangle& lt = s.low_tris[tri];
-    const glm::dvec3 low_p = b[0] * lt.p[0] + b[1] * lt.p[1] + b[2] * lt.p[2];
-    glm::dvec3 low_n = b[0] * lt.n[0] + b[1] * lt.n[1] + b[2] * lt.n[2];
-    const double low_len = glm::length(low_n);
-    low_n = low_len > 0.0 ? low_n / low_len : glm::dvec3(0, 0, 1);
+    const auto low_normal = [&] {
+      const glm::dvec3 ln = b[0] * lt.n[0] + b[1] * lt.n[1] + b[2] * lt.n[2];
+      const double l = glm::length(ln);
+      return l > 0.0 ? ln / l : glm::dvec3(0, 0, 1);
+    };
+    if (r + kAhead < n && smp.hit_tri[r + kAhead] != raycast::no_hit) {  // the hit's data, scattered over the mesh
+      const std::size_t ahead = smp.hit_tri[r + kAhead];
+      __builtin_prefetch(&sc.index[3 * ahead]);
+      if (in.object) __builtin_prefetch(&in.object[ahead]);
+      if (!in.material.empty()) __builtin_prefetch(&in.material[ahead]);
+    }
     const std::uint32_t ht = smp.hit_tri[r];
     if (ht == raycast::no_hit) {
-      if (m.has(s_object_normal))
-        for (int c = 0; c < 3; ++c) m.at(i, s_object_normal)[c] += low_n[c];
-      if (m.has(s_miss_position))
+      if (m.has(s_object_normal)) {
+        const glm::dvec3 ln = low_normal();
+        for (int c = 0; c < 3; ++c) m.at(i, s_object_normal)[c] += ln[c];
+      }
+      if (m.has(s_miss_position)) {
+        const glm::dvec3 low_p = b[0] * lt.p[0] + b[1] * lt.p[1] + b[2] * lt.p[2];
         for (int c = 0; c < 3; ++c) m.at(i, s_miss_position)[c] += low_p[c];
+      }
       continue;
     }
-    // The hit: point and normal interpolated with its barycentrics; the face normal where the
-    // corner normals cancel.
+    // The hit: point and normal interpolated with its barycentrics (each only where a map reads
+    // it); the face normal where the corner normals cancel.
     const double w[3] = {1.0 - double(smp.u[r]) - double(smp.v[r]), double(smp.u[r]), double(smp.v[r])};
-    glm::dvec3 q[3], x(0.0), nh(0.0);
-    for (int c = 0; c < 3; ++c) {
-      q[c] = glm::dvec3(sc.positions[sc.index[3 * std::size_t(ht) + std::size_t(c)]]);
-      x += w[c] * q[c];
-      nh += w[c] * glm::dvec3(sc.normals[3 * std::size_t(ht) + std::size_t(c)]);
+    const std::uint32_t* corner = &sc.index[3 * std::size_t(ht)];
+    glm::dvec3 q[3], x(0.0), nh(0.0), face(0.0);
+    if (m.needs_point) {
+      for (int c = 0; c < 3; ++c) {
+        q[c] = glm::dvec3(sc.positions[corner[c]]);
+        x += w[c] * q[c];
+      }
+      face = glm::cross(q[1] - q[0], q[2] - q[0]);
     }
-    const glm::dvec3 face = glm::cross(q[1] - q[0], q[2] - q[0]);
-    double len = glm::length(nh);
-    if (!(len > 1e-12)) nh = face, len = glm::length(nh);
-    nh = len > 0.0 ? nh / len : low_n;
+    if (m.needs_normal) {
+      for (int c = 0; c < 3; ++c) nh += w[c] * glm::dvec3(sc.normals[3 * std::size_t(ht) + std::size_t(c)]);
+      double len = glm::length(nh);
+      if (!(len > 1e-12)) {
+        for (int c = 0; c < 3; ++c) q[c] = glm::dvec3(sc.positions[corner[c]]);
+        nh = glm::cross(q[1] - q[0], q[2] - q[0]), len = glm::length(nh);
+      }
+      nh = len > 0.0 ? nh / len : low_normal();
+    }
     m.hit_point[r] = x;
     m.hit_normal[r] = nh;
     *m.at(i, s_hits) += 1.0;
@@ -243,7 +267,7 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
     const std::uint32_t src = m.source_tri(ht);
     if (m.has(s_curvature)) {
       double k = 0.0;
-      for (int c = 0; c < 3; ++c) k += w[c] * double(in.curvature[sc.index[3 * std::size_t(ht) + std::size_t(c)]]);
+      for (int c = 0; c < 3; ++c) k += w[c] * double(in.curvature[corner[c]]);
       *m.at(i, s_curvature) += k;
     }
     if (m.has(s_color) && in.high->has_colors())
@@ -253,7 +277,7 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
       }
     if (m.ids) {
       m.object_id[r] = in.object ? std::int64_t(in.object[ht]) : 0;
-      m.material_id[r] = in.material.empty() ? 0 : std::int64_t(in.material[src]);
+      m.material_id[r] = in.material.empty() ? 0 : std::int64_t(in.material[ht]);
     }
     // Secondary rays from just off the surface, on the side the rays go to.
     if (!m.rays_ao && !m.rays_thickness) continue;
@@ -326,10 +350,12 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
       if (!m.has(slot)) continue;
       const std::vector<std::int64_t>& id = which == 0 ? m.object_id : m.material_id;
       // Samples grouped by texel, in sample order (a counting sort).
-      std::vector<std::uint32_t> start(m.texels + 1, 0), order(n);
+      std::vector<std::uint32_t>&start = m.start, &order = m.order, &fill = m.fill;
+      start.assign(m.texels + 1, 0);
+      order.resize(n);
       for (std::size_t r = 0; r < n; ++r) ++start[std::size_t(smp.texel[r]) + 1];
       for (std::size_t t = 1; t <= m.texels; ++t) start[t] += start[t - 1];
-      std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+      fill.assign(start.begin(), start.end() - 1);
       for (std::size_t r = 0; r < n; ++r) order[fill[smp.texel[r]]++] = std::uint32_t(r);
       for (std::size_t t = 0; t < m.texels; ++t) {
         if (start[t] == start[t + 1]) continue;

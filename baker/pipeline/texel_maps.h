@@ -31,7 +31,7 @@ struct MapInputs {
   // Per BVH triangle its high-poly triangle (HighSelection::kept), or null: the same index.
   const std::uint32_t* source = nullptr;
   std::vector<float> curvature;  // with the curvature map: per high-poly position, 1 / scene units
-  // Per BVH triangle, the high-poly object's / material's index (null: 0 for all).
+  // Per BVH triangle, the high-poly object's / material's index (null, empty: 0 for all).
   const std::uint32_t* object = nullptr;
   std::vector<std::uint32_t> material;
   // AO and bent normals: rays meeting the high-poly within ao_distance are occluded; thickness:

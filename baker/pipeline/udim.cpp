@@ -194,21 +194,24 @@ UdimBake bake_udim_tiles(const Mesh& low, const Mesh& high, const Mesh* cage, co
     UdimBake out;
     out.tiles.resize(n);
     std::vector<std::vector<std::uint8_t>> disagree(n);  // per tile, per texel: its samples disagree
-    OutputAllocation outputs([&opt, &out, &disagree] {
+    const bool extra = opt.maps.wants_extra();
+    std::vector<MapTargets> map_out(extra ? n : 0);  // per tile, the other maps' raw values
+    std::vector<float> curvature;
+    OutputAllocation outputs([&opt, &out, &disagree, &map_out, &curvature, &high, extra] {
       for (std::size_t i = 0; i < out.tiles.size(); ++i) allocate_outputs(opt, out.tiles[i].result, disagree[i]);
+      for (MapTargets& t : map_out) t = allocate_map_targets(opt.maps, opt.width, opt.height);
+      if (extra) curvature = map_curvature(opt, high);
     });
     BakeResult shared;
     const auto kept = std::make_shared<TraceInputs>();
     TraceInputs& in = *kept;
     prepare_trace(low, high, cage, opt, threads, in, shared, stage);
 
-    // The extra maps: what they read, once; where they go, per tile.
-    const bool extra = opt.maps.wants_extra();
+    // The extra maps: what they read, once for every tile (after the allocation's curvature).
     MapInputs map_in;
-    std::vector<MapTargets> map_out(extra ? n : 0);
     if (extra) {
-      map_in = make_map_inputs(opt, in.s, in.scene, in.selection, high);
-      for (MapTargets& t : map_out) t = allocate_map_targets(opt.maps, opt.width, opt.height);
+      outputs.wait();
+      map_in = make_map_inputs(opt, in.s, in.scene, in.selection, high, std::move(curvature));
     }
 
     // Trace: every tile with the shared scene, its own bins. Progress runs over all tiles.
