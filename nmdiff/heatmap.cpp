@@ -63,7 +63,7 @@ int text_width(const std::string& text, int scale) { return static_cast<int>(tex
 
 }  // namespace
 
-Image render_heatmap(const AngleField& field, double scale_max_deg) {
+Image render_heatmap(const AngleField& field, double scale_max_deg, const std::string& unit) {
   const int w = field.width, h = field.height;
   if (!(scale_max_deg > 0.0)) scale_max_deg = 1.0;
 
@@ -72,8 +72,9 @@ Image render_heatmap(const AngleField& field, double scale_max_deg) {
   const int bar = std::max(4, h / 16);
   const int scale = std::max(1, std::min(w, h) / 256);
   char max_text[32];
-  std::snprintf(max_text, sizeof max_text, "%.3go", scale_max_deg);
-  const bool with_text = w >= text_width("0o", scale) + text_width(max_text, scale) + 4 * scale;
+  std::snprintf(max_text, sizeof max_text, "%.3g%s", scale_max_deg, unit.c_str());
+  const std::string zero_text = "0" + unit;
+  const bool with_text = w >= text_width(zero_text, scale) + text_width(max_text, scale) + 4 * scale;
   const int text_rows = with_text ? 7 * scale : 0;
   Image out(w, h + gap + bar + text_rows, 3, 0.0f);
 
@@ -91,7 +92,7 @@ Image render_heatmap(const AngleField& field, double scale_max_deg) {
   }
   if (with_text) {
     const int ty = h + gap + bar + scale;
-    draw_text(out, 0, ty, scale, "0o");
+    draw_text(out, 0, ty, scale, zero_text);
     draw_text(out, w - text_width(max_text, scale), ty, scale, max_text);
   }
   return out;

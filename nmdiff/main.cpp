@@ -1,5 +1,6 @@
-// nmdiff: compares two tangent-space normal maps by the angle between their normals.
-// Parses arguments, reads files and wires them to the pure comparison in nmdiff.h.
+// nmdiff: compares two tangent-space normal maps by the angle between their normals, and the
+// texture set's other maps in their own units. Parses arguments, reads files and wires them to the
+// pure comparisons in nmdiff.h and map_diff.h.
 #include <cerrno>
 #include <cmath>
 #include <csignal>
@@ -7,6 +8,7 @@
 #include <cstring>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -22,6 +24,7 @@
 #include "io/output_files.h"
 #include "io/text_file.h"
 #include "conventions.h"
+#include "map_diff.h"
 #include "nmdiff.h"
 
 namespace {
@@ -107,6 +110,78 @@ nlohmann::json to_json(const std::string& a, const std::string& b, const DiffSta
   return j;
 }
 
+// The other maps' summary: the same lines as print_summary's, in the map's units.
+void print_map_summary(const std::string& a, const std::string& b, const diff::MapDiffStats& s, const diff::MapDiffOptions& o,
+                       bool resampled, const std::string& resample) {
+  const bool id = diff::map_family(s.kind) == diff::MapFamily::id;
+  std::cout << "nmdiff: " << a << " vs " << b << " (" << nmbake::map_name(s.kind) << " maps, " << s.width << "x" << s.height
+            << (resampled ? ", B resampled " + (id ? std::string("nearest") : resample) : std::string()) << ")\n";
+  std::cout << "compared " << s.texels_compared << " texels";
+  if (s.padding_compared) std::cout << " (" << s.padding_compared << " of them padding)";
+  std::cout << "; skipped " << s.skipped_mask << " outside the mask, " << s.skipped_alpha << " by alpha\n";
+  const auto& t = o.tolerances;
+  if (id) {
+    std::cout << "colour differs: " << s.texels_differing << " texels (" << fmt("%.4f", 100 * s.share_differing) << "%)";
+    if (s.texels_differing) std::cout << ", first at texel (" << s.worst_x << ", " << s.worst_y << ")";
+    std::cout << "\ntolerance: share <= " << t.max_share << ": " << (s.within ? "within" : "OUTSIDE") << "\n";
+    return;
+  }
+  std::cout << "absolute difference (" << s.units << "): mean " << fmt("%.6g", s.mean) << "  rms " << fmt("%.6g", s.rms)
+            << "  p95 " << fmt("%.6g", s.p95) << "  p99 " << fmt("%.6g", s.p99) << "  max " << fmt("%.6g", s.max);
+  if (s.worst_x >= 0) std::cout << " at texel (" << s.worst_x << ", " << s.worst_y << ")";
+  std::cout << "\ntolerances: mean <= " << t.max_mean << ", p99 <= " << t.max_p99 << ", max <= " << t.max_abs << ": "
+            << (s.within ? "within" : "OUTSIDE") << "\n";
+}
+
+nlohmann::json decoding_json(const diff::MapDecoding& d) {
+  if (!d.from_metadata) return nullptr;
+  nlohmann::json j{{"metadata", d.range_text}};
+  if (d.kind == nmbake::MapKind::position) {
+    j["offset"] = {d.offset[0], d.offset[1], d.offset[2]};
+    j["scale"] = {d.scale[0], d.scale[1], d.scale[2]};
+  } else {
+    j["offset"] = d.offset[0];
+    j["scale"] = d.scale[0];
+  }
+  return j;
+}
+
+// The other maps' statistics; the keys of to_json where they mean the same.
+nlohmann::json map_to_json(const std::string& a, const std::string& b, const diff::MapDiffStats& s, const diff::MapDiffOptions& o,
+                           const std::string& mask, const std::string& resample) {
+  nlohmann::json j;
+  j["a"] = a;
+  j["b"] = b;
+  j["map"] = nmbake::map_name(s.kind);
+  j["units"] = s.units;
+  j["width"] = s.width;
+  j["height"] = s.height;
+  j["texels_compared"] = s.texels_compared;
+  if (diff::map_family(s.kind) == diff::MapFamily::id) {
+    j["texels_differing"] = s.texels_differing;
+    j["share_differing"] = s.share_differing;
+    j["first_differing"] = s.texels_differing ? nlohmann::json{{"x", s.worst_x}, {"y", s.worst_y}} : nlohmann::json(nullptr);
+    j["tolerances"] = {{"max_share", o.tolerances.max_share}};
+  } else {
+    j["mean"] = s.mean;
+    j["rms"] = s.rms;
+    j["p95"] = s.p95;
+    j["p99"] = s.p99;
+    j["max"] = s.max;
+    j["worst"] = s.worst_x >= 0 ? nlohmann::json{{"x", s.worst_x}, {"y", s.worst_y}, {"value", s.max}} : nlohmann::json(nullptr);
+    j["tolerances"] = {{"max_mean", o.tolerances.max_mean}, {"max_p99", o.tolerances.max_p99}, {"max_abs", o.tolerances.max_abs}};
+    j["decoding"] = {{"a", decoding_json(o.decoding_a)}, {"b", decoding_json(o.decoding_b)}};
+  }
+  j["within"] = s.within;
+  j["skipped"] = {{"mask", s.skipped_mask}, {"alpha", s.skipped_alpha}};
+  j["padding_compared"] = s.padding_compared;
+  j["nonfinite_texels"] = s.nonfinite_texels;
+  j["resample"] = resample;
+  j["mask"] = mask.empty() ? nlohmann::json(nullptr) : nlohmann::json(mask);
+  j["warnings"] = s.warnings;
+  return j;
+}
+
 // The command line as given, and the comparison options it sets.
 struct CommandLine {
   diff::DiffOptions options;
@@ -116,6 +191,10 @@ struct CommandLine {
   bool same_convention = false;
   double heatmap_scale = 0.0;  // 0 = automatic
   bool ignore_alpha = false;
+  std::string map_kind;  // --map: "" = from the maps' nmbake:map metadata
+  double max_abs = 0.0, max_share = 0.0;
+  // Which tolerances the command line gives (the others take their defaults for the map's kind).
+  bool mean_given = false, p99_given = false, deg_given = false, abs_given = false, share_given = false;
 };
 
 // A tolerance is a finite number of degrees, at least 0 (NaN would make every comparison pass or
@@ -130,20 +209,48 @@ const CLI::Validator finite_tolerance(
     },
     "DEG>=0");
 
+// --max-abs is in the map's units, --max-share a share of texels in [0,1].
+CLI::Validator finite_at_least_zero(double most) {
+  return CLI::Validator(
+      [most](std::string& text) {
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (end == text.c_str() || *end != '\0' || !std::isfinite(v) || v < 0.0 || v > most)
+          return std::string("a tolerance must be a finite number from 0") + (std::isinf(most) ? "" : " to 1") + ", got '" +
+                 text + "'";
+        return std::string();
+      },
+      std::isinf(most) ? "NUMBER>=0" : "SHARE 0-1");
+}
+
 // nmdiff's arguments, bound to the fields of `cl`, and the text of --help.
 void add_arguments(CLI::App& app, CommandLine& cl) {
   diff::DiffOptions& options = cl.options;
   app.add_option("A", cl.path_a, "Map to check (e.g. a fresh bake); any format OpenImageIO reads")->required();
   app.add_option("B", cl.path_b, "Reference map (e.g. the golden map)")->required();
-  app.add_option("--max-mean", options.tolerances.max_mean_deg, "Tolerance on the mean difference, degrees")
+  app.add_option("--max-mean", options.tolerances.max_mean_deg,
+                 "Tolerance on the mean difference, degrees (other maps: in the map's units, default 0.005 x its range)")
       ->capture_default_str()
       ->check(finite_tolerance);
-  app.add_option("--max-p99", options.tolerances.max_p99_deg, "Tolerance on the 99th percentile, degrees")
+  app.add_option("--max-p99", options.tolerances.max_p99_deg,
+                 "Tolerance on the 99th percentile, degrees (other maps: in the map's units, default 0.01 x its range)")
       ->capture_default_str()
       ->check(finite_tolerance);
-  app.add_option("--max-deg", options.tolerances.max_deg, "Tolerance on the largest difference, degrees")
+  app.add_option("--max-deg", options.tolerances.max_deg, "Tolerance on the largest difference, degrees (normal maps)")
       ->capture_default_str()
       ->check(finite_tolerance);
+  app.add_option("--max-abs", cl.max_abs,
+                 "Grey maps (ao, thickness, height, curvature, position, vertex-color): tolerance on the largest "
+                 "absolute difference, in the map's units (default 0.02 x its range)")
+      ->check(finite_at_least_zero(std::numeric_limits<double>::infinity()));
+  app.add_option("--max-share", cl.max_share,
+                 "ID maps (object-id, material-id): tolerance on the share of texels whose colour differs (default 0)")
+      ->check(finite_at_least_zero(1.0));
+  app.add_option("--map", cl.map_kind,
+                 "Compare as this kind of map, whatever the files' nmbake:map metadata says (needed for maps "
+                 "without it; without either, a normal map)")
+      ->check(CLI::IsMember({"normal", "object-normal", "ao", "bent-normal", "height", "thickness", "curvature", "position",
+                             "object-id", "material-id", "vertex-color"}));
   app.add_option("--mask", cl.mask_path,
                  "Low-poly mesh (OBJ, PLY, OFF, STL with UVs): compare only texels inside its UV layout, "
                  "rasterized as the baker does, so padding is ignored");
@@ -180,6 +287,10 @@ void add_arguments(CLI::App& app, CommandLine& cl) {
       "of nearly equal float maps by at most 0.78 deg (p99 0.45 deg).\n"
       "A warning is printed when the maps look like they differ by a green flip or a red/green swap.\n"
       "The last line of output is: mean=<deg> p99=<deg> max=<deg> texels=<n> within=<0|1>\n"
+      "Other maps (kind from nmbake:map or --map) compare in their units, decoded with each file's own\n"
+      "range (height and position: scene units, curvature: 1/scene units, ao and thickness: a share,\n"
+      "vertex-color: RGB 0-1); ID maps by exact colour. Their last line: map=<kind> units=<units>\n"
+      "mean=<v> p99=<v> max=<v> texels=<n> within=<0|1> (ID maps: differing=<n> share=<v>).\n"
       "Maps whose nmbake:green, nmbake:space or nmbake:bitangent metadata disagree are a difference:\n"
       "exit 1, said on stderr (with --same-convention green is normalised, different spaces refused).\n"
       "Outputs are checked first (an input or another output: exit 2; a folder, device, FIFO or\n"
@@ -213,17 +324,28 @@ std::optional<int> parse_command_line(int argc, char** argv, CommandLine& cl) {
 
   if (const std::optional<int> status = nmbake::parse_command_line(app, argc, argv, "nmdiff")) return status;
   cl.green_given = app.count("--green-a") + app.count("--green-b") > 0;
+  cl.mean_given = app.count("--max-mean") > 0;
+  cl.p99_given = app.count("--max-p99") > 0;
+  cl.deg_given = app.count("--max-deg") > 0;
+  cl.abs_given = app.count("--max-abs") > 0;
+  cl.share_given = app.count("--max-share") > 0;
   apply_choices(cl);
   return std::nullopt;
 }
 
 // Map A and map B compared.
 struct Comparison {
-  DiffStats stats;
+  nmbake::MapKind kind = nmbake::MapKind::normal;
+  DiffStats stats;         // normal-like maps
   diff::AngleField field;  // filled only when a heatmap is asked for
   bool resized = false;    // B was resampled onto A's grid
   Conventions seen;        // what the maps' metadata said
+  // The other maps (diff::map_family not normal): what was compared with what, and how.
+  diff::MapDiffOptions map_options;
+  diff::MapDiffStats map_stats;
 };
+
+bool is_normal_like(const Comparison& c) { return diff::map_family(c.kind) == diff::MapFamily::normal; }
 
 std::string metadata_value(const std::map<std::string, std::string>& metadata, const char* key) {
   const auto it = metadata.find(key);
@@ -260,6 +382,54 @@ Conventions read_conventions(CommandLine& cl) {
   return seen;
 }
 
+// Refuses a tolerance option of another family of maps than `kind`'s (a bad command line, exit 2).
+void check_tolerance_options(const CommandLine& cl, nmbake::MapKind kind) {
+  const std::string what = cl.path_a + " is " + (cl.map_kind.empty() ? "" : "compared as ") +
+                           (nmbake::map_name(kind)[0] == 'a' || nmbake::map_name(kind)[0] == 'o' ? "an " : "a ") +
+                           nmbake::map_name(kind) + " map";
+  switch (diff::map_family(kind)) {
+    case diff::MapFamily::normal:
+      if (cl.abs_given || cl.share_given)
+        throw nmbake::UsageError(std::string(cl.abs_given ? "--max-abs" : "--max-share") + " is for the other maps: " + what +
+                                 " (its tolerances are --max-mean, --max-p99 and --max-deg, degrees)");
+      break;
+    case diff::MapFamily::grey:
+      if (cl.deg_given || cl.share_given)
+        throw nmbake::UsageError(std::string(cl.deg_given ? "--max-deg" : "--max-share") + " is not for this map: " + what +
+                                 " (its tolerances are --max-mean, --max-p99 and --max-abs, in its units)");
+      break;
+    case diff::MapFamily::id:
+      if (cl.mean_given || cl.p99_given || cl.deg_given || cl.abs_given)
+        throw nmbake::UsageError(std::string(cl.mean_given  ? "--max-mean"
+                                             : cl.p99_given ? "--max-p99"
+                                             : cl.deg_given ? "--max-deg"
+                                                            : "--max-abs") +
+                                 " is not for this map: " + what + " (compared by exact colour; its tolerance is --max-share)");
+      break;
+  }
+}
+
+// The other maps: decoded with each file's ranges and compared in their units (map_diff.h).
+void compare_other_maps(const CommandLine& cl, const nmbake::Image& a, const nmbake::Image& b,
+                        const std::map<std::string, std::string>& metadata_a,
+                        const std::map<std::string, std::string>& metadata_b, Comparison& c) {
+  diff::MapDiffOptions& mo = c.map_options;
+  mo.decoding_a = diff::map_decoding(c.kind, metadata_a, cl.path_a);
+  mo.decoding_b = diff::map_decoding(c.kind, metadata_b, cl.path_b);
+  mo.mask = cl.options.mask;
+  mo.use_alpha = cl.options.use_alpha;
+  mo.include_padding = cl.options.include_padding;
+  mo.resample = cl.options.resample;
+  // Defaults from A's range (B's where A has none: the comparison decodes A with it then).
+  const bool a_ranged = mo.decoding_a.from_metadata || !mo.decoding_b.from_metadata;
+  mo.tolerances = diff::default_map_tolerances(a_ranged ? mo.decoding_a : mo.decoding_b);
+  if (cl.mean_given) mo.tolerances.max_mean = cl.options.tolerances.max_mean_deg;
+  if (cl.p99_given) mo.tolerances.max_p99 = cl.options.tolerances.max_p99_deg;
+  if (cl.abs_given) mo.tolerances.max_abs = cl.max_abs;
+  if (cl.share_given) mo.tolerances.max_share = cl.max_share;
+  c.map_stats = diff::compare_maps(a, b, mo, cl.heatmap_path.empty() ? nullptr : &c.field);
+}
+
 // Reads both maps and the --mask mesh (setting cl.options.mask) and compares the maps.
 Comparison compare_files(CommandLine& cl) {
   const std::string &path_a = cl.path_a, &path_b = cl.path_b;
@@ -267,6 +437,25 @@ Comparison compare_files(CommandLine& cl) {
   Comparison c;
   const nmbake::Image a = nmbake::read_image(path_a);
   const nmbake::Image b = nmbake::read_image(path_b);
+  const auto metadata_a = nmbake::read_image_metadata(path_a);
+  const auto metadata_b = nmbake::read_image_metadata(path_b);
+  c.kind = diff::resolve_map_kind(cl.map_kind, metadata_value(metadata_a, "nmbake:map"), metadata_value(metadata_b, "nmbake:map"),
+                                  path_a, path_b);
+  check_tolerance_options(cl, c.kind);
+  if (!is_normal_like(c)) {
+    c.resized = a.width != b.width || a.height != b.height;
+    if (c.resized && options.resample == diff::Resample::none)
+      throw nmbake::InputError("sizes differ: " + path_a + " is " + std::to_string(a.width) + "x" + std::to_string(a.height) +
+                               ", " + path_b + " is " + std::to_string(b.width) + "x" + std::to_string(b.height) +
+                               " (use --resample nearest|bilinear|box)");
+    if (!cl.mask_path.empty()) {
+      nmbake::LoadOptions load;
+      load.require_uvs = true;
+      options.mask = diff::uv_layout_mask(nmbake::load_mesh(cl.mask_path, load), a.width, a.height);
+    }
+    compare_other_maps(cl, a, b, metadata_a, metadata_b, c);
+    return c;
+  }
   diff::check_normal_map(a, path_a);
   diff::check_normal_map(b, path_b);
   c.seen = read_conventions(cl);
@@ -302,9 +491,48 @@ double write_heatmap(const CommandLine& cl, const Comparison& c, nmbake::OutputF
   return scale;
 }
 
+// The other maps' heatmap: the absolute differences in the map's units (ID maps: 1 where the colour
+// differs), with the scale and units in the metadata, to its temporary in `outputs`. Returns the scale.
+double write_map_heatmap(const CommandLine& cl, const Comparison& c, nmbake::OutputFiles& outputs) {
+  const diff::MapDiffStats& s = c.map_stats;
+  const bool id = diff::map_family(s.kind) == diff::MapFamily::id;
+  const double automatic = id ? 1.0 : std::max(c.map_options.tolerances.max_abs, s.p99);
+  const double scale = cl.heatmap_scale > 0 ? cl.heatmap_scale : automatic > 0 ? automatic : 1.0;
+  nmbake::WriteOptions out;
+  out.metadata = {{"nmdiff:map", nmbake::map_name(s.kind)},
+                  {"nmdiff:units", s.units},
+                  {"nmdiff:scale_min", "0"},
+                  {"nmdiff:scale_max", fmt("%.6g", scale)},
+                  {"nmdiff:legend",
+                   "bar under the map: 0 at the left, scale_max (in units) at the right; "
+                   "dark grey texels were not compared"},
+                  {"nmdiff:a", cl.path_a},
+                  {"nmdiff:b", cl.path_b}};
+  out.temp_path = outputs.add(cl.heatmap_path);
+  nmbake::write_image(cl.heatmap_path, diff::render_heatmap(c.field, scale, ""), out);
+  return scale;
+}
+
+// report() for the other maps.
+void report_map(const CommandLine& cl, const Comparison& c) {
+  const diff::MapDiffStats& s = c.map_stats;
+  print_map_summary(cl.path_a, cl.path_b, s, c.map_options, c.resized, cl.resample);
+  for (const std::string& w : s.warnings) std::cerr << "warning: " << w << "\n";
+  nmbake::OutputFiles outputs;
+  const double scale = cl.heatmap_path.empty() ? 0.0 : write_map_heatmap(cl, c, outputs);
+  if (!cl.json_path.empty())
+    nmbake::write_text_file(cl.json_path, outputs.add(cl.json_path),
+                            map_to_json(cl.path_a, cl.path_b, s, c.map_options, cl.mask_path, cl.resample).dump(2) + "\n");
+  outputs.commit();
+  if (!cl.heatmap_path.empty())
+    std::cout << "heatmap: " << cl.heatmap_path << " (0 to " << fmt("%.3g", scale) << " " << s.units << ")\n";
+  std::cout << diff::map_summary_line(s) << std::endl;
+}
+
 // Everything nmdiff prints and writes after the comparison, in order: the summary, warnings, the
 // heatmap and the JSON (renamed into place together), and the last line.
 void report(const CommandLine& cl, const Comparison& c) {
+  if (!is_normal_like(c)) return report_map(cl, c);
   print_summary(cl.path_a, cl.path_b, c.stats, cl.options, c.resized, cl.resample);
   for (const std::string& w : c.stats.warnings) std::cerr << "warning: " << w << "\n";
   nmbake::OutputFiles outputs;
@@ -337,6 +565,7 @@ int run(int argc, char** argv) {
   check_outputs(cl);
   const Comparison c = compare_files(cl);
   report(cl, c);
+  if (!is_normal_like(c)) return c.map_stats.within ? kWithin : kOutside;
   return verdict_within(c.stats, c.seen) ? kWithin : kOutside;
 }
 

@@ -100,8 +100,9 @@ std::string summary_line(const DiffStats& stats);
 // A colour picture of `field`: 0 deg dark blue-violet rising through teal and green to yellow at
 // `scale_max_deg` (and above); texels not compared are dark grey. A legend bar from 0 (left) to
 // scale_max_deg (right) is drawn under the map, with the two values written in small digits when
-// the picture is wide enough. RGB, values in [0,1].
-Image render_heatmap(const AngleField& field, double scale_max_deg);
+// the picture is wide enough, each followed by `unit` ("o" draws a degree sign; "" for the other
+// maps, whose field holds differences in their own units). RGB, values in [0,1].
+Image render_heatmap(const AngleField& field, double scale_max_deg, const std::string& unit = "o");
 
 // The automatic heatmap scale: max(tolerances.max_deg, stats.p99_deg), at least 0.1 deg.
 double auto_heatmap_scale(const DiffStats& stats, const Tolerances& tolerances);
