@@ -280,3 +280,19 @@ TEST(NmdiffMaps, CommandLineNamesKindUnitsAndExitsByTolerance) {
   EXPECT_TRUE(nmbake::test::contains(err, "a.exr is a height map, ao.png an ao map")) << err;
   EXPECT_EQ(err.find('\n'), err.size() - 1) << err;
 }
+
+TEST(NmdiffMaps, VertexColorIsTheLargestChannelDifferenceInRgb) {
+  Image a(4, 2, 3, 0.25f), b(4, 2, 3, 0.25f);
+  b.at(1, 1)[0] = 0.35f;  // red 0.1
+  b.at(1, 1)[2] = 0.45f;  // blue 0.2: this texel differs by 0.2
+  diff::MapDiffOptions o;
+  o.decoding_a = o.decoding_b = diff::map_decoding(MapKind::vertex_color, {}, "a");
+  o.tolerances = diff::default_map_tolerances(o.decoding_a);
+  const diff::MapDiffStats s = diff::compare_maps(a, b, o);
+  EXPECT_EQ(s.units, "rgb");
+  EXPECT_NEAR(s.max, 0.2, 1e-6);
+  EXPECT_NEAR(s.mean, 0.2 / 8, 1e-6);
+  EXPECT_EQ(s.worst_x, 1);
+  EXPECT_EQ(s.worst_y, 1);
+  EXPECT_FALSE(s.within);
+}
