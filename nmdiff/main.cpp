@@ -442,7 +442,8 @@ Comparison compare_files(CommandLine& cl) {
   c.kind = diff::resolve_map_kind(cl.map_kind, metadata_value(metadata_a, "nmbake:map"), metadata_value(metadata_b, "nmbake:map"),
                                   path_a, path_b);
   check_tolerance_options(cl, c.kind);
-  if (!is_normal_like(c)) {
+  // Both kinds of map: sizes that differ need --resample; --mask's layout at A's size.
+  const auto sizes_and_mask = [&] {
     c.resized = a.width != b.width || a.height != b.height;
     if (c.resized && options.resample == diff::Resample::none)
       throw nmbake::InputError("sizes differ: " + path_a + " is " + std::to_string(a.width) + "x" + std::to_string(a.height) +
@@ -453,22 +454,16 @@ Comparison compare_files(CommandLine& cl) {
       load.require_uvs = true;
       options.mask = diff::uv_layout_mask(nmbake::load_mesh(cl.mask_path, load), a.width, a.height);
     }
+  };
+  if (!is_normal_like(c)) {
+    sizes_and_mask();
     compare_other_maps(cl, a, b, metadata_a, metadata_b, c);
     return c;
   }
   diff::check_normal_map(a, path_a);
   diff::check_normal_map(b, path_b);
   c.seen = read_conventions(cl);
-  c.resized = a.width != b.width || a.height != b.height;
-  if (c.resized && options.resample == diff::Resample::none)
-    throw nmbake::InputError("sizes differ: " + path_a + " is " + std::to_string(a.width) + "x" + std::to_string(a.height) +
-                             ", " + path_b + " is " + std::to_string(b.width) + "x" + std::to_string(b.height) +
-                             " (use --resample nearest|bilinear|box)");
-  if (!cl.mask_path.empty()) {
-    nmbake::LoadOptions load;
-    load.require_uvs = true;
-    options.mask = diff::uv_layout_mask(nmbake::load_mesh(cl.mask_path, load), a.width, a.height);
-  }
+  sizes_and_mask();
 
   c.stats = diff::compare_normal_maps(a, b, options, cl.heatmap_path.empty() ? nullptr : &c.field);
   return c;
