@@ -93,9 +93,9 @@ struct TexelMaps::Impl {
   int stride = 0;      // doubles per texel
   std::vector<double> sums, kept;
   bool rays_ao = false, rays_thickness = false, ids = false;
-  // Per sample of the pass: hit point and unit normal, and the secondary rays' sums.
-  std::vector<glm::dvec3> hit_point, hit_normal, bent_sum;
-  std::vector<std::uint32_t> open_rays, thick_rays_cast;
+  // Per sample of the pass: the hit's unit normal, and the secondary rays' sums.
+  std::vector<glm::dvec3> hit_normal, bent_sum;
+  std::vector<std::uint32_t> open_rays;
   std::vector<std::int64_t> object_id, material_id;
   RayQueue queue[2];  // AO's (occlusion only), thickness's (first hits)
   std::vector<double> thick_sum, thick_sq;
@@ -165,7 +165,6 @@ struct TexelMaps::Impl {
         const double d = h.hit() ? std::min(1.0, double(h.t) / in.thickness_distance) : 1.0;
         thick_sum[r] += d;
         thick_sq[r] += d * d;
-        ++thick_rays_cast[r];
       }
     }
     q.n = 0;
@@ -193,11 +192,9 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
   const HighScene& sc = *in.scene;
   const std::size_t n = smp.count;
   std::fill(m.sums.begin(), m.sums.end(), 0.0);
-  m.hit_point.assign(n, glm::dvec3(0.0));
   m.hit_normal.assign(n, glm::dvec3(0.0));
   m.bent_sum.assign(n, glm::dvec3(0.0));
   m.open_rays.assign(n, 0);
-  m.thick_rays_cast.assign(n, 0);
   m.thick_sum.assign(n, 0.0);
   m.thick_sq.assign(n, 0.0);
   if (m.ids) m.object_id.assign(n, -1), m.material_id.assign(n, -1);
@@ -256,7 +253,6 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
       }
       nh = len > 0.0 ? nh / len : low_normal();
     }
-    m.hit_point[r] = x;
     m.hit_normal[r] = nh;
     *m.at(i, s_hits) += 1.0;
     if (m.has(s_object_normal))
@@ -325,7 +321,7 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
     if (m.has(s_thickness) && hit) {
       m.at(i, s_thickness)[0] += m.thick_sum[r];
       m.at(i, s_thickness)[1] += m.thick_sq[r];
-      m.at(i, s_thickness)[2] += double(m.thick_rays_cast[r]);
+      m.at(i, s_thickness)[2] += double(per_sample);  // every ray queued is cast
     }
     if (m.has(s_bent)) {
       const PixelFrame frame = interpolate_frame(s.low_tris[tri].n, s.low_tris[tri].t, b, in.bitangent);
