@@ -57,6 +57,9 @@ TEST(MapsCli, RefusalsWriteNothing) {
       {"--maps thickness --thickness-distance -1 -o t.png", "--thickness-distance must be a distance above 0"},
       {"--maps ao --ao-rays 0 -o t.png", "--ao-rays takes a number of rays"},
       {"--maps normal --ao-rays 16 -o t.png", "--ao-rays applies to --maps with"},
+      {"--maps ao --ao-rays auto -o t.png", "--ao-rays auto is not available yet"},
+      {"--maps ao --max-ao-error 0.01 -o t.png", "--max-ao-error applies to --ao-rays auto"},
+      {"--maps curvature --curvature-scale 0 -o t.png", "--curvature-scale must be a distance above 0"},
   };
   for (const auto& c : cases) {
     const test::CliRun r = test::run_nmbake(sample_args() + " " + c.args + " --report r.json");
