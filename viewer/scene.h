@@ -7,10 +7,12 @@
 #include <cstddef>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "decoding.h"
 #include "core/image.h"
 #include "metrics.h"
+#include "texture_set.h"
 #include "vertex_data.h"
 
 namespace nmview {
@@ -19,25 +21,30 @@ struct Scene {
   LowVertices low;       // low-poly with the baker's per-corner frames
   HighVertices high;     // high-poly with its file normals, else angle-weighted vertex normals
   nmbake::Image map;     // the normal map as read, at least 3 channels, any size
+  std::vector<SetMap> set_maps;  // the texture set's other members (map path with <MAP>), MapKind order
   MapDecoding decoding;  // the convention the map was baked with (metadata, then overrides)
   Bounds bounds;         // union of both meshes, object space
   float radius = 0.0f;   // largest distance of a vertex of either mesh from bounds.centre()
-  std::string low_name, map_name, high_name;
+  std::string low_name, map_name, high_name;  // map_name: the path as given (with <MAP> for a set)
+  TextureSetFiles map_files;                  // the set's files, for check_screenshot
   std::size_t low_triangles = 0, high_triangles = 0;
 };
 
 // Throws nmbake::InputError (from the loaders, or "<map>: has N channel(s); a normal map needs
-// RGB") on bad input, nmbake::UsageError for a bad override. Notes (the map's decoding and where it
-// came from, normals computed, a tangent-space map that does not look like one) go to `log`.
+// RGB") on bad input, nmbake::UsageError for a bad override. `maps` is the texture set
+// (find_texture_set): its normal map is required (require_normal_map, checked after the low-poly
+// is read, so inputs are reported in command-line order); every other member is read into
+// set_maps. Notes (the set's members, the map's decoding and where it came from, normals computed,
+// a tangent-space map that does not look like one) go to `log`.
 // `uv_set` is the low-poly's UV set the map was baked into (nmbake --uv-set, LoadOptions::uv_set:
 // 0 the first, below nmbake::kMaxUvSets); its UVs and tangent frames are the ones shown.
-Scene load_scene(const std::string& low_path, const std::string& map_path, const std::string& high_path, std::ostream& log,
+Scene load_scene(const std::string& low_path, const TextureSetFiles& maps, const std::string& high_path, std::ostream& log,
                  const DecodingOverrides& overrides = {}, unsigned uv_set = 0);
 
-// Refuses a screenshot path that is one of the scene's three files (UsageError) or a file that
-// cannot be written (OutputError: a special file, a folder, a dangling link), before anything is
-// written (io/output_files.h). An empty path passes.
-void check_screenshot(const std::string& path, const std::string& low_path, const std::string& map_path,
+// Refuses a screenshot path that is one of the scene's files (the meshes and every map of the set
+// found: UsageError) or a file that cannot be written (OutputError: a special file, a folder, a
+// dangling link), before anything is written (io/output_files.h). An empty path passes.
+void check_screenshot(const std::string& path, const std::string& low_path, const TextureSetFiles& maps,
                       const std::string& high_path);
 
 // Writes the RGB of `image` with nmbake::write_image (8-bit for PNG) under the output contract
