@@ -44,18 +44,6 @@ void clamp_light(Light& light) {
   light.elevation = std::clamp(light.elevation, -89.0f, 89.0f);
 }
 
-// lit, then each map of the set, then lit again.
-void next_display(Toggles& toggles, const std::vector<nmbake::MapKind>& maps) {
-  if (!toggles.show_map) {
-    toggles.show_map = !maps.empty();
-    if (toggles.show_map) toggles.shown = maps.front();
-    return;
-  }
-  const auto at = std::find(maps.begin(), maps.end(), toggles.shown);
-  if (at == maps.end() || at + 1 == maps.end()) toggles.show_map = false;
-  else toggles.shown = *(at + 1);
-}
-
 void on_key(GLFWwindow* window, int key, int, int action, int) {
   if (action == GLFW_RELEASE) return;
   State& s = state_of(window);
@@ -73,7 +61,7 @@ void on_key(GLFWwindow* window, int key, int, int action, int) {
       s.toggles.ao = !s.toggles.ao;
       if (!s.renderer->has_map(nmbake::MapKind::ao)) std::cerr << "nmview: A: the set has no ao map\n";
       break;
-    case GLFW_KEY_M: next_display(s.toggles, s.renderer->shown_maps()); break;
+    case GLFW_KEY_M: cycle_display(s.toggles, s.renderer->shown_maps()); break;
     case GLFW_KEY_D: s.toggles.difference = !s.toggles.difference; break;
     case GLFW_KEY_S: s.toggles.specular = s.toggles.specular > 0.0f ? 0.0f : 0.3f; break;
     case GLFW_KEY_L: s.orbit_light = !s.orbit_light; break;
@@ -131,6 +119,17 @@ std::string title(const Scene& scene) {
 }
 
 }  // namespace
+
+void cycle_display(Toggles& toggles, const std::vector<nmbake::MapKind>& maps) {
+  if (!toggles.show_map) {
+    toggles.show_map = !maps.empty();
+    if (toggles.show_map) toggles.shown = maps.front();
+    return;
+  }
+  const auto at = std::find(maps.begin(), maps.end(), toggles.shown);
+  if (at == maps.end() || at + 1 == maps.end()) toggles.show_map = false;
+  else toggles.shown = *(at + 1);
+}
 
 void run_interactive(const Scene& scene, const InteractiveOptions& options) {
   Window window(options.width, options.height, title(scene));

@@ -23,14 +23,15 @@ namespace nmview {
 
 struct Toggles {
   bool map = true;               // left pane decodes the normal map; off: the low-poly's bare shading
-  bool ao = false;               // left pane's lit render (ambient + diffuse, not specular) times the ao map, if loaded
-  bool show_map = false;         // left pane shows `shown` unlit in its own colours, if loaded (wins over the rest)
-  nmbake::MapKind shown = nmbake::MapKind::normal;  // with show_map: normal or a map given to add_set_map
+  bool ao = false;               // lit left pane (ambient + diffuse, not specular) times the ao map, if added
+  bool show_map = false;         // left pane shows `shown` unlit in its own colours, if added (wins over the rest)
   bool wireframe = false;        // triangle edges over both models
   bool tangent_colours = false;  // left pane shows the map's RGB (tangent-space colours) unlit
   bool difference = false;       // a third pane: |left - right| x kDifferenceGain as a heat colour
   bool labels = true;            // pane titles with triangle counts
   float specular = 0.0f;         // Blinn specular weight, 0 = off
+  // With show_map: normal, or a map given to Renderer::add_set_map.
+  nmbake::MapKind shown = nmbake::MapKind::normal;
 };
 
 constexpr float kDifferenceGain = 8.0f;

@@ -21,13 +21,15 @@ struct Scene {
   LowVertices low;       // low-poly with the baker's per-corner frames
   HighVertices high;     // high-poly with its file normals, else angle-weighted vertex normals
   nmbake::Image map;     // the normal map as read, at least 3 channels, any size
-  std::vector<SetMap> set_maps;  // the texture set's other members (map path with <MAP>), MapKind order
   MapDecoding decoding;  // the convention the map was baked with (metadata, then overrides)
   Bounds bounds;         // union of both meshes, object space
   float radius = 0.0f;   // largest distance of a vertex of either mesh from bounds.centre()
-  std::string low_name, map_name, high_name;  // map_name: the path as given (with <MAP> for a set)
-  TextureSetFiles map_files;                  // the set's files, for check_screenshot
+  std::string low_name, map_name, high_name;
   std::size_t low_triangles = 0, high_triangles = 0;
+  // The texture set (a map path with <MAP>; map_name is that path): its files, and its members
+  // other than the normal map as read, in MapKind order.
+  TextureSetFiles map_files;
+  std::vector<SetMap> set_maps;
 };
 
 // Throws nmbake::InputError (from the loaders, or "<map>: has N channel(s); a normal map needs

@@ -69,8 +69,8 @@ SetMap load_set_map(const SetFile& file, std::ostream& log) {
     throw nmbake::InputError(file.path + ": empty image");
   const std::map<std::string, std::string> metadata = nmbake::read_image_metadata(file.path);
   if (const auto it = metadata.find("nmbake:map"); it != metadata.end() && it->second != nmbake::map_name(file.kind))
-    log << "nmview: warning: " << file.path << ": its nmbake:map metadata says '" << it->second
-        << "'; shown as the name says, " << nmbake::map_name(file.kind) << "\n";
+    log << "nmview: warning: " << file.path << ": its nmbake:map metadata says '" << it->second << "'; shown as the name says, "
+        << nmbake::map_name(file.kind) << "\n";
   return map;
 }
 
