@@ -3,6 +3,7 @@
 //   nmview LOW.obj normal.png HIGH.ply                 window: left low + map, right high
 //   nmview LOW.obj normal.png HIGH.ply --screenshot cmp.png --size 1600x800 --view 30,20
 //   nmview LOW.obj normal.png HIGH.ply --compare       appearance difference over fixed views
+//   nmview LOW.obj 'crate_<MAP>.png' HIGH.ply          the texture set: AO lit, A and M keys, --show MAP
 //
 // main only parses arguments and wires the stages together; errors print "error: <what>" and
 // exit with the baker's codes (errors.h).

@@ -35,8 +35,10 @@ Scene load_scene(const std::string& low_path, const TextureSetFiles& maps, const
   if (scene.map.width <= 0 || scene.map.height <= 0) throw nmbake::InputError(map_path + ": empty image");
   const std::map<std::string, std::string> metadata = nmbake::read_image_metadata(map_path);
   if (const auto it = metadata.find("nmbake:map"); it != metadata.end() && it->second != "normal")
-    log << "nmview: warning: " << map_path << ": its nmbake:map metadata says '" << it->second
-        << "', not normal; a set is shown from a path with <MAP> (crate_<MAP>.png)\n";
+    log << "nmview: warning: " << map_path << ": its nmbake:map metadata says '" << it->second << "', not normal"
+        << (maps.has_token ? "; decoded as the normal map its name says"
+                           : "; a set is shown from a path with <MAP> (crate_<MAP>.png)")
+        << "\n";
   std::string note;
   scene.decoding = resolve_decoding(metadata, overrides, map_path, &note);
   log << "nmview: " << map_path << ": decoded as " << note << "\n";
