@@ -4,6 +4,7 @@
 // on a 2 x 2 plane at z = 0 facing +Z (UV = (x + 1) / 2, (y + 1) / 2) with maps written here, so
 // that every screenshot pixel has a known answer: the pixel of a point is found with the
 // viewer's own camera (view.h), and the left pane of a WxH screenshot is its left W/2 columns.
+#include <sys/stat.h>
 #include <sys/wait.h>
 
 #include <algorithm>
@@ -323,6 +324,18 @@ TEST(NmviewSet, SetWithNoMapsIsAnInputError) {
   EXPECT_EQ(no_normal.exit_code, 2) << no_normal.err;
   EXPECT_EQ(error_line(no_normal.err),
             "error: " + pattern + ": the set has ao but no normal map (" + dir + "/none_normal.png); the lit render needs one");
+}
+
+TEST(NmviewSet, SetMemberThatIsNotAFileIsRefused) {
+  // A FIFO found for a name is a member like any other: read by the loader, which refuses it at
+  // once (exit 2, as a FIFO normal map) instead of waiting for a writer.
+  const SetScene s = make_set({});
+  ASSERT_EQ(::mkfifo((s.dir + "/set_ao.png").c_str(), 0600), 0);
+  const Result r =
+      nmview(s.dir, quote(s.plane) + " " + quote(s.pattern) + " " + quote(s.plane) + " --screenshot " + quote(s.dir + "/s.png"));
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_TRUE(contains(error_line(r.err), s.dir + "/set_ao.png")) << r.err;
+  EXPECT_FALSE(fs::exists(s.dir + "/s.png"));
 }
 
 TEST(NmviewSet, ShowRefusesMapsNotInTheSet) {
