@@ -220,7 +220,7 @@ nlohmann::json maps_report(const Args& a, const BakeOptions& o, const BakeResult
         break;
       case MapKind::thickness:
         j["thickness_distance"] = m.distance;
-        j["rays_per_texel"] = o.maps.ao_rays;
+        j["rays_per_texel"] = o.maps.ao_rays_auto ? nlohmann::json("auto") : nlohmann::json(o.maps.ao_rays);
         break;
       case MapKind::height:
         j["height_range"] = {m.range_min, m.range_max};
@@ -242,6 +242,16 @@ nlohmann::json maps_report(const Args& a, const BakeOptions& o, const BakeResult
         break;
       }
       default: break;
+    }
+    if (m.rays_mean >= 0.0) {  // --ao-rays auto: its threshold and the rays it spent, over every tile
+      double sum = 0.0, texels = 0.0, most = 0.0;
+      for (const BakeResult* p : parts) {
+        const double n = double(p->stats.trace.texels_covered);
+        sum += p->maps[extra].rays_mean * n, texels += n;
+        most = std::max(most, p->maps[extra].rays_max);
+      }
+      j["max_ao_error"] = o.maps.max_ao_error;
+      j["rays"] = {{"mean", texels > 0.0 ? sum / texels : 0.0}, {"max", most}};
     }
     if (m.error_mean >= 0.0) {
       double sum = 0.0, texels = 0.0, p95 = 0.0;

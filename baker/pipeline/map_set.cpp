@@ -60,6 +60,16 @@ void error_summary(const Image& err, const std::vector<std::uint8_t>& coverage, 
   out.error_p95 = v[k];
 }
 
+// Mean and most of the covered texels of a rays-per-texel image (--ao-rays auto); none: -1.
+void rays_summary(const Image& rays, const std::vector<std::uint8_t>& coverage, BakedMap& out) {
+  if (rays.pixels.empty()) return;
+  const std::vector<double> v = covered_values(rays, coverage);
+  double sum = 0.0, most = 0.0;
+  for (double n : v) sum += n, most = std::max(most, n);
+  out.rays_mean = v.empty() ? 0.0 : sum / double(v.size());
+  out.rays_max = most;
+}
+
 // The names of the high-poly's objects (one: the file's name) and materials (none: one, "").
 std::vector<std::string> object_names(const Mesh& high) {
   std::vector<std::string> names;
@@ -186,6 +196,7 @@ std::vector<BakedMap> finish_maps(const BakeOptions& opt, const Prepared& s, con
           for (int c = 0; c < 3; ++c) p[c] = p[c] * 0.5f + 0.5f;
         });
         if (kind == MapKind::bent_normal) {
+          rays_summary(raw.ao_rays, coverage, m);
           m.distance = in.ao_distance;
           m.metadata.push_back({"nmbake:ao_distance", number(in.ao_distance)});
         }
@@ -194,12 +205,14 @@ std::vector<BakedMap> finish_maps(const BakeOptions& opt, const Prepared& s, con
         m.distance = in.ao_distance;
         m.metadata.push_back({"nmbake:ao_distance", number(in.ao_distance)});
         error_summary(raw.ao_error, coverage, m);
+        rays_summary(raw.ao_rays, coverage, m);
         m.error = std::move(raw.ao_error);
         break;
       case MapKind::thickness:
         m.distance = in.thickness_distance;
         m.metadata.push_back({"nmbake:thickness_distance", number(in.thickness_distance)});
         error_summary(raw.thickness_error, coverage, m);
+        rays_summary(raw.thickness_rays, coverage, m);
         m.error = std::move(raw.thickness_error);
         break;
       case MapKind::height: {
