@@ -7,10 +7,13 @@
 
 #include "core/curvature.h"
 #include "core/padding.h"
+#include "core/parallel.h"
 
 namespace nmbake {
 
 namespace {
+
+constexpr std::size_t kTexelChunk = 1 << 16;  // texels a thread takes at once in finish_maps
 
 std::string number(double v) {
   char text[40];
@@ -185,9 +188,11 @@ std::vector<BakedMap> finish_maps(const BakeOptions& opt, const Prepared& s, con
     m.kind = kind;
     m.metadata.push_back({"nmbake:map", map_name(kind)});
     Image img = std::move(raw.raw[k]);
-    const auto each = [&](auto&& f) {
-      for (std::size_t i = 0; i < coverage.size(); ++i)
-        if (coverage[i]) f(&img.pixels[i * std::size_t(img.channels)]);
+    const auto each = [&](auto&& f) {  // every covered texel, on every thread (each texel on its own)
+      parallel_chunks(threads, coverage.size(), kTexelChunk, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+          if (coverage[i]) f(&img.pixels[i * std::size_t(img.channels)]);
+      });
     };
     switch (kind) {
       case MapKind::object_normal:

@@ -292,12 +292,13 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
   const HighScene& sc = *in.scene;
   const std::size_t n = smp.count;
   std::fill(m.sums.begin(), m.sums.end(), 0.0);
-  m.hit_normal.assign(n, glm::dvec3(0.0));
-  m.bent_sum.assign(n, glm::dvec3(0.0));
-  m.open_rays.assign(n, 0);
-  m.thick_sum.assign(n, 0.0);
-  m.thick_sq.assign(n, 0.0);
-  if (m.rays_ao || m.rays_thickness) {
+  const bool rays = m.rays_ao || m.rays_thickness;
+  if (rays) {  // the secondary rays' per-sample state and sums, only where a map casts them
+    m.hit_normal.assign(n, glm::dvec3(0.0));
+    m.bent_sum.assign(n, glm::dvec3(0.0));
+    m.open_rays.assign(n, 0);
+    m.thick_sum.assign(n, 0.0);
+    m.thick_sq.assign(n, 0.0);
     m.hit_point.assign(n, glm::dvec3(0.0));
     m.hit_face.assign(n, glm::dvec3(0.0));
     m.ray_group.assign(n, 0);
@@ -363,7 +364,7 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
       }
       nh = len > 0.0 ? nh / len : low_normal();
     }
-    m.hit_normal[r] = nh;
+    if (rays) m.hit_normal[r] = nh;
     *m.at(i, s_hits) += 1.0;
     if (m.has(s_object_normal))
       for (int c = 0; c < 3; ++c) m.at(i, s_object_normal)[c] += nh[c];
@@ -386,7 +387,7 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
       m.material_id[r] = in.material.empty() ? 0 : std::int64_t(in.material[ht]);
     }
     // Secondary rays from just off the surface, on the side the rays go to.
-    if (!m.rays_ao && !m.rays_thickness) continue;
+    if (!rays) continue;
     const double face_len = glm::length(face);
     glm::dvec3 ng = face_len > 0.0 ? face / face_len : nh;
     if (glm::dot(ng, nh) < 0.0) ng = -ng;
@@ -410,7 +411,7 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
   }
 
   // Per sample: AO, bent normal and thickness into its texel, in sample order.
-  for (std::size_t r = 0; r < n; ++r) {
+  for (std::size_t r = 0; rays && r < n; ++r) {
     const std::size_t i = smp.texel[r];
     const bool hit = smp.hit_tri[r] != raycast::no_hit;
     const std::size_t tri = std::size_t(smp.low_tri[r]);
@@ -440,24 +441,29 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
     }
   }
 
-  // The ID maps: per texel the index most of its hit samples take.
+  // The ID maps: per texel the index most of its hit samples take. Samples grouped by texel, in
+  // sample order (a counting sort, once for both maps); a texel of one sample takes its index.
   if (m.ids) {
+    std::vector<std::uint32_t>&start = m.start, &order = m.order, &fill = m.fill;
+    start.assign(m.texels + 1, 0);
+    order.resize(n);
+    for (std::size_t r = 0; r < n; ++r) ++start[std::size_t(smp.texel[r]) + 1];
+    for (std::size_t t = 1; t <= m.texels; ++t) start[t] += start[t - 1];
+    fill.assign(start.begin(), start.end() - 1);
+    for (std::size_t r = 0; r < n; ++r) order[fill[smp.texel[r]]++] = std::uint32_t(r);
     for (int which = 0; which < 2; ++which) {
       const Slot slot = which == 0 ? s_object_id : s_material_id;
       if (!m.has(slot)) continue;
       const std::vector<std::int64_t>& id = which == 0 ? m.object_id : m.material_id;
-      // Samples grouped by texel, in sample order (a counting sort).
-      std::vector<std::uint32_t>&start = m.start, &order = m.order, &fill = m.fill;
-      start.assign(m.texels + 1, 0);
-      order.resize(n);
-      for (std::size_t r = 0; r < n; ++r) ++start[std::size_t(smp.texel[r]) + 1];
-      for (std::size_t t = 1; t <= m.texels; ++t) start[t] += start[t - 1];
-      fill.assign(start.begin(), start.end() - 1);
-      for (std::size_t r = 0; r < n; ++r) order[fill[smp.texel[r]]++] = std::uint32_t(r);
       for (std::size_t t = 0; t < m.texels; ++t) {
-        if (start[t] == start[t + 1]) continue;
+        const std::uint32_t first = start[t], end = start[t + 1];
+        if (first == end) continue;
+        if (end - first == 1) {
+          *m.at(t, slot) = id[order[first]] >= 0 ? double(id[order[first]]) : -1.0;
+          continue;
+        }
         m.vote.clear();
-        for (std::uint32_t k = start[t]; k < start[t + 1]; ++k)
+        for (std::uint32_t k = first; k < end; ++k)
           if (id[order[k]] >= 0) m.vote.push_back(id[order[k]]);
         *m.at(t, slot) = most_frequent(m.vote);
       }
