@@ -195,9 +195,8 @@ MapDiffStats compare_maps(const Image& a, const Image& b_in, const MapDiffOption
     s.warnings.push_back("ID colours are never blended: B resampled by the nearest texel");
 
   // Select, decode and measure each texel.
-  std::vector<float> diffs;
-  diffs.reserve(texels);
-  double sum = 0.0, sum_sq = 0.0;
+  DiffTally tally;  // in the map's units, or 0/1 per ID texel
+  tally.values.reserve(texels);
   for (std::size_t i = 0; i < texels; ++i) {
     const float* pa = &a.pixels[i * a.channels];
     const float* pb = &b.pixels[i * b.channels];
@@ -226,24 +225,19 @@ MapDiffStats compare_maps(const Image& a, const Image& b_in, const MapDiffOption
       }
     }
     if (field) field->degrees[i] = static_cast<float>(d);
-    if (d > s.max || s.worst_x < 0) {
-      s.max = d;
-      s.worst_x = static_cast<int>(i % a.width);
-      s.worst_y = static_cast<int>(i / a.width);
-    }
-    sum += d;
-    sum_sq += d * d;
-    diffs.push_back(static_cast<float>(d));
+    tally.add(i, a.width, d);
   }
 
   // Statistics.
-  s.texels_compared = diffs.size() + s.nonfinite_texels;
-  if (!diffs.empty()) {
-    const double n = static_cast<double>(diffs.size());
-    s.mean = sum / n;
-    s.rms = std::sqrt(sum_sq / n);
-    s.p95 = percentile(diffs, 0.95);
-    s.p99 = percentile(diffs, 0.99);
+  s.texels_compared = tally.values.size() + s.nonfinite_texels;
+  s.max = tally.max;
+  s.worst_x = tally.worst_x, s.worst_y = tally.worst_y;
+  if (!tally.values.empty()) {
+    const double n = static_cast<double>(tally.values.size());
+    s.mean = tally.sum / n;
+    s.rms = std::sqrt(tally.sum_sq / n);
+    s.p95 = percentile(tally.values, 0.95);
+    s.p99 = percentile(tally.values, 0.99);
   }
   if (s.texels_compared > 0) s.share_differing = double(s.texels_differing) / double(s.texels_compared);
   const MapTolerances& t = options.tolerances;

@@ -135,10 +135,9 @@ DiffStats compare_normal_maps(const Image& a, const Image& b_in, const DiffOptio
 
   // Select, decode and measure each texel.
   // Floats for the percentiles and a byte per texel keep an 8k x 8k comparison under 0.4 GB.
-  std::vector<float> angles;
+  DiffTally tally;  // in degrees
   std::vector<std::uint8_t> compared(texels, 0);
-  angles.reserve(texels);
-  double sum = 0.0, sum_sq = 0.0;
+  tally.values.reserve(texels);
   std::size_t over1 = 0, over5 = 0;
   for (std::size_t i = 0; i < texels; ++i) {
     const float* pa = &a.pixels[i * a.channels];
@@ -160,29 +159,24 @@ DiffStats compare_normal_maps(const Image& a, const Image& b_in, const DiffOptio
     s.nonfinite_texels += nonfinite;
     const double d = nonfinite ? 180.0 : angle_deg(na, nb);  // a NaN texel is as different as can be
     if (field) field->degrees[i] = static_cast<float>(d);
-    if (d > s.max_deg || s.worst_x < 0) {
-      s.max_deg = d;
-      s.worst_x = static_cast<int>(i % a.width);
-      s.worst_y = static_cast<int>(i / a.width);
-    }
-    sum += d;
-    sum_sq += d * d;
+    tally.add(i, a.width, d);
     over1 += d > 1.0;
     over5 += d > 5.0;
-    angles.push_back(static_cast<float>(d));
     compared[i] = 1;
   }
 
   // Statistics.
-  s.texels_compared = angles.size();
-  if (!angles.empty()) {
-    const double n = static_cast<double>(angles.size());
-    s.mean_deg = sum / n;
-    s.rms_deg = std::sqrt(sum_sq / n);
+  s.texels_compared = tally.values.size();
+  s.max_deg = tally.max;
+  s.worst_x = tally.worst_x, s.worst_y = tally.worst_y;
+  if (!tally.values.empty()) {
+    const double n = static_cast<double>(tally.values.size());
+    s.mean_deg = tally.sum / n;
+    s.rms_deg = std::sqrt(tally.sum_sq / n);
     s.over_1deg = static_cast<double>(over1) / n;
     s.over_5deg = static_cast<double>(over5) / n;
-    s.p95_deg = percentile(angles, 0.95);
-    s.p99_deg = percentile(angles, 0.99);
+    s.p95_deg = percentile(tally.values, 0.95);
+    s.p99_deg = percentile(tally.values, 0.99);
   }
   const Tolerances& t = options.tolerances;
   // A map holding NaN is broken whatever the tolerances.

@@ -22,6 +22,17 @@ TexelSelection select_texel(const Image& a, const Image& b, std::size_t i, const
   return in_layout ? TexelSelection::outside_alpha : TexelSelection::outside_mask;
 }
 
+void DiffTally::add(std::size_t i, int width, double d) {
+  if (d > max || worst_x < 0) {
+    max = d;
+    worst_x = static_cast<int>(i % static_cast<std::size_t>(width));
+    worst_y = static_cast<int>(i / static_cast<std::size_t>(width));
+  }
+  sum += d;
+  sum_sq += d * d;
+  values.push_back(static_cast<float>(d));
+}
+
 double percentile(std::vector<float>& values, double p) {
   if (values.empty()) return 0.0;
   const std::size_t rank = static_cast<std::size_t>(std::ceil(p * static_cast<double>(values.size())));

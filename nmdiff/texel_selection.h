@@ -1,7 +1,7 @@
-// Which texels nmdiff compares, shared by the normal-map comparison (nmdiff.h) and the other maps'
-// (map_diff.h): a texel is compared when the mask (the low-poly's UV layout) and both maps' alpha
-// coverage take it, or whatever they say with include_padding; and the nearest-rank percentile
-// both report.
+// Which texels nmdiff compares and what it keeps of them, shared by the normal-map comparison
+// (nmdiff.h) and the other maps' (map_diff.h): a texel is compared when the mask (the low-poly's UV
+// layout) and both maps' alpha coverage take it, or whatever they say with include_padding; the
+// running tally of the compared texels' differences and the nearest-rank percentile both report.
 #pragma once
 
 #include <cstddef>
@@ -33,6 +33,16 @@ bool count_skipped(TexelSelection t, Stats& s) {
   else return false;
   return true;
 }
+
+// The compared texels' differences as they come: every value (for the percentiles), their sum and
+// sum of squares, the largest and the first texel (row-major) holding it (-1: none yet).
+struct DiffTally {
+  std::vector<float> values;
+  double sum = 0.0, sum_sq = 0.0, max = 0.0;
+  int worst_x = -1, worst_y = -1;
+  // Texel `i` of a map `width` texels wide differs by `d` (>= 0, in the comparison's units).
+  void add(std::size_t i, int width, double d);
+};
 
 // Nearest-rank percentile (p in [0, 1]) of unsorted values, reordered in place; 0 when empty.
 double percentile(std::vector<float>& values, double p);
