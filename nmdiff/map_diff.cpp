@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "core/errors.h"
+#include "texel_selection.h"
 
 namespace nmbake::diff {
 namespace {
@@ -34,23 +35,6 @@ bool parse_numbers(const std::string& text, char sep, int count, double* out) {
 std::string metadata_value(const std::map<std::string, std::string>& metadata, const char* key) {
   const auto it = metadata.find(key);
   return it == metadata.end() ? std::string() : it->second;
-}
-
-// Channel index of the coverage (alpha), or -1 when the image has none.
-int alpha_channel(const Image& m) { return m.channels == 2 ? 1 : m.channels >= 4 ? 3 : -1; }
-
-bool covered(const Image& m, const float* px) {
-  const int c = alpha_channel(m);
-  return c < 0 || px[c] >= 0.5f;
-}
-
-// Nearest-rank percentile of unsorted values (reordered in place), as compare_normal_maps takes it.
-double percentile(std::vector<float>& values, double p) {
-  if (values.empty()) return 0.0;
-  const std::size_t rank = static_cast<std::size_t>(std::ceil(p * static_cast<double>(values.size())));
-  const std::size_t index = std::min(values.size() - 1, rank == 0 ? 0 : rank - 1);
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(index), values.end());
-  return values[index];
 }
 
 // "a height", "an ao".
@@ -211,25 +195,16 @@ MapDiffStats compare_maps(const Image& a, const Image& b_in, const MapDiffOption
     s.warnings.push_back("ID colours are never blended: B resampled by the nearest texel");
 
   // Select, decode and measure each texel.
-  std::vector<float> diffs;
-  diffs.reserve(texels);
-  double sum = 0.0, sum_sq = 0.0;
+  DiffTally tally;  // in the map's units, or 0/1 per ID texel
+  tally.values.reserve(texels);
   for (std::size_t i = 0; i < texels; ++i) {
     const float* pa = &a.pixels[i * a.channels];
     const float* pb = &b.pixels[i * b.channels];
-    const bool in_layout = options.mask.empty() || options.mask[i] != 0;
-    const bool in_alpha = !options.use_alpha || (covered(a, pa) && covered(b, pb));
-    if (!options.include_padding && !in_layout) {
-      ++s.skipped_mask;
-      continue;
-    }
-    if (!options.include_padding && !in_alpha) {
-      ++s.skipped_alpha;
-      continue;
-    }
+    const TexelSelection sel = select_texel(a, b, i, options.mask, options.use_alpha, options.include_padding);
+    if (count_skipped(sel, s)) continue;
     bool finite = true;
     for (int c = 0; c < needed; ++c) finite = finite && std::isfinite(pa[c]) && std::isfinite(pb[c]);
-    if (!in_layout || !in_alpha) ++s.padding_compared;
+    if (sel == TexelSelection::padding) ++s.padding_compared;
     if (!finite) {
       ++s.nonfinite_texels;
       if (field) field->degrees[i] = std::numeric_limits<float>::max();  // shown as the worst
@@ -250,24 +225,19 @@ MapDiffStats compare_maps(const Image& a, const Image& b_in, const MapDiffOption
       }
     }
     if (field) field->degrees[i] = static_cast<float>(d);
-    if (d > s.max || s.worst_x < 0) {
-      s.max = d;
-      s.worst_x = static_cast<int>(i % a.width);
-      s.worst_y = static_cast<int>(i / a.width);
-    }
-    sum += d;
-    sum_sq += d * d;
-    diffs.push_back(static_cast<float>(d));
+    tally.add(i, a.width, d);
   }
 
   // Statistics.
-  s.texels_compared = diffs.size() + s.nonfinite_texels;
-  if (!diffs.empty()) {
-    const double n = static_cast<double>(diffs.size());
-    s.mean = sum / n;
-    s.rms = std::sqrt(sum_sq / n);
-    s.p95 = percentile(diffs, 0.95);
-    s.p99 = percentile(diffs, 0.99);
+  s.texels_compared = tally.values.size() + s.nonfinite_texels;
+  s.max = tally.max;
+  s.worst_x = tally.worst_x, s.worst_y = tally.worst_y;
+  if (!tally.values.empty()) {
+    const double n = static_cast<double>(tally.values.size());
+    s.mean = tally.sum / n;
+    s.rms = std::sqrt(tally.sum_sq / n);
+    s.p95 = percentile(tally.values, 0.95);
+    s.p99 = percentile(tally.values, 0.99);
   }
   if (s.texels_compared > 0) s.share_differing = double(s.texels_differing) / double(s.texels_compared);
   const MapTolerances& t = options.tolerances;

@@ -8,6 +8,7 @@
 #include "core/codec.h"
 #include "core/errors.h"
 #include "core/rasterize.h"
+#include "texel_selection.h"
 
 namespace nmbake::diff {
 namespace {
@@ -21,17 +22,6 @@ double angle_deg(const double a[3], const double b[3]) {
   const double cx = a[1] * b[2] - a[2] * b[1], cy = a[2] * b[0] - a[0] * b[2], cz = a[0] * b[1] - a[1] * b[0];
   const double dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
   return std::atan2(std::sqrt(cx * cx + cy * cy + cz * cz), dot) * (180.0 / kPi);
-}
-
-bool alpha_covers(const Image& m, const float* px) { return m.channels < 4 || px[3] >= 0.5f; }
-
-// Nearest-rank percentile of unsorted values (reordered in place).
-double percentile(std::vector<float>& values, double p) {
-  if (values.empty()) return 0.0;
-  std::size_t rank = static_cast<std::size_t>(std::ceil(p * static_cast<double>(values.size())));
-  std::size_t index = std::min(values.size() - 1, rank == 0 ? 0 : rank - 1);
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(index), values.end());
-  return values[index];
 }
 
 // Mean difference over the compared texels when B's channels are reinterpreted by `remap`.
@@ -145,24 +135,15 @@ DiffStats compare_normal_maps(const Image& a, const Image& b_in, const DiffOptio
 
   // Select, decode and measure each texel.
   // Floats for the percentiles and a byte per texel keep an 8k x 8k comparison under 0.4 GB.
-  std::vector<float> angles;
+  DiffTally tally;  // in degrees
   std::vector<std::uint8_t> compared(texels, 0);
-  angles.reserve(texels);
-  double sum = 0.0, sum_sq = 0.0;
+  tally.values.reserve(texels);
   std::size_t over1 = 0, over5 = 0;
   for (std::size_t i = 0; i < texels; ++i) {
     const float* pa = &a.pixels[i * a.channels];
     const float* pb = &b.pixels[i * b.channels];
-    const bool in_layout = options.mask.empty() || options.mask[i] != 0;
-    const bool covered = !options.use_alpha || (alpha_covers(a, pa) && alpha_covers(b, pb));
-    if (!options.include_padding && !in_layout) {
-      ++s.skipped_mask;
-      continue;
-    }
-    if (!options.include_padding && !covered) {
-      ++s.skipped_alpha;
-      continue;
-    }
+    const TexelSelection sel = select_texel(a, b, i, options.mask, options.use_alpha, options.include_padding);
+    if (count_skipped(sel, s)) continue;
     double na[3], nb[3];
     const bool nonfinite = !std::isfinite(pa[0]) || !std::isfinite(pa[1]) || !std::isfinite(pa[2]) || !std::isfinite(pb[0]) ||
                            !std::isfinite(pb[1]) || !std::isfinite(pb[2]);
@@ -174,33 +155,28 @@ DiffStats compare_normal_maps(const Image& a, const Image& b_in, const DiffOptio
       ++s.invalid_b;
       continue;
     }
-    if (!in_layout || !covered) ++s.padding_compared;
+    if (sel == TexelSelection::padding) ++s.padding_compared;
     s.nonfinite_texels += nonfinite;
     const double d = nonfinite ? 180.0 : angle_deg(na, nb);  // a NaN texel is as different as can be
     if (field) field->degrees[i] = static_cast<float>(d);
-    if (d > s.max_deg || s.worst_x < 0) {
-      s.max_deg = d;
-      s.worst_x = static_cast<int>(i % a.width);
-      s.worst_y = static_cast<int>(i / a.width);
-    }
-    sum += d;
-    sum_sq += d * d;
+    tally.add(i, a.width, d);
     over1 += d > 1.0;
     over5 += d > 5.0;
-    angles.push_back(static_cast<float>(d));
     compared[i] = 1;
   }
 
   // Statistics.
-  s.texels_compared = angles.size();
-  if (!angles.empty()) {
-    const double n = static_cast<double>(angles.size());
-    s.mean_deg = sum / n;
-    s.rms_deg = std::sqrt(sum_sq / n);
+  s.texels_compared = tally.values.size();
+  s.max_deg = tally.max;
+  s.worst_x = tally.worst_x, s.worst_y = tally.worst_y;
+  if (!tally.values.empty()) {
+    const double n = static_cast<double>(tally.values.size());
+    s.mean_deg = tally.sum / n;
+    s.rms_deg = std::sqrt(tally.sum_sq / n);
     s.over_1deg = static_cast<double>(over1) / n;
     s.over_5deg = static_cast<double>(over5) / n;
-    s.p95_deg = percentile(angles, 0.95);
-    s.p99_deg = percentile(angles, 0.99);
+    s.p95_deg = percentile(tally.values, 0.95);
+    s.p99_deg = percentile(tally.values, 0.99);
   }
   const Tolerances& t = options.tolerances;
   // A map holding NaN is broken whatever the tolerances.

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 
+#include "core/maps.h"
 #include "io/image_io.h"
 #include "test_support.h"
 
@@ -54,6 +55,20 @@ TEST(MapsCli, AoRaysAutoReportsItsThresholdAndRays) {
   EXPECT_LE(r.report["maps"][0]["standard_error"]["p95"].get<double>(), 0.05);
 }
 
+// --curvature-smoothing: its rings in the curvature map's report entry, the default when not given;
+// a smoother curvature has a smaller automatic scale on the same mesh.
+TEST(MapsCli, CurvatureSmoothingIsReported) {
+  const test::CliRun plain = test::run_nmbake(sample_args() + " --maps curvature -o t.exr --report r.json");
+  ASSERT_EQ(plain.code, 0) << plain.err;
+  ASSERT_EQ(plain.report["maps"].size(), 1u);
+  EXPECT_EQ(plain.report["maps"][0]["curvature_smoothing"], kDefaultCurvatureSmoothing);
+  const test::CliRun none =
+      test::run_nmbake(sample_args() + " --maps curvature --curvature-smoothing 0 -o t.exr --report r.json");
+  ASSERT_EQ(none.code, 0) << none.err;
+  EXPECT_EQ(none.report["maps"][0]["curvature_smoothing"], 0);
+  EXPECT_LE(plain.report["maps"][0]["curvature_scale"].get<double>(), none.report["maps"][0]["curvature_scale"].get<double>());
+}
+
 TEST(MapsCli, MapComposesWithUdim) {
   const test::CliRun r = test::run_nmbake(sample_args() + " --maps normal,position -o 't_<MAP>.<UDIM>.tif'");
   ASSERT_EQ(r.code, 0) << r.err;
@@ -79,7 +94,13 @@ TEST(MapsCli, RefusalsWriteNothing) {
       {"--maps ao --ao-rays auto --max-ao-error -0.1 -o t.png", "--max-ao-error must be a standard error above 0"},
       {"--maps ao --ao-rays auto --max-ao-error nan -o t.png", "--max-ao-error"},
       {"--maps ao --ao-rays auto --max-ao-error inf -o t.png", "--max-ao-error"},
-      {"--maps curvature --curvature-scale 0 -o t.png", "--curvature-scale must be a distance above 0"},
+      {"--maps curvature --curvature-scale 0 -o t.png", "--curvature-scale must be a mean curvature above 0 in 1/scene units"},
+      {"--maps curvature --curvature-smoothing -1 -o t.png",
+       "--curvature-smoothing takes a number of rings from 0 to 16, got -1"},
+      {"--maps curvature --curvature-smoothing 17 -o t.png",
+       "--curvature-smoothing takes a number of rings from 0 to 16, got 17"},
+      {"--maps curvature --curvature-smoothing 1.5 -o t.png", "--curvature-smoothing"},
+      {"--maps normal --curvature-smoothing 2 -o t.png", "--curvature-smoothing applies to --maps with curvature"},
   };
   for (const auto& c : cases) {
     const test::CliRun r = test::run_nmbake(sample_args() + " " + c.args + " --report r.json");

@@ -153,7 +153,7 @@ void add_options(CLI::App& app, Args& a) {
                  "the AO's, for thickness its own (default 0.02: about a fixed 256-ray bake's error)");
   app.add_option("--ao-distance", a.ao_distance,
                  "ao, bent-normal: a ray meeting the high-poly within D scene units is occluded (default 0.1 x the scene's "
-                 "diagonal)");
+                 "diagonal: measured to reach a sculpt's cavities before the whole object darkens itself)");
   app.add_option("--ao-occluders", a.ao_occluders,
                  "With --match names: group (default: only the object's own high-poly objects occlude) or all")
       ->check(CLI::IsMember({"group", "all"}));
@@ -161,10 +161,15 @@ void add_options(CLI::App& app, Args& a) {
                  "height: A:B, the distances (scene units, outwards positive) written as 0 and 1 (default: the bake's own "
                  "largest distance each way, so 0.5 is the low-poly surface; in the report)");
   app.add_option("--thickness-distance", a.thickness_distance,
-                 "thickness: the distance that counts as fully thick, scene units (default 0.1 x the scene's diagonal)");
+                 "thickness: the distance that counts as fully thick, scene units (default 0.2 x the scene's diagonal: "
+                 "measured to spread the map most between thin and thick parts)");
   app.add_option("--curvature-scale", a.curvature_scale,
                  "curvature: the mean curvature (1/scene units) written as 0 or 1 (default: the bake's mean + one standard "
                  "deviation of |curvature|, in the report)");
+  app.add_option("--curvature-smoothing", a.curvature_smoothing,
+                 "curvature: passes of smoothing over the high-poly, each reaching one ring of neighbours further, 0-" +
+                     std::to_string(kMaxCurvatureSmoothing) + " (default " + std::to_string(kDefaultCurvatureSmoothing) +
+                     ": measured to cut a sculpt's texel-scale noise 4 to 8 times while moving a torus's answer by 0.2 to 3%)");
   app.set_version_flag("--version", std::string("nmbake ") + NMBAKE_VERSION);
   require_numbers(app);
 }
@@ -182,11 +187,11 @@ MapOptions map_options(const Args& a) {
     for (MapKind k : kinds) names += (names.empty() ? "" : " or ") + std::string(map_name(k));
     throw UsageError(std::string(option) + " applies to --maps with " + names);
   };
-  const auto distance = [](bool given, double d, const char* option) {
+  const auto distance = [](bool given, double d, const char* option, const char* what = "a distance above 0 in scene units") {
     if (given && !(d > 0.0 && d < kMaxDistance)) {
       char got[32];
       std::snprintf(got, sizeof got, "%g", d);
-      throw UsageError(std::string(option) + " must be a distance above 0 in scene units, got " + got);
+      throw UsageError(std::string(option) + " must be " + what + ", got " + got);
     }
   };
   needs(a.ao_distance_given, "--ao-distance", {MapKind::ao, MapKind::bent_normal});
@@ -196,8 +201,15 @@ MapOptions map_options(const Args& a) {
   distance(a.thickness_distance_given, a.thickness_distance, "--thickness-distance");
   if (a.thickness_distance_given) m.thickness_distance = a.thickness_distance;
   needs(a.curvature_scale_given, "--curvature-scale", {MapKind::curvature});
-  distance(a.curvature_scale_given, a.curvature_scale, "--curvature-scale");
+  distance(a.curvature_scale_given, a.curvature_scale, "--curvature-scale", "a mean curvature above 0 in 1/scene units");
   if (a.curvature_scale_given) m.curvature_scale = a.curvature_scale;
+  needs(a.curvature_smoothing_given, "--curvature-smoothing", {MapKind::curvature});
+  if (a.curvature_smoothing_given) {
+    if (a.curvature_smoothing < 0 || a.curvature_smoothing > kMaxCurvatureSmoothing)
+      throw UsageError("--curvature-smoothing takes a number of rings from 0 to " + std::to_string(kMaxCurvatureSmoothing) +
+                       ", got " + std::to_string(a.curvature_smoothing));
+    m.curvature_smoothing = a.curvature_smoothing;
+  }
   needs(a.ao_rays != "64", "--ao-rays", {MapKind::ao, MapKind::bent_normal, MapKind::thickness});
   if (a.ao_rays == "auto") {
     m.ao_rays_auto = true;
@@ -330,6 +342,7 @@ void finish_args(Args& a, const CLI::App& app) {
   a.max_ao_error_given = app.count("--max-ao-error") > 0;
   a.thickness_distance_given = app.count("--thickness-distance") > 0;
   a.curvature_scale_given = app.count("--curvature-scale") > 0;
+  a.curvature_smoothing_given = app.count("--curvature-smoothing") > 0;
 }
 
 }  // namespace nmbake

@@ -45,6 +45,8 @@ struct Args {
   std::string ao_rays = "64";  // a count, or "auto"
   double ao_distance = 0.0, max_ao_error = 0.0, thickness_distance = 0.0, curvature_scale = 0.0;
   bool ao_distance_given = false, max_ao_error_given = false, thickness_distance_given = false, curvature_scale_given = false;
+  int curvature_smoothing = kDefaultCurvatureSmoothing;
+  bool curvature_smoothing_given = false;
   std::string ao_occluders = "group", height_range;
 };
 

@@ -277,6 +277,7 @@ nlohmann::json maps_report(const Args& a, const BakeOptions& o, const BakeResult
       case MapKind::curvature:
         j["curvature_scale"] = m.range_max;
         j["curvature_scale_given"] = o.maps.curvature_scale > 0.0;
+        j["curvature_smoothing"] = o.maps.curvature_smoothing;
         break;
       case MapKind::position:
         j["box"] = {{"min", {m.box_min.x, m.box_min.y, m.box_min.z}}, {"max", {m.box_max.x, m.box_max.y, m.box_max.z}}};

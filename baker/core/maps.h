@@ -45,6 +45,10 @@ constexpr int kMaxAoRays = 65536;
 // 256-ray bake's on the accuracy bench's sculpts: bench/accuracy_ao.cpp) and the most rays per texel.
 constexpr double kDefaultMaxAoError = 0.02;
 constexpr int kMaxAutoAoRays = 1024;
+// --curvature-smoothing: the default rings of smoothing (measured: docs/accuracy/map_defaults.md)
+// and the most the option takes.
+constexpr int kDefaultCurvatureSmoothing = 2;
+constexpr int kMaxCurvatureSmoothing = 16;
 
 struct MapOptions {
   std::vector<MapKind> maps{MapKind::normal};  // in the order asked; each once
@@ -72,6 +76,9 @@ struct MapOptions {
   // Curvature: the mean curvature (1/scene units) that reaches 0 or 1; <= 0: automatic (from the
   // bake's distribution, reported).
   double curvature_scale = 0.0;
+  // Curvature: passes of smoothing over the high-poly's welded mesh (rings of neighbours,
+  // core/curvature.h CurvatureOptions), 0 to kMaxCurvatureSmoothing.
+  int curvature_smoothing = kDefaultCurvatureSmoothing;
 
   bool wants(MapKind kind) const {
     for (MapKind k : maps)
@@ -91,8 +98,11 @@ struct MapOptions {
   }
 };
 
-// The automatic distances, as a share of the scene's bounding-box diagonal.
+// The automatic distances, as a share of the scene's bounding-box diagonal, measured on the sculpts
+// (docs/accuracy/map_defaults.md): AO's reaches the sculpted detail's cavities (90% of their
+// darkening at the whole diagonal) while the base shape alone still darkens under 1% on the torus;
+// thickness's spreads its values most between thin and thick parts.
 constexpr double kAutoAoDistance = 0.1;
-constexpr double kAutoThickness = 0.1;
+constexpr double kAutoThickness = 0.2;
 
 }  // namespace nmbake

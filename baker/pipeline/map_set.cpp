@@ -118,7 +118,8 @@ std::vector<glm::vec3> id_colors(const std::vector<std::string>& names) {
 }
 
 std::vector<float> map_curvature(const BakeOptions& opt, const Mesh& high) {
-  return opt.maps.wants(MapKind::curvature) ? vertex_mean_curvature(high) : std::vector<float>();
+  return opt.maps.wants(MapKind::curvature) ? vertex_mean_curvature(high, CurvatureOptions{opt.maps.curvature_smoothing})
+                                            : std::vector<float>();
 }
 
 MapInputs make_map_inputs(const BakeOptions& opt, const Prepared& s, const HighScene& scene, const HighSelection& selection,
