@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "accuracy_ao.h"
 #include "accuracy_error.h"
 #include "accuracy_hard_assets.h"
 #include "accuracy_report.h"
@@ -50,6 +51,10 @@ struct Args {
   std::vector<std::string> scenes;
   // --max-errors E[:F],...: the --samples auto rows' thresholds (and deep factors, BakeOptions::deep_factor)
   std::vector<std::pair<double, double>> max_errors{{kDefaultMaxErrorDeg, kDefaultDeepFactor}};
+  // The AO rows (scene "ao"): their sculpts, map side, --ao-rays auto thresholds and threads.
+  std::vector<std::string> ao_scenes{"suz_L4", "torus_s3"};
+  int ao_size = 128, ao_threads = 2;
+  std::vector<double> max_ao_errors{0.015, kDefaultMaxAoError, 0.025, 0.03};
   std::string out = "docs/accuracy", data = NMBAKE_SHARED_DATA, nmview = NMBAKE_NMVIEW;
   std::string font = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
   std::string command = "nmbake_accuracy";  // the command line as given, for accuracy.md
@@ -58,12 +63,16 @@ struct Args {
 const char* kUsage =
     "usage: nmbake_accuracy [--quick] [--scenes a,b] [--max-errors 1,2:4] [--out DIR] [--data DIR] [--nmview PATH|none] [--font "
     "TTF]\n"
+    "       [--ao-scenes a,b] [--ao-size N] [--ao-threads N] [--max-ao-errors 0.01,0.02]\n"
     "Bakes every scene at sizes 512, 1024, 2048 (height_field also 4096) with 1, 4 and 16 samples, and with\n"
     "--samples auto at each --max-errors threshold (default: nmbake's), and writes\n"
     "DIR/accuracy.csv, DIR/accuracy.md and DIR/accuracy.png (default DIR: docs/accuracy).\n"
     "Scenes: height_field, displaced_sphere (analytic), suz_L4, torus_s3 (sculpts), bunny00 (scan; needs --data),\n"
     "hard_assets (the known-answer models of tests/procedural at 512 and 1024 with 1 sample and four hit settings;\n"
-    "writes DIR/hard_assets.csv and a section of accuracy.md, or DIR/hard_assets.md when it runs alone).\n"
+    "writes DIR/hard_assets.csv and a section of accuracy.md, or DIR/hard_assets.md when it runs alone),\n"
+    "ao (the AO map's error against its rays on --ao-scenes, default suz_L4,torus_s3, at --ao-size, default 128, with\n"
+    "--ao-threads, default 2: fixed 8 to 1024 rays and --ao-rays auto at each --max-ao-errors against a 4096-ray\n"
+    "reference; writes DIR/ao.{csv,md,png}).\n"
     "--quick: sizes 64 and 128 (real scenes 128, hard assets 256), samples 1 and 4, a coarse sphere: a smoke check of seconds.\n"
     "--check: exit 1 unless on every analytic scene the float error of the largest size and samples is below a\n"
     "quarter of the smallest's (the smoke test in ctest).\n";
@@ -97,7 +106,19 @@ Args parse_args(int argc, char** argv) {
           a.max_errors.push_back({std::atof(t.c_str()), t.find(':') == std::string::npos
                                                             ? kDefaultDeepFactor
                                                             : std::atof(t.c_str() + t.find(':') + 1)});
-    } else if (s == "--out") a.out = value();
+    } else if (s == "--ao-scenes") {
+      a.ao_scenes.clear();
+      std::stringstream ss(value());
+      for (std::string t; std::getline(ss, t, ',');)
+        if (!t.empty()) a.ao_scenes.push_back(t);
+    } else if (s == "--max-ao-errors") {
+      a.max_ao_errors.clear();
+      std::stringstream ss(value());
+      for (std::string t; std::getline(ss, t, ',');)
+        if (!t.empty()) a.max_ao_errors.push_back(std::atof(t.c_str()));
+    } else if (s == "--ao-size") a.ao_size = std::atoi(value().c_str());
+    else if (s == "--ao-threads") a.ao_threads = std::atoi(value().c_str());
+    else if (s == "--out") a.out = value();
     else if (s == "--data") a.data = value();
     else if (s == "--nmview") a.nmview = value();
     else if (s == "--font") a.font = value();
@@ -115,9 +136,9 @@ Args parse_args(int argc, char** argv) {
     a.nmview.clear();
   }
   if (a.scenes.empty())
-    a.scenes = a.quick
-                   ? std::vector<std::string>{"height_field", "displaced_sphere", "hard_assets"}
-                   : std::vector<std::string>{"height_field", "displaced_sphere", "suz_L4", "torus_s3", "bunny00", "hard_assets"};
+    a.scenes = a.quick ? std::vector<std::string>{"height_field", "displaced_sphere", "hard_assets"}
+                       : std::vector<std::string>{"height_field", "displaced_sphere", "suz_L4", "torus_s3",
+                                                  "bunny00",      "hard_assets",      "ao"};
   return a;
 }
 
@@ -259,10 +280,20 @@ void bake_scene(const Args& a, AccuracyScene& sc, const std::string& work, Accur
   if (sc.analytic) res.floor8[sc.name] = f8, res.floor16[sc.name] = f16;
 }
 
-AccuracyResults run_scenes(const Args& a, const std::string& work, Clock::time_point start) {
+AccuracyResults run_scenes(const Args& a, const std::string& work, Clock::time_point start, AoResults& ao) {
   AccuracyResults res;
   for (const std::string& name : a.scenes) {
     const auto t0 = Clock::now();
+    if (name == "ao") {
+      for (const std::string& scene : a.ao_scenes) {
+        std::optional<AccuracyScene> sc = load_scene(a, scene);
+        if (!sc) continue;
+        std::fprintf(stderr, "nmbake_accuracy: ao on %s: %s\n", sc->name.c_str(), sc->description.c_str());
+        run_ao_rows(*sc, a.ao_size, a.max_ao_errors, a.ao_threads, ao);
+      }
+      std::fprintf(stderr, "nmbake_accuracy: ao done in %.0f s, %.0f s since the start\n", since(t0), since(start));
+      continue;
+    }
     if (name == "hard_assets") {
       res.hard_rows = run_hard_assets(a.quick ? std::vector<int>{256} : std::vector<int>{512, 1024}, res.hard_notes);
       res.hard_seconds = since(t0);
@@ -295,9 +326,15 @@ int main(int argc, char** argv) {
     fs::create_directories(a.out);
     const std::string work = (fs::path(a.out) / ".work").string();
     if (!a.nmview.empty()) fs::create_directories(work);
-    const AccuracyResults res = run_scenes(a, work, start);
+    AoResults ao;
+    const AccuracyResults res = run_scenes(a, work, start, ao);
     if (!a.nmview.empty()) fs::remove_all(work);
     info.seconds = since(start);
+    if (!ao.rows.empty()) {
+      write_ao_files(a.out, ao, info, a.font);
+      std::fprintf(stderr, "nmbake_accuracy: wrote %s/ao.{csv,md,png}; %zu rows\n", a.out.c_str(), ao.rows.size());
+      if (res.rows.empty() && res.hard_rows.empty()) return 0;
+    }
     const std::string md_name = write_accuracy_files(a.out, res, info, a.font);
     std::fprintf(stderr, "nmbake_accuracy: wrote %s/%s; %zu rows%s in %.0f s\n", a.out.c_str(),
                  res.rows.empty() ? md_name.c_str() : "accuracy.{csv,md,png}", res.rows.size(),

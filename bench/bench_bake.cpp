@@ -7,6 +7,7 @@
 // value and MET / NOT MET. Everything printed is measured in this run; nothing asserts (not a test).
 //
 //   bench_bake SHARED_DATA NMBAKE_EXE [--rounds N] [--trace-rounds N] [--quick] [--scratch DIR] [--sections LIST]
+//                [--ao-size N]
 //
 // --rounds N: each timed figure is the best of N rounds (default 3; 1 with --quick).
 // --trace-rounds N: rounds of section 1's bake-then-bare-loops comparison at 1 and 4 samples
@@ -14,13 +15,14 @@
 // with more rounds, and those rounds cost little. 16 samples take --rounds.
 // --quick: fewer rows (1 sample only, no 4096^2 or 4M-triangle commands) as a smoke check.
 // --sections LIST: only these sections (comma-separated numbers; 0, the scenes, always runs).
+// --ao-size N: the map side of section 12's AO rows (default 2048; Blender's AO bake takes minutes there).
 // --scratch DIR: where the generated meshes are written once and reused (default
 // $TMPDIR/nmbake-bench); each run's maps and reports go to a subfolder removed at the end.
 //
 // The sections live in bench_tracing.cpp (1, 2), bench_commands.cpp (3, 6), bench_scaling.cpp
 // (4, 5), bench_floods.cpp (7), bench_batch.cpp (8), bench_png.cpp (9), bench_blender.cpp (10,
 // with blender_bake.py; Blender is $NMBAKE_BLENDER or `blender` on PATH, else nmbake's rows alone)
-// and bench_memory.cpp (11);
+// bench_memory.cpp (11) and bench_maps.cpp (12, texture sets);
 // this file parses the arguments, prints the machine, generates the scenes (0) and prints the
 // targets. `bench_bake --measure-child CMD ARGS...` is not for people: section 10 starts each
 // command through it (bench_bake.h).
@@ -128,6 +130,8 @@ Args parse_args(int argc, char** argv) {
       trace_rounds_given = true;
     } else if (s == "--sections" && i + 1 < argc) {
       a.sections = argv[++i];
+    } else if (s == "--ao-size" && i + 1 < argc) {
+      a.ao_size = std::max(16, std::atoi(argv[++i]));
     } else if (s == "--scratch" && i + 1 < argc) {
       a.scratch = argv[++i];
     } else if (!s.empty() && s[0] != '-' && positional < 2) {
@@ -135,7 +139,7 @@ Args parse_args(int argc, char** argv) {
     } else {
       std::fprintf(stderr,
                    "usage: bench_bake SHARED_DATA NMBAKE_EXE [--rounds N] [--trace-rounds N] [--quick] [--scratch DIR] "
-                   "[--sections 3,9]\n");
+                   "[--sections 3,9] [--ao-size N]\n");
       std::exit(1);
     }
   }
@@ -205,6 +209,7 @@ int main(int argc, char** argv) {
   if (args.runs(9)) run_png_settings(run, scenes);
   if (args.runs(10)) run_blender(run, scenes);
   if (args.runs(11)) run_memory(run, scenes);
+  if (args.runs(12)) run_maps(run, scenes);
   print_targets(run, start);
   std::error_code ec;
   fs::remove_all(run.run_dir, ec);

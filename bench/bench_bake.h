@@ -22,6 +22,7 @@ struct Args {
   int rounds = 3;        // each timed figure the best of this many rounds
   int trace_rounds = 7;  // rounds of section 1 at 1 and 4 samples
   bool quick = false;    // fewer rows, as a smoke check
+  int ao_size = 2048;    // --ao-size: section 12's AO rows, map side (Blender's AO bake at 2048^2 takes minutes)
   std::string sections;  // --sections: the sections to run ("3,9"); empty = all (0, the scenes, always runs)
   bool runs(int section) const;
 };
@@ -113,6 +114,10 @@ struct Measured {
 // and its output (and the helper's figures) into `log` (bench_blender.cpp).
 Measured measure(const std::vector<std::string>& command, const std::string& log);
 void run_memory(BenchRun& run, const Scenes& scenes);  // 11 (bench_memory.cpp)
-int measure_child(char** argv);                        // argv: CMD ARGS..., null-terminated
+// Blender: $NMBAKE_BLENDER when set, else `blender` on PATH; empty (and `why`) when not found
+// (bench_blender.cpp).
+std::string find_blender(std::string& why);
+void run_maps(BenchRun& run, const Scenes& scenes);  // 12 (bench_maps.cpp)
+int measure_child(char** argv);                      // argv: CMD ARGS..., null-terminated
 
 }  // namespace nmbake::bench

@@ -61,24 +61,6 @@ std::vector<char*> c_argv(const std::vector<std::string>& args) {
   return v;
 }
 
-// Blender: $NMBAKE_BLENDER when set, else `blender` on PATH; empty (and `why`) when not found.
-std::string find_blender(std::string& why) {
-  const char* env = std::getenv("NMBAKE_BLENDER");
-  const std::string name = env && *env ? env : "blender";
-  auto executable = [](const std::string& p) { return fs::is_regular_file(p) && ::access(p.c_str(), X_OK) == 0; };
-  if (name.find('/') != std::string::npos) {
-    if (executable(name)) return name;
-    why = "NMBAKE_BLENDER=" + name + " is not an executable";
-    return "";
-  }
-  const char* path = std::getenv("PATH");
-  std::stringstream dirs(path ? path : "");
-  for (std::string dir; std::getline(dirs, dir, ':');)
-    if (!dir.empty() && executable(dir + "/" + name)) return dir + "/" + name;
-  why = env && *env ? "NMBAKE_BLENDER=" + name + " is not on PATH" : "no `blender` on PATH and NMBAKE_BLENDER not set";
-  return "";
-}
-
 // One side's figures over the rounds.
 struct Side {
   std::vector<double> wall, rss;  // seconds, MiB per round
@@ -202,6 +184,23 @@ void judge(BenchRun& run, const Pair& p, bool m1, const std::string& no_blender)
 }
 
 }  // namespace
+
+std::string find_blender(std::string& why) {
+  const char* env = std::getenv("NMBAKE_BLENDER");
+  const std::string name = env && *env ? env : "blender";
+  auto executable = [](const std::string& p) { return fs::is_regular_file(p) && ::access(p.c_str(), X_OK) == 0; };
+  if (name.find('/') != std::string::npos) {
+    if (executable(name)) return name;
+    why = "NMBAKE_BLENDER=" + name + " is not an executable";
+    return "";
+  }
+  const char* path = std::getenv("PATH");
+  std::stringstream dirs(path ? path : "");
+  for (std::string dir; std::getline(dirs, dir, ':');)
+    if (!dir.empty() && executable(dir + "/" + name)) return dir + "/" + name;
+  why = env && *env ? "NMBAKE_BLENDER=" + name + " is not on PATH" : "no `blender` on PATH and NMBAKE_BLENDER not set";
+  return "";
+}
 
 Measured measure(const std::vector<std::string>& command, const std::string& log) {
   Measured m;

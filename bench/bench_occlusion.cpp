@@ -10,8 +10,19 @@
 // k-th ray, the order the bake casts them in. Single-threaded by default (rays per second of one
 // core); the lanes of the comparison run interleaved, the best of the rounds kept.
 //
+// --from-bake SIZE: the rays of the bake itself instead. The 1M-triangle pair (the sculpt's low.obj
+// onto its high-poly subdivided) is baked at SIZE^2, 1 sample, by the library: the normal map alone,
+// then normal + ao with --rays rays per texel, each the best of the rounds, so that the AO's share
+// of the trace stage is their difference; then normal + position + object-normal give each covered
+// texel's hit point and interpolated high-poly normal, and from them the AO's rays as the bake draws
+// them (texel-keyed streams, level 0, sample 0, cosine-weighted about the normal, tfar the bake's AO
+// distance; the start offset along the interpolated normal, where the bake takes the face's), in
+// texel order. The bare loop, rtcOccluded1 per ray on a default Embree scene of the high-poly,
+// traces them on the same threads; only the Embree calls are timed (the rays are made per chunk
+// outside the clock). Prints both times and their ratio.
+//
 // usage: bench_occlusion [--sculpt DIR] [--subdivide N] [--points P] [--rays N] [--distance F]
-//                        [--rounds R] [--threads T] [--chunk C] [--variants]
+//                        [--rounds R] [--threads T] [--chunk C] [--variants] [--from-bake SIZE]
 #include <embree3/rtcore.h>
 
 #include <algorithm>
@@ -29,7 +40,9 @@
 
 #include "bench_support.h"
 #include "core/hemisphere.h"
+#include "core/parallel.h"
 #include "io/mesh_io.h"
+#include "pipeline/bake.h"
 #include "raycast.h"
 
 using namespace nmbake;
@@ -47,6 +60,7 @@ struct Args {
   int rounds = 3;
   int threads = 1;
   bool variants = false;
+  int from_bake = 0;         // map side of the bake whose AO rays are traced; 0: the synthetic rays
   std::size_t chunk = 4096;  // rays per call (64 points' rays)
 };
 
@@ -66,6 +80,7 @@ Args parse(int argc, char** argv) {
     else if (s == "--rounds") a.rounds = std::atoi(value());
     else if (s == "--threads") a.threads = std::max(1, std::atoi(value()));
     else if (s == "--variants") a.variants = true;
+    else if (s == "--from-bake") a.from_bake = std::atoi(value());
     else if (s == "--chunk") a.chunk = std::size_t(std::atoll(value()));
     else throw std::runtime_error("unknown argument " + s);
   }
@@ -363,6 +378,96 @@ void thickness(const Mesh& high, const Args& args, RTCScene bare, const raycast:
   }
 }
 
+// --from-bake: the bake's own AO rays, the bake's AO trace against the bare loop over them.
+void from_bake(const Mesh& high, const Args& args, RTCScene bare) {
+  LoadOptions lo;
+  lo.require_uvs = true;
+  const Mesh low = load_mesh(args.sculpt + "/low.obj", lo);
+  BakeOptions o;
+  o.width = o.height = args.from_bake;
+  o.threads = args.threads;
+  o.maps.ao_rays = args.rays;
+  const auto trace_seconds = [&](std::vector<MapKind> maps, BakeResult* keep) {
+    o.maps.maps = std::move(maps);
+    double best = 1e30;
+    for (int round = 0; round < args.rounds; ++round) {
+      BakeResult r = bake_normal_map(low, high, nullptr, o);
+      best = std::min(best, r.stats.trace.seconds);
+      if (keep && round == 0) *keep = std::move(r);
+    }
+    return best;
+  };
+  BakeResult ao;
+  const double t_normal = trace_seconds({MapKind::normal}, nullptr);
+  const double t_ao = trace_seconds({MapKind::normal, MapKind::ao}, &ao);
+  const double distance = ao.maps.at(0).distance;
+  o.maps.maps = {MapKind::normal, MapKind::position, MapKind::object_normal};
+  const BakeResult hits = bake_normal_map(low, high, nullptr, o);
+  const BakedMap &pos = hits.maps.at(0), &nrm = hits.maps.at(1);
+
+  // Per covered texel: its hit point (mesh coordinates) and normal.
+  std::vector<std::uint32_t> texels;
+  for (std::size_t t = 0; t < hits.coverage.size(); ++t)
+    if (hits.coverage[t]) texels.push_back(std::uint32_t(t));
+  glm::dvec3 box_lo(1e300), box_hi(-1e300);
+  for (const glm::vec3& p : high.positions) box_lo = glm::min(box_lo, glm::dvec3(p)), box_hi = glm::max(box_hi, glm::dvec3(p));
+  const double eps = 1e-5 * glm::length(box_hi - box_lo);
+  const glm::dvec3 lo_box = pos.box_min - high.origin, extent = pos.box_max - pos.box_min;
+  const std::size_t per = std::size_t(args.rays), chunk_texels = std::max<std::size_t>(1, args.chunk / per);
+  std::atomic<std::size_t> next{0}, occluded{0};
+  std::vector<double> busy(std::size_t(worker_threads(args.threads)), 0.0);
+  run_on_threads(int(busy.size()), [&](int id) {
+    Rays r;
+    for (auto* v : {&r.ox, &r.oy, &r.oz, &r.dx, &r.dy, &r.dz, &r.tnear, &r.tfar}) v->resize(chunk_texels * per);
+    std::vector<std::uint8_t> out(chunk_texels * per);
+    const Lane lane = single(bare);
+    std::size_t hit = 0;
+    for (std::size_t first; (first = next.fetch_add(chunk_texels)) < texels.size();) {
+      const std::size_t n = std::min(chunk_texels, texels.size() - first);
+      for (std::size_t k = 0; k < n; ++k) {
+        const std::size_t t = texels[first + k];
+        const float* p = &pos.image.pixels[3 * t];
+        const float* c = &nrm.image.pixels[3 * t];
+        const glm::dvec3 x = lo_box + glm::dvec3(p[0], p[1], p[2]) * extent;
+        glm::dvec3 nh(2.0 * c[0] - 1.0, 2.0 * c[1] - 1.0, 2.0 * c[2] - 1.0);
+        nh = glm::length(nh) > 0.0 ? glm::normalize(nh) : glm::dvec3(0, 0, 1);
+        const glm::vec3 org(x + eps * nh);
+        SampleStream stream(sample_key(t, 0, 0));
+        for (std::size_t j = 0; j < per; ++j) {
+          const double u1 = stream.next(), u2 = stream.next();
+          const glm::vec3 d(cosine_direction(nh, u1, u2));
+          const std::size_t i = k * per + j;
+          r.ox[i] = org.x, r.oy[i] = org.y, r.oz[i] = org.z, r.dx[i] = d.x, r.dy[i] = d.y, r.dz[i] = d.z;
+          r.tnear[i] = 0.0f, r.tfar[i] = float(distance);
+        }
+      }
+      const auto t0 = Clock::now();
+      lane(r, 0, n * per, out.data());
+      busy[std::size_t(id)] += since(t0);
+      for (std::size_t i = 0; i < n * per; ++i) hit += out[i];
+    }
+    occluded += hit;
+  });
+  const double t_bare = *std::max_element(busy.begin(), busy.end());
+  double open = 0.0;  // the bake's own AO map over its covered texels: its share of unoccluded rays
+  std::size_t covered = 0;
+  for (std::size_t t = 0; t < ao.coverage.size(); ++t)
+    if (ao.coverage[t]) open += double(ao.maps[0].image.pixels[t]), ++covered;
+  const double rays = double(texels.size()) * double(per), t_trace = t_ao - t_normal;
+  std::printf(
+      "bench_occlusion --from-bake %d: %zu covered texels x %zu rays = %.0fM AO rays (tfar %.4g; occluded: %.2f%% in the bare "
+      "loop, %.2f%% in the bake's AO map), %d thread(s), load %s\n\n",
+      args.from_bake, texels.size(), per, rays * 1e-6, distance, 100.0 * double(occluded) / rays,
+      covered ? 100.0 * (1.0 - open / double(covered)) : 0.0, int(busy.size()), bench::load_average().c_str());
+  std::printf("| what | seconds | Mrays/s |\n|---|---|---|\n");
+  std::printf("| bake trace stage, normal alone | %.2f | |\n", t_normal);
+  std::printf("| bake trace stage, normal + ao | %.2f | |\n", t_ao);
+  std::printf("| the AO's tracing in the bake (difference) | %.2f | %.2f |\n", t_trace, rays / t_trace * 1e-6);
+  std::printf("| bare loop over the same rays (rtcOccluded1 per ray, Embree calls only) | %.2f | %.2f |\n", t_bare,
+              rays / t_bare * 1e-6);
+  std::printf("\nratio bake AO tracing / bare loop: %.3f\n", t_trace / t_bare);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -370,6 +475,13 @@ int main(int argc, char** argv) {
     const Args args = parse(argc, argv);
     Mesh high = load_mesh(args.sculpt + "/high.ply");
     for (int s = 0; s < args.subdivide; ++s) high = bench::subdivide(high);
+    if (args.from_bake > 0) {
+      BareScene bare(high, RTC_SCENE_FLAG_NONE);
+      std::printf("bench_occlusion: %s, subdivided %d: %zu triangles\n", args.sculpt.c_str(), args.subdivide,
+                  high.triangle_count());
+      from_bake(high, args, bare.scene);
+      return 0;
+    }
     double diagonal = 0;
     const Rays rays = make_rays(high, args, false, diagonal);
     std::printf(

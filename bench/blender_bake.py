@@ -2,13 +2,16 @@
 # (bench_blender.cpp) runs, as a whole command, alternately with nmbake on the same pair.
 #
 #   blender -b --factory-startup --python-exit-code 1 --python blender_bake.py -- \
-#       LOW HIGH OUT.png SIZE SAMPLES EXTRUSION
+#       LOW HIGH OUT.png SIZE SAMPLES EXTRUSION [ao DISTANCE]
 #
 # LOW (.obj with UVs) is the active object and HIGH (.ply or .obj) the selected one; the bake is
 # selected-to-active, type NORMAL, tangent space, on the CPU, SAMPLES samples per texel, a 16-texel
 # margin, into a SIZE x SIZE 8-bit non-colour image saved as PNG. EXTRUSION is Blender's cage
 # extrusion, one fixed distance in scene units for the whole mesh, where nmbake measures an
-# automatic cage per vertex. The bench passes 0.05 for its suz_L4 scenes (a Suzanne about 2 units
+# automatic cage per vertex. With `ao DISTANCE` the bake is type AO instead (ambient occlusion of
+# the high-poly seen from the low-poly's texels through the same cage, SAMPLES samples per texel,
+# the world's AO distance set to DISTANCE scene units, as nmbake's --ao-distance), into a byte
+# image saved as PNG; check_ao then only checks the bake wrote something. The bench passes 0.05 for its suz_L4 scenes (a Suzanne about 2 units
 # wide): nmbake's automatic cage on the 1M-triangle pair has a scene-wide front distance of 0.042
 # (per vertex: mean 0.038, max 0.10).
 # Prints "blender-bake: load L bake B save S" (seconds), which the bench parses. Any failure raises,
@@ -22,9 +25,10 @@ import bpy
 
 def parse_args():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
-    if len(argv) != 6:
-        raise SystemExit("usage: blender -b --python blender_bake.py -- LOW HIGH OUT SIZE SAMPLES EXTRUSION")
-    return argv[0], argv[1], argv[2], int(argv[3]), int(argv[4]), float(argv[5])
+    if len(argv) not in (6, 8) or (len(argv) == 8 and argv[6] != "ao"):
+        raise SystemExit("usage: blender -b --python blender_bake.py -- LOW HIGH OUT SIZE SAMPLES EXTRUSION [ao DISTANCE]")
+    ao = float(argv[7]) if len(argv) == 8 else None
+    return argv[0], argv[1], argv[2], int(argv[3]), int(argv[4]), float(argv[5]), ao
 
 
 def import_mesh(path):
@@ -68,8 +72,17 @@ def check_normals(image):
         raise RuntimeError("%d of %d sampled texels hold a zero normal: the bake wrote nothing" % (zero, sampled))
 
 
+def check_ao(image):
+    """Raises when every sampled texel holds one value: Cycles wrote nothing. Runs after the timing."""
+    pixels = array.array("f", [0.0]) * len(image.pixels)
+    image.pixels.foreach_get(pixels)
+    values = set(round(pixels[i], 3) for i in range(0, len(pixels), 4 * 97))
+    if len(values) < 3:
+        raise RuntimeError("the AO bake holds %d distinct values: it wrote nothing" % len(values))
+
+
 def main():
-    low_path, high_path, out_path, size, samples, extrusion = parse_args()
+    low_path, high_path, out_path, size, samples, extrusion, ao_distance = parse_args()
     t0 = time.time()
     # --factory-startup's cube, camera and light.
     for obj in list(bpy.data.objects):
@@ -97,11 +110,16 @@ def main():
     bake.cage_extrusion = extrusion
     bake.margin = 16
     bake.normal_space = "TANGENT"
+    if ao_distance is not None:
+        # Cycles' AO bake reads the world's AO distance (WorldLighting.distance).
+        if scene.world is None:
+            scene.world = bpy.data.worlds.new("World")
+        scene.world.light_settings.distance = ao_distance
     bpy.ops.object.select_all(action="DESELECT")
     high.select_set(True)
     low.select_set(True)
     bpy.context.view_layer.objects.active = low
-    if "FINISHED" not in bpy.ops.object.bake(type="NORMAL"):
+    if "FINISHED" not in bpy.ops.object.bake(type="NORMAL" if ao_distance is None else "AO"):
         raise RuntimeError("the bake did not finish")
     t2 = time.time()
 
@@ -110,7 +128,10 @@ def main():
     image.save()
     t3 = time.time()
     print("blender-bake: load %.2f bake %.2f save %.2f" % (t1 - t0, t2 - t1, t3 - t2), flush=True)
-    check_normals(image)
+    if ao_distance is None:
+        check_normals(image)
+    else:
+        check_ao(image)
 
 
 main()

@@ -330,22 +330,32 @@ TEST(MapsVertexColor, InterpolatedAtTheHit) {
   EXPECT_TRUE(baked(none, MapKind::vertex_color).image.pixels.empty());
 }
 
-// Every map the same whatever the thread count.
+// Every map the same whatever the thread count, with fixed rays and with --ao-rays auto (its rays
+// per texel too).
 TEST(MapsThreads, IdenticalAcrossThreadCounts) {
   const Mesh low = test::make_torus(24, 12), high = test::make_torus(96, 48);
-  BakeOptions o = options(48,
-                          {MapKind::normal, MapKind::ao, MapKind::bent_normal, MapKind::height, MapKind::thickness,
-                           MapKind::position, MapKind::object_id},
-                          -1.0f, -1.0f);
-  o.samples = 4;
-  o.maps.ao_rays = 16;
-  o.threads = 1;
-  const BakeResult one = bake_normal_map(low, high, nullptr, o);
-  o.threads = 2;
-  const BakeResult two = bake_normal_map(low, high, nullptr, o);
-  ASSERT_EQ(one.maps.size(), two.maps.size());
-  for (std::size_t k = 0; k < one.maps.size(); ++k)
-    EXPECT_TRUE(one.maps[k].image.pixels == two.maps[k].image.pixels) << map_name(one.maps[k].kind);
+  for (bool automatic : {false, true}) {
+    BakeOptions o = options(48,
+                            {MapKind::normal, MapKind::ao, MapKind::bent_normal, MapKind::height, MapKind::thickness,
+                             MapKind::position, MapKind::object_id},
+                            -1.0f, -1.0f);
+    o.samples = 4;
+    o.maps.ao_rays = 16;
+    o.maps.ao_rays_auto = automatic;
+    o.maps.max_ao_error = 0.05;
+    o.threads = 1;
+    const BakeResult one = bake_normal_map(low, high, nullptr, o);
+    o.threads = 2;
+    const BakeResult two = bake_normal_map(low, high, nullptr, o);
+    ASSERT_EQ(one.maps.size(), two.maps.size());
+    for (std::size_t k = 0; k < one.maps.size(); ++k) {
+      EXPECT_TRUE(one.maps[k].image.pixels == two.maps[k].image.pixels) << map_name(one.maps[k].kind) << " auto " << automatic;
+      EXPECT_EQ(one.maps[k].rays_mean, two.maps[k].rays_mean) << map_name(one.maps[k].kind);
+    }
+    if (automatic) {
+      EXPECT_GT(one.maps[1].rays_max, one.maps[1].rays_mean);  // ao: more rays where occlusion is partial
+    }
+  }
 }
 
 // A UDIM bake of a layout in one tile gives the single bake's maps.

@@ -37,6 +37,23 @@ TEST(MapsCli, EveryMapToItsFileWithItsMetadataAndReport) {
   EXPECT_TRUE(test::contains(r.err, "height map in 8 bits")) << r.err;  // the warning for 8-bit height
 }
 
+// --ao-rays auto: the report's entries say the mode, the threshold and the rays spent per texel.
+TEST(MapsCli, AoRaysAutoReportsItsThresholdAndRays) {
+  const test::CliRun r = test::run_nmbake(
+      sample_args() + " --maps ao,bent-normal,thickness --ao-rays auto --max-ao-error 0.05 -o 't_<MAP>.png' --report r.json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  ASSERT_EQ(r.report["maps"].size(), 3u);
+  for (const auto& m : r.report["maps"]) {
+    EXPECT_EQ(m["rays_per_texel"], "auto") << m.dump();
+    EXPECT_EQ(m["max_ao_error"], 0.05) << m.dump();
+    ASSERT_TRUE(m.contains("rays")) << m.dump();
+    EXPECT_GT(m["rays"]["mean"].get<double>(), 0.0) << m.dump();
+    EXPECT_LE(m["rays"]["max"].get<double>(), 1024.0) << m.dump();
+    EXPECT_GE(m["rays"]["max"].get<double>(), m["rays"]["mean"].get<double>()) << m.dump();
+  }
+  EXPECT_LE(r.report["maps"][0]["standard_error"]["p95"].get<double>(), 0.05);
+}
+
 TEST(MapsCli, MapComposesWithUdim) {
   const test::CliRun r = test::run_nmbake(sample_args() + " --maps normal,position -o 't_<MAP>.<UDIM>.tif'");
   ASSERT_EQ(r.code, 0) << r.err;
@@ -57,8 +74,11 @@ TEST(MapsCli, RefusalsWriteNothing) {
       {"--maps thickness --thickness-distance -1 -o t.png", "--thickness-distance must be a distance above 0"},
       {"--maps ao --ao-rays 0 -o t.png", "--ao-rays takes a number of rays"},
       {"--maps normal --ao-rays 16 -o t.png", "--ao-rays applies to --maps with"},
-      {"--maps ao --ao-rays auto -o t.png", "--ao-rays auto is not available yet"},
       {"--maps ao --max-ao-error 0.01 -o t.png", "--max-ao-error applies to --ao-rays auto"},
+      {"--maps ao --ao-rays auto --max-ao-error 0 -o t.png", "--max-ao-error must be a standard error above 0"},
+      {"--maps ao --ao-rays auto --max-ao-error -0.1 -o t.png", "--max-ao-error must be a standard error above 0"},
+      {"--maps ao --ao-rays auto --max-ao-error nan -o t.png", "--max-ao-error"},
+      {"--maps ao --ao-rays auto --max-ao-error inf -o t.png", "--max-ao-error"},
       {"--maps curvature --curvature-scale 0 -o t.png", "--curvature-scale must be a distance above 0"},
   };
   for (const auto& c : cases) {

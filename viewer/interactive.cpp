@@ -20,9 +20,11 @@ const std::vector<std::string> kHelp = {
     "LEFT DRAG: ORBIT   RIGHT DRAG OR ARROWS: LIGHT   WHEEL: ZOOM   R: RESET",
     "N: MAP ON/OFF   W: WIREFRAME   T: TANGENT COLOURS   D: DIFFERENCE",
     "L: ORBITING LIGHT   S: SPECULAR   P: SCREENSHOT   H: HELP   Q: QUIT",
+    "A: AO ON/OFF   M: NEXT MAP OF THE SET (LIT, NORMAL, AO, ...)",
 };
 
 struct State {
+  const Renderer* renderer = nullptr;
   InteractiveOptions initial;
   OrbitView view;
   Light light;
@@ -55,6 +57,11 @@ void on_key(GLFWwindow* window, int key, int, int action, int) {
     case GLFW_KEY_N: s.toggles.map = !s.toggles.map; break;
     case GLFW_KEY_W: s.toggles.wireframe = !s.toggles.wireframe; break;
     case GLFW_KEY_T: s.toggles.tangent_colours = !s.toggles.tangent_colours; break;
+    case GLFW_KEY_A:
+      s.toggles.ao = !s.toggles.ao;
+      if (!s.renderer->has_map(nmbake::MapKind::ao)) std::cerr << "nmview: A: the set has no ao map\n";
+      break;
+    case GLFW_KEY_M: cycle_display(s.toggles, s.renderer->shown_maps()); break;
     case GLFW_KEY_D: s.toggles.difference = !s.toggles.difference; break;
     case GLFW_KEY_S: s.toggles.specular = s.toggles.specular > 0.0f ? 0.0f : 0.3f; break;
     case GLFW_KEY_L: s.orbit_light = !s.orbit_light; break;
@@ -113,12 +120,25 @@ std::string title(const Scene& scene) {
 
 }  // namespace
 
+void cycle_display(Toggles& toggles, const std::vector<nmbake::MapKind>& maps) {
+  if (!toggles.show_map) {
+    toggles.show_map = !maps.empty();
+    if (toggles.show_map) toggles.shown = maps.front();
+    return;
+  }
+  const auto at = std::find(maps.begin(), maps.end(), toggles.shown);
+  if (at == maps.end() || at + 1 == maps.end()) toggles.show_map = false;
+  else toggles.shown = *(at + 1);
+}
+
 void run_interactive(const Scene& scene, const InteractiveOptions& options) {
   Window window(options.width, options.height, title(scene));
   std::cerr << "nmview: " << current_renderer() << "\n";
   Renderer renderer(scene.low, scene.high, scene.map, scene.radius, scene.decoding);
+  for (const SetMap& m : scene.set_maps) renderer.add_set_map(m.kind, m.image);
 
   State s;
+  s.renderer = &renderer;
   s.initial = options;
   s.view = options.view;
   s.light = options.light;

@@ -1,6 +1,8 @@
 // The interactive window: one orbit camera and one light drive both panes.
 #pragma once
 
+#include <vector>
+
 #include "scene.h"
 #include "renderer.h"
 #include "view.h"
@@ -13,6 +15,9 @@ struct InteractiveOptions {
   Light light;                     // initial light, restored by R
   Toggles toggles;
 };
+
+// The M key: lit, then each map of `maps` (Renderer::shown_maps) shown unlit, then lit again.
+void cycle_display(Toggles& toggles, const std::vector<nmbake::MapKind>& maps);
 
 // Opens the window and runs until it is closed (Esc or Q). Throws nmbake::Error
 // (ExitCode::output) when no window can be opened (no display).

@@ -3,6 +3,7 @@
 //   nmview LOW.obj normal.png HIGH.ply                 window: left low + map, right high
 //   nmview LOW.obj normal.png HIGH.ply --screenshot cmp.png --size 1600x800 --view 30,20
 //   nmview LOW.obj normal.png HIGH.ply --compare       appearance difference over fixed views
+//   nmview LOW.obj 'crate_<MAP>.png' HIGH.ply          the texture set: AO lit, A and M keys, --show MAP
 //
 // main only parses arguments and wires the stages together; errors print "error: <what>" and
 // exit with the baker's codes (errors.h).
@@ -40,6 +41,7 @@ struct Options {
   std::string light = "-30,30";
   std::string show;
   bool no_map = false;
+  bool no_ao = false;
   bool compare = false;
   unsigned uv_set = 0;  // the low-poly's UV set the map was baked into (nmbake --uv-set)
   nmview::DecodingOverrides decoding;
@@ -66,17 +68,26 @@ void parse_size(const std::string& text, int& width, int& height) {
   height = int(h);
 }
 
+// Toggles, and at most one display: "lit" or a map name of the set (core/maps.h).
 void parse_show(const std::string& text, nmview::Toggles& toggles) {
   std::istringstream in(text);
-  std::string item;
+  std::string item, display;
   while (std::getline(in, item, ',')) {
-    if (item == "wire") toggles.wireframe = true;
+    nmbake::MapKind kind;
+    if (item == "lit" || nmbake::parse_map_name(item, kind)) {
+      if (!display.empty())
+        throw nmbake::UsageError("--show: " + display + " and " + item + ": the left pane shows one of lit and the set's maps");
+      display = item;
+      toggles.show_map = item != "lit";
+      if (toggles.show_map) toggles.shown = kind;
+    } else if (item == "wire") toggles.wireframe = true;
     else if (item == "diff") toggles.difference = true;
     else if (item == "tangent") toggles.tangent_colours = true;
     else if (item == "specular") toggles.specular = 0.3f;
     else if (item == "nolabels") toggles.labels = false;
     else if (!item.empty())
-      throw nmbake::UsageError("--show: unknown item '" + item + "' (wire, diff, tangent, specular, nolabels)");
+      throw nmbake::UsageError("--show: unknown item '" + nmbake::printable(item) +
+                               "' (wire, diff, tangent, specular, nolabels; lit or one map: " + nmbake::map_name_list() + ")");
   }
 }
 
@@ -87,11 +98,20 @@ int run(const Options& o) {
   parse_pair("--light", o.light, io.light.azimuth, io.light.elevation);
   parse_show(o.show, io.toggles);
   io.toggles.map = !o.no_map;
+  // The texture set's files (a map path with <MAP>); none is read yet.
+  const nmview::TextureSetFiles maps = nmview::find_texture_set(o.map);
+  if (io.toggles.show_map && !maps.find(io.toggles.shown)) {
+    const std::string name = nmbake::map_name(io.toggles.shown);
+    throw nmbake::UsageError("--show " + name + ": " + o.map + " has no " + name + " map" +
+                             (maps.has_token ? " (" + nmview::describe_set(maps) + ")"
+                                             : "; give the set's path with <MAP> (crate_<MAP>.png) to load its maps"));
+  }
+  io.toggles.ao = !o.no_ao && maps.find(nmbake::MapKind::ao);
   // The screenshot may not be an input (exit 1) nor a file that cannot be written (exit 3): checked
   // before anything is loaded or rendered.
-  nmview::check_screenshot(o.screenshot, o.low, o.map, o.high);
+  nmview::check_screenshot(o.screenshot, o.low, maps, o.high);
 
-  const nmview::Scene scene = nmview::load_scene(o.low, o.map, o.high, std::cerr, o.decoding, o.uv_set);
+  const nmview::Scene scene = nmview::load_scene(o.low, maps, o.high, std::cerr, o.decoding, o.uv_set);
 
   if (!o.compare && o.screenshot.empty()) {
     nmview::run_interactive(scene, io);
@@ -101,9 +121,11 @@ int run(const Options& o) {
   nmview::HeadlessContext context;
   std::cerr << "nmview: " << context.description() << "\n";
   nmview::Renderer renderer(scene.low, scene.high, scene.map, scene.radius, scene.decoding);
+  for (const nmview::SetMap& m : scene.set_maps) renderer.add_set_map(m.kind, m.image);
 
   if (o.compare) {
-    // Each view is measured at the size of one pane of the --size window.
+    // Each view is measured at the size of one pane of the --size window, lit and without AO: the
+    // high-poly has no occlusion to compare it with.
     const int pane_width = io.width / 2, pane_height = io.height;
     nmview::Toggles measure;
     measure.map = io.toggles.map;
@@ -140,7 +162,11 @@ int run_command_line(int argc, char** argv) {
       "lit alike from one camera"};
   Options o;
   app.add_option("low", o.low, "Low-poly mesh with UVs (OBJ, PLY, OFF, STL, glTF, FBX, DAE...), as given to nmbake")->required();
-  app.add_option("map", o.map, "Normal map baked for it (any size; its nmbake:* metadata says how it was baked)")->required();
+  app.add_option("map", o.map,
+                 "Normal map baked for it (any size; its nmbake:* metadata says how it was baked), or the texture set "
+                 "as nmbake -o wrote it, with <MAP> for each map's name (crate_<MAP>.png: every map found is loaded, "
+                 "the normal map is required)")
+      ->required();
   app.add_option("high", o.high, "High-poly mesh (its normals, else computed ones)")->required();
   app.add_option("--screenshot", o.screenshot,
                  "Render without a display to FILE and exit (with --compare: write the worst view's difference "
@@ -150,6 +176,7 @@ int run_command_line(int argc, char** argv) {
   app.add_option("--light", o.light, "Light azimuth,elevation in degrees relative to the view direction (0,0 = from the eye)")
       ->capture_default_str();
   app.add_flag("--no-map", o.no_map, "Left pane without the normal map (the low-poly's bare shading)");
+  app.add_flag("--no-ao", o.no_ao, "Lit render without the set's ao map (by default multiplied in when the set has one)");
   app.add_flag("--compare", o.compare,
                "Render both models from 10 fixed views (8 around at 20 deg elevation, top, bottom) with one light "
                "and print the appearance difference. psnr/rmse/within2 are over the INTERIOR: pixels fully covered "
@@ -173,7 +200,9 @@ int run_command_line(int argc, char** argv) {
                  "may have several)")
       ->check(CLI::Range(0u, nmbake::kMaxUvSets - 1))
       ->capture_default_str();
-  app.add_option("--show", o.show, "Start with toggles on: wire,diff,tangent,specular,nolabels");
+  app.add_option("--show", o.show,
+                 "Start with toggles on: wire,diff,tangent,specular,nolabels; and what the left pane shows: lit (the "
+                 "default) or one map of the set unlit in its own colours (normal, ao, curvature, object-id, ...)");
   nmbake::require_numbers(app);
 
   if (const std::optional<int> status = nmbake::parse_command_line(app, argc, argv, "nmview")) return *status;

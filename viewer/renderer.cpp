@@ -9,6 +9,7 @@
 #include "core/errors.h"
 #include "font.h"
 #include "shaders.h"
+#include "texture_set.h"
 
 namespace nmview {
 namespace {
@@ -85,6 +86,29 @@ void set_camera(GLuint program, const CameraMatrices& camera) {
   if (eye >= 0) glUniform3fv(eye, 1, &camera.eye[0]);
 }
 
+// A map as an RGB texture (texture_set.h display_rgb: rows flipped so that texture t = mesh v,
+// grey repeated). 16-bit storage keeps 16-bit maps exact; 8-bit maps are exact in it too. `exact`:
+// nearest filtering and no mipmaps, so every sample is one texel's value (ID maps).
+GLuint upload_map(const nmbake::Image& map, const char* name, bool exact) {
+  GLint max_size = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+  if (map.width > max_size || map.height > max_size)
+    fail(std::string("the ") + name + " map is " + std::to_string(map.width) + "x" + std::to_string(map.height) +
+         ", larger than this OpenGL's texture limit " + std::to_string(max_size));
+  const std::vector<float> rgb = display_rgb(map);
+  GLuint texture = 0;
+  glGenTextures(1, &texture);
+  glBindTexture(GL_TEXTURE_2D, texture);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB16, map.width, map.height, 0, GL_RGB, GL_FLOAT, rgb.data());
+  if (!exact) glGenerateMipmap(GL_TEXTURE_2D);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, exact ? GL_NEAREST : GL_LINEAR_MIPMAP_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, exact ? GL_NEAREST : GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  return texture;
+}
+
 }  // namespace
 
 std::string with_thousands(std::size_t n) {
@@ -139,31 +163,7 @@ Renderer::Renderer(const LowVertices& low, const HighVertices& high, const nmbak
   upload(high, {{0, 3}, {1, 3}}, high_.vao, high_.vbo, high_.ebo);
   high_.index_count = high.indices.size();
 
-  // The map: RGB, rows flipped so that texture t = mesh v (image row 0 is v = 1). 16-bit storage
-  // keeps 16-bit maps exact; 8-bit maps are exact in it too.
-  GLint max_size = 0;
-  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
-  if (map.width > max_size || map.height > max_size)
-    fail("the normal map is " + std::to_string(map.width) + "x" + std::to_string(map.height) +
-         ", larger than this OpenGL's texture limit " + std::to_string(max_size));
-  std::vector<float> rgb(std::size_t(map.width) * std::size_t(map.height) * 3);
-  for (int y = 0; y < map.height; ++y)
-    for (int x = 0; x < map.width; ++x) {
-      const float* src = map.at(x, map.height - 1 - y);
-      float* dst = &rgb[(std::size_t(y) * std::size_t(map.width) + std::size_t(x)) * 3];
-      dst[0] = src[0];
-      dst[1] = src[1];
-      dst[2] = src[2];
-    }
-  glGenTextures(1, &map_texture_);
-  glBindTexture(GL_TEXTURE_2D, map_texture_);
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB16, map.width, map.height, 0, GL_RGB, GL_FLOAT, rgb.data());
-  glGenerateMipmap(GL_TEXTURE_2D);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  map_texture_ = upload_map(map, "normal", false);
 
   glGenVertexArrays(1, &empty_vao_);
   glGenVertexArrays(1, &text_vao_);
@@ -182,6 +182,27 @@ Renderer::Renderer(const LowVertices& low, const HighVertices& high, const nmbak
   else if (error != GL_NO_ERROR) fail("OpenGL error " + std::to_string(error) + " while uploading the meshes");
 }
 
+void Renderer::add_set_map(nmbake::MapKind kind, const nmbake::Image& image) {
+  if (kind == nmbake::MapKind::normal) return;  // the constructor's map
+  unsigned& texture = set_textures_[int(kind)];
+  glDeleteTextures(1, &texture);
+  texture = upload_map(image, nmbake::map_name(kind), shown_texel_exact(kind));
+  if (GLenum error = glGetError(); error == GL_OUT_OF_MEMORY)
+    throw nmbake::ResourceError(std::string("out of memory uploading the ") + nmbake::map_name(kind) +
+                                " map to OpenGL (GL_OUT_OF_MEMORY)");
+  else if (error != GL_NO_ERROR)
+    fail("OpenGL error " + std::to_string(error) + " while uploading the " + nmbake::map_name(kind) + " map");
+}
+
+bool Renderer::has_map(nmbake::MapKind kind) const { return kind == nmbake::MapKind::normal || set_textures_[int(kind)] != 0; }
+
+std::vector<nmbake::MapKind> Renderer::shown_maps() const {
+  std::vector<nmbake::MapKind> kinds;
+  for (int k = 0; k < nmbake::kMapKinds; ++k)
+    if (has_map(nmbake::MapKind(k))) kinds.push_back(nmbake::MapKind(k));
+  return kinds;
+}
+
 Renderer::~Renderer() {
   for (Pane& p : panes_) {
     glDeleteFramebuffers(1, &p.msaa_fbo);
@@ -196,6 +217,7 @@ Renderer::~Renderer() {
     glDeleteBuffers(1, &m->ebo);
   }
   glDeleteTextures(1, &map_texture_);
+  glDeleteTextures(nmbake::kMapKinds, set_textures_);
   glDeleteVertexArrays(1, &empty_vao_);
   glDeleteVertexArrays(1, &text_vao_);
   glDeleteBuffers(1, &text_vbo_);
@@ -246,11 +268,26 @@ void Renderer::draw_model(int which, const CameraMatrices& camera, const Toggles
   glUseProgram(program);
   set_camera(program, camera);
   glUniform1f(uniform(program, "u_specular"), toggles.specular);
+  // A map shown texel-exact is drawn without multisampling: every sample of a pixel then takes
+  // the fragment's one colour, so the resolve cannot blend two IDs.
+  bool single_sample = false;
   if (which == 0) {
+    const bool show = toggles.show_map && has_map(toggles.shown);
+    const unsigned ao = set_textures_[int(nmbake::MapKind::ao)];
+    const unsigned shown = show && toggles.shown != nmbake::MapKind::normal ? set_textures_[int(toggles.shown)] : map_texture_;
+    single_sample = show && shown_texel_exact(toggles.shown);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, map_texture_);
     glUniform1i(uniform(program, "u_map"), 0);
-    glUniform1i(uniform(program, "u_mode"), toggles.tangent_colours ? 2 : toggles.map ? 0 : 1);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, ao ? ao : map_texture_);
+    glUniform1i(uniform(program, "u_ao_map"), 1);
+    glUniform1i(uniform(program, "u_ao"), toggles.ao && ao ? 1 : 0);
+    glActiveTexture(GL_TEXTURE2);
+    glBindTexture(GL_TEXTURE_2D, shown);
+    glUniform1i(uniform(program, "u_shown"), 2);
+    glActiveTexture(GL_TEXTURE0);
+    glUniform1i(uniform(program, "u_mode"), show ? 3 : toggles.tangent_colours ? 2 : toggles.map ? 0 : 1);
     glUniform1i(uniform(program, "u_object"), decoding_.object_space ? 1 : 0);
     glUniform1f(uniform(program, "u_green"), decoding_.green_down ? -1.0f : 1.0f);
     glUniform1i(uniform(program, "u_bitangent"), decoding_.bitangent == nmbake::BitangentMode::per_vertex ? 1 : 0);
@@ -261,7 +298,9 @@ void Renderer::draw_model(int which, const CameraMatrices& camera, const Toggles
     glEnable(GL_POLYGON_OFFSET_FILL);
     glPolygonOffset(1.0f, 1.0f);
   }
+  if (single_sample) glDisable(GL_MULTISAMPLE);
   glDrawElements(GL_TRIANGLES, GLsizei(model.index_count), GL_UNSIGNED_INT, nullptr);
+  glEnable(GL_MULTISAMPLE);
   glDisable(GL_POLYGON_OFFSET_FILL);
   if (toggles.wireframe) {
     glUseProgram(wire_program_);
@@ -382,9 +421,12 @@ void Renderer::render(unsigned target, int width, int height, const OrbitView& v
   const float margin = 4.0f * scale;
   if (toggles.labels) {
     // Two lines per pane, clipped to the pane: what it is with its triangle count, then its mode.
-    const std::string mode = toggles.tangent_colours ? "MAP IN TANGENT-SPACE COLOURS"
-                             : toggles.map           ? "WITH NORMAL MAP"
-                                                     : "NO MAP (BARE SHADING)";
+    const bool ao = toggles.ao && set_textures_[int(nmbake::MapKind::ao)] != 0;
+    const std::string mode = toggles.show_map && has_map(toggles.shown)
+                                 ? std::string(nmbake::map_name(toggles.shown)) + " MAP, UNLIT"
+                             : toggles.tangent_colours ? "MAP IN TANGENT-SPACE COLOURS"
+                             : toggles.map             ? std::string(ao ? "WITH NORMAL MAP X AO" : "WITH NORMAL MAP")
+                                                       : std::string(ao ? "NO MAP (BARE SHADING) X AO" : "NO MAP (BARE SHADING)");
     const std::vector<std::pair<std::string, std::string>> titles = {
         {"LOW  " + with_thousands(low_triangles()) + " TRIS", mode},
         {"HIGH  " + with_thousands(high_triangles()) + " TRIS", "OWN NORMALS"},

@@ -14,6 +14,7 @@
 
 #include "decoding.h"
 #include "core/image.h"
+#include "core/maps.h"
 #include "metrics.h"
 #include "vertex_data.h"
 #include "view.h"
@@ -22,11 +23,15 @@ namespace nmview {
 
 struct Toggles {
   bool map = true;               // left pane decodes the normal map; off: the low-poly's bare shading
+  bool ao = false;               // lit left pane (ambient + diffuse, not specular) times the ao map, if added
+  bool show_map = false;         // left pane shows `shown` unlit in its own colours, if added (wins over the rest)
   bool wireframe = false;        // triangle edges over both models
   bool tangent_colours = false;  // left pane shows the map's RGB (tangent-space colours) unlit
   bool difference = false;       // a third pane: |left - right| x kDifferenceGain as a heat colour
   bool labels = true;            // pane titles with triangle counts
   float specular = 0.0f;         // Blinn specular weight, 0 = off
+  // With show_map: normal, or a map given to Renderer::add_set_map.
+  nmbake::MapKind shown = nmbake::MapKind::normal;
 };
 
 constexpr float kDifferenceGain = 8.0f;
@@ -49,6 +54,16 @@ class Renderer {
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
+
+  // Uploads a texture-set member other than the normal map (texture_set.h; any size, 1 to 4
+  // channels: grey is shown as grey), replacing one of the same kind. ID maps (shown_texel_exact)
+  // get nearest filtering and are drawn without multisampling, so every covered pixel is exactly one
+  // texel's colour. Throws like the constructor for a map over the GL texture limit.
+  void add_set_map(nmbake::MapKind kind, const nmbake::Image& image);
+  // Whether `kind` can be shown: normal always, the others once added.
+  bool has_map(nmbake::MapKind kind) const;
+  // normal, then every added map, in MapKind order (the order the display cycles through).
+  std::vector<nmbake::MapKind> shown_maps() const;
 
   // A whole frame into framebuffer `target` (0 = the window) of `width` x `height` pixels.
   // `help` lines are printed at the bottom left.
@@ -81,6 +96,7 @@ class Renderer {
 
   Model low_, high_;
   unsigned map_texture_ = 0;
+  unsigned set_textures_[nmbake::kMapKinds] = {};  // by MapKind; 0 = not loaded (normal uses map_texture_)
   unsigned low_program_ = 0, high_program_ = 0, wire_program_ = 0;
   unsigned background_program_ = 0, pane_program_ = 0, difference_program_ = 0, text_program_ = 0;
   unsigned empty_vao_ = 0, text_vao_ = 0, text_vbo_ = 0;

@@ -1,6 +1,7 @@
 #include "scene.h"
 
 #include <algorithm>
+#include <map>
 
 #include "core/errors.h"
 #include "io/image_io.h"
@@ -11,12 +12,13 @@
 
 namespace nmview {
 
-Scene load_scene(const std::string& low_path, const std::string& map_path, const std::string& high_path, std::ostream& log,
+Scene load_scene(const std::string& low_path, const TextureSetFiles& maps, const std::string& high_path, std::ostream& log,
                  const DecodingOverrides& overrides, unsigned uv_set) {
   Scene scene;
   scene.low_name = low_path;
-  scene.map_name = map_path;
+  scene.map_name = maps.pattern;
   scene.high_name = high_path;
+  scene.map_files = maps;
 
   // Inputs are read in command-line order so the first bad one is the one reported.
   nmbake::LoadOptions low_options;
@@ -24,12 +26,21 @@ Scene load_scene(const std::string& low_path, const std::string& map_path, const
   low_options.uv_set = uv_set;
   nmbake::Mesh low = nmbake::load_mesh(low_path, low_options);
 
+  if (maps.has_token) log << "nmview: " << maps.pattern << ": " << describe_set(maps) << "\n";
+  require_normal_map(maps);
+  const std::string map_path = maps.find(nmbake::MapKind::normal)->path;
   scene.map = nmbake::read_image(map_path);
   if (scene.map.channels < 3)
     throw nmbake::InputError(map_path + ": has " + std::to_string(scene.map.channels) + " channel(s); a normal map needs RGB");
   if (scene.map.width <= 0 || scene.map.height <= 0) throw nmbake::InputError(map_path + ": empty image");
+  const std::map<std::string, std::string> metadata = nmbake::read_image_metadata(map_path);
+  if (const auto it = metadata.find("nmbake:map"); it != metadata.end() && it->second != "normal")
+    log << "nmview: warning: " << map_path << ": its nmbake:map metadata says '" << it->second << "', not normal"
+        << (maps.has_token ? "; decoded as the normal map its name says"
+                           : "; a set is shown from a path with <MAP> (crate_<MAP>.png)")
+        << "\n";
   std::string note;
-  scene.decoding = resolve_decoding(nmbake::read_image_metadata(map_path), overrides, map_path, &note);
+  scene.decoding = resolve_decoding(metadata, overrides, map_path, &note);
   log << "nmview: " << map_path << ": decoded as " << note << "\n";
   double blue = 0.0;
   for (int y = 0; y < scene.map.height; ++y)
@@ -38,6 +49,9 @@ Scene load_scene(const std::string& low_path, const std::string& map_path, const
   if (blue < 0.5 && !scene.decoding.object_space)
     log << "nmview: warning: " << map_path << ": mean blue " << blue
         << " < 0.5, so most normals point into the surface; is this a tangent-space normal map?\n";
+
+  for (const SetFile& file : maps.found)
+    if (file.kind != nmbake::MapKind::normal) scene.set_maps.push_back(load_set_map(file, log));
 
   nmbake::LoadOptions high_options;  // on the low-poly's origin (both re-centred when far), as nmbake does
   high_options.origin = low.origin;
@@ -61,10 +75,14 @@ Scene load_scene(const std::string& low_path, const std::string& map_path, const
   return scene;
 }
 
-void check_screenshot(const std::string& path, const std::string& low_path, const std::string& map_path,
+void check_screenshot(const std::string& path, const std::string& low_path, const TextureSetFiles& maps,
                       const std::string& high_path) {
-  nmbake::check_output_files({{"", low_path, "the low-poly"}, {"", map_path, "the map"}, {"", high_path, "the high-poly"}},
-                             {{"--screenshot", path, "the screenshot"}});
+  // In command-line order, as before the texture set: the low-poly, the map(s), the high-poly.
+  std::vector<nmbake::NamedFile> inputs = {{"", low_path, "the low-poly"}};
+  for (const SetFile& f : maps.found)
+    inputs.push_back({"", f.path, maps.has_token ? "the " + std::string(nmbake::map_name(f.kind)) + " map" : "the map"});
+  inputs.push_back({"", high_path, "the high-poly"});
+  nmbake::check_output_files(inputs, {{"--screenshot", path, "the screenshot"}});
 }
 
 void write_screenshot(const std::string& path, const Rgba8Image& image, const Scene& scene) {
@@ -72,7 +90,7 @@ void write_screenshot(const std::string& path, const Rgba8Image& image, const Sc
   for (std::size_t i = 0; i < std::size_t(image.width) * std::size_t(image.height); ++i)
     for (int c = 0; c < 3; ++c) rgb.pixels[3 * i + std::size_t(c)] = float(image.pixels[4 * i + std::size_t(c)]) / 255.0f;
   // Checked again here: the interactive viewer's screenshots are checked nowhere else.
-  check_screenshot(path, scene.low_name, scene.map_name, scene.high_name);
+  check_screenshot(path, scene.low_name, scene.map_files, scene.high_name);
   nmbake::OutputFiles outputs;
   nmbake::WriteOptions options;
   options.temp_path = outputs.add(path);

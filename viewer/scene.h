@@ -7,10 +7,12 @@
 #include <cstddef>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "decoding.h"
 #include "core/image.h"
 #include "metrics.h"
+#include "texture_set.h"
 #include "vertex_data.h"
 
 namespace nmview {
@@ -24,20 +26,27 @@ struct Scene {
   float radius = 0.0f;   // largest distance of a vertex of either mesh from bounds.centre()
   std::string low_name, map_name, high_name;
   std::size_t low_triangles = 0, high_triangles = 0;
+  // The texture set (a map path with <MAP>; map_name is that path): its files, and its members
+  // other than the normal map as read, in MapKind order.
+  TextureSetFiles map_files;
+  std::vector<SetMap> set_maps;
 };
 
 // Throws nmbake::InputError (from the loaders, or "<map>: has N channel(s); a normal map needs
-// RGB") on bad input, nmbake::UsageError for a bad override. Notes (the map's decoding and where it
-// came from, normals computed, a tangent-space map that does not look like one) go to `log`.
+// RGB") on bad input, nmbake::UsageError for a bad override. `maps` is the texture set
+// (find_texture_set): its normal map is required (require_normal_map, checked after the low-poly
+// is read, so inputs are reported in command-line order); every other member is read into
+// set_maps. Notes (the set's members, the map's decoding and where it came from, normals computed,
+// a tangent-space map that does not look like one) go to `log`.
 // `uv_set` is the low-poly's UV set the map was baked into (nmbake --uv-set, LoadOptions::uv_set:
 // 0 the first, below nmbake::kMaxUvSets); its UVs and tangent frames are the ones shown.
-Scene load_scene(const std::string& low_path, const std::string& map_path, const std::string& high_path, std::ostream& log,
+Scene load_scene(const std::string& low_path, const TextureSetFiles& maps, const std::string& high_path, std::ostream& log,
                  const DecodingOverrides& overrides = {}, unsigned uv_set = 0);
 
-// Refuses a screenshot path that is one of the scene's three files (UsageError) or a file that
-// cannot be written (OutputError: a special file, a folder, a dangling link), before anything is
-// written (io/output_files.h). An empty path passes.
-void check_screenshot(const std::string& path, const std::string& low_path, const std::string& map_path,
+// Refuses a screenshot path that is one of the scene's files (the meshes and every map of the set
+// found: UsageError) or a file that cannot be written (OutputError: a special file, a folder, a
+// dangling link), before anything is written (io/output_files.h). An empty path passes.
+void check_screenshot(const std::string& path, const std::string& low_path, const TextureSetFiles& maps,
                       const std::string& high_path);
 
 // Writes the RGB of `image` with nmbake::write_image (8-bit for PNG) under the output contract

@@ -7,16 +7,17 @@ namespace nmview::shaders {
 // Lambert with a little ambient on a grey albedo, optional Blinn specular (0 by default so
 // software rendering stays stable). Linear values, written to the framebuffer as they are (no
 // sRGB encoding), with alpha 1 as the coverage mask. One-sided: a normal facing away from the
-// light gets the ambient term only, on both panes alike.
+// light gets the ambient term only, on both panes alike. `occlusion` (the ao map, 1 = open)
+// multiplies the Lambert term, ambient and diffuse alike, and not the specular highlight.
 inline const char* kLighting = R"(
 uniform vec3 u_light_dir;   // unit, towards the light, scene space
 uniform vec3 u_eye;         // camera position, scene space
 uniform float u_specular;   // Blinn specular weight, 0 = off
 const float kAlbedo = 0.8;
 const float kAmbient = 0.1;
-vec3 shade(vec3 n, vec3 position) {
+vec3 shade(vec3 n, vec3 position, float occlusion) {
   float diffuse = max(dot(n, u_light_dir), 0.0);
-  float value = kAlbedo * (kAmbient + (1.0 - kAmbient) * diffuse);
+  float value = occlusion * kAlbedo * (kAmbient + (1.0 - kAmbient) * diffuse);
   if (u_specular > 0.0 && diffuse > 0.0) {
     vec3 h = normalize(normalize(u_eye - position) + u_light_dir);
     value += u_specular * pow(max(dot(n, h), 0.0), 64.0);
@@ -56,7 +57,9 @@ void main() {
 // bitangent map takes B interpolated from the corners' B (computed by interpolate_frame); an
 // object-space map is the normal itself (re-centring the scene does not turn directions).
 // The map texture's rows are uploaded bottom-up, so texture coordinates are the mesh UVs as they
-// are (v = 1 is the image's top row).
+// are (v = 1 is the image's top row); so are the texture set's other maps (texture_set.h).
+// Mode 3 shows one of them (u_shown) unlit, as its texels are; u_ao multiplies the lit modes by the
+// ao map's value.
 inline const char* kLowFragment = R"(
 in vec3 v_position;
 in vec3 v_normal;
@@ -64,7 +67,11 @@ in vec4 v_tangent;
 in vec2 v_uv;
 in vec3 v_bitangent;
 uniform sampler2D u_map;
-uniform int u_mode;       // 0 = lit with the map, 1 = lit with the bare interpolated normal, 2 = map colours
+uniform sampler2D u_ao_map;
+uniform sampler2D u_shown;
+uniform int u_mode;       // 0 = lit with the map, 1 = lit with the bare interpolated normal, 2 = map colours,
+                          // 3 = u_shown's colours
+uniform int u_ao;         // 1 = the lit modes times u_ao_map's red (grey) value
 uniform int u_object;     // 1 = object-space map
 uniform float u_green;    // +1 green up (OpenGL), -1 green down (DirectX)
 uniform int u_bitangent;  // 0 = per pixel, 1 = per vertex
@@ -72,6 +79,10 @@ out vec4 frag_color;
 void main() {
   vec3 N = v_normal;
   vec3 T = v_tangent.xyz;
+  if (u_mode == 3) {
+    frag_color = vec4(texture(u_shown, v_uv).rgb, 1.0);
+    return;
+  }
   vec3 texel = texture(u_map, v_uv).rgb;
   if (u_mode == 2) {
     frag_color = vec4(texel, 1.0);
@@ -88,7 +99,8 @@ void main() {
   } else {
     n = normalize(N);
   }
-  frag_color = vec4(shade(n, v_position), 1.0);
+  float occlusion = u_ao == 1 ? texture(u_ao_map, v_uv).r : 1.0;
+  frag_color = vec4(shade(n, v_position, occlusion), 1.0);
 }
 )";
 
@@ -109,7 +121,7 @@ inline const char* kHighFragment = R"(
 in vec3 v_position;
 in vec3 v_normal;
 out vec4 frag_color;
-void main() { frag_color = vec4(shade(normalize(v_normal), v_position), 1.0); }
+void main() { frag_color = vec4(shade(normalize(v_normal), v_position, 1.0), 1.0); }
 )";
 
 // Wireframe overlay: the triangles again as lines, in one flat colour.

@@ -146,10 +146,11 @@ void add_options(CLI::App& app, Args& a) {
                  "Maps to bake from the same hits, comma-separated (default normal): " + map_name_list() +
                      ". Several need <MAP> in -o (crate_<MAP>.png); README, \"Texture sets\", defines each");
   app.add_option("--ao-rays", a.ao_rays,
-                 "Rays per texel for ao, bent-normal and thickness, 1-65536 (default 64; auto, rays until a standard error, "
-                 "is not available yet)");
+                 "Rays per texel for ao, bent-normal and thickness, 1-65536 (default 64), or auto: 32 rays, then more in "
+                 "rounds where the texel's standard error is above --max-ao-error (where occlusion is partial), at most 1024");
   app.add_option("--max-ao-error", a.max_ao_error,
-                 "With --ao-rays auto (not available yet): the standard error a texel's AO stops at");
+                 "With --ao-rays auto: the standard error (0-1 share) at which a texel's rays stop, for ao and bent-normal "
+                 "the AO's, for thickness its own (default 0.02: about a fixed 256-ray bake's error)");
   app.add_option("--ao-distance", a.ao_distance,
                  "ao, bent-normal: a ray meeting the high-poly within D scene units is occluded (default 0.1 x the scene's "
                  "diagonal)");
@@ -199,8 +200,7 @@ MapOptions map_options(const Args& a) {
   if (a.curvature_scale_given) m.curvature_scale = a.curvature_scale;
   needs(a.ao_rays != "64", "--ao-rays", {MapKind::ao, MapKind::bent_normal, MapKind::thickness});
   if (a.ao_rays == "auto") {
-    // Not built yet: the rounds and their stopping rule are still to be chosen by measurement.
-    throw UsageError("--ao-rays auto is not available yet in this version; give a number of rays (default 64)");
+    m.ao_rays_auto = true;
   } else {
     std::size_t used = 0;
     long long n = 0;

@@ -1,6 +1,9 @@
 #include "cli/job.h"
 
+#include <algorithm>
+#include <atomic>
 #include <cstdio>
+#include <exception>
 #include <future>
 #include <optional>
 #include <tuple>
@@ -131,6 +134,52 @@ void check_tile_files(const Args& a, const std::vector<MapFiles>& files) {
   check_output_files(inputs, outputs);
 }
 
+// One image to its temporary file.
+struct ImageWrite {
+  std::string path;
+  const Image* image;
+  WriteOptions options;
+};
+
+// The images written, each to its temporary, largest first. One larger than all the rest together
+// (a plain normal map, one with its masks) takes every thread its encoder uses, alone; the others
+// go side by side, one per thread, so that one file's serial parts (assembling, checksums, the
+// write and its fsync) overlap another's encoding. The bytes do not depend on the threads
+// (WriteOptions::threads). An error is the first file's in `writes` order that failed, whatever
+// the threads did first.
+void write_images(const JobEnv& env, std::vector<ImageWrite>& writes, int threads) {
+  std::vector<std::size_t> order(writes.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  const auto size = [&](std::size_t i) { return writes[i].image->pixels.size(); };
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return size(x) > size(y); });
+  std::size_t rest = 0, k = 0;
+  for (std::size_t i : order) rest += size(i);
+  for (; k < order.size() && 2 * size(order[k]) >= rest; ++k) {  // alone, on every thread
+    if (env.interrupted()) throw Cancelled();
+    rest -= size(order[k]);
+    write_image(writes[order[k]].path, *writes[order[k]].image, writes[order[k]].options);
+  }
+  if (k == order.size()) return;
+  std::vector<std::exception_ptr> failed(writes.size());
+  std::atomic<std::size_t> next{k};
+  std::atomic<bool> stop{false};
+  run_on_threads(std::max(1, std::min(worker_threads(threads), int(order.size() - k))), [&](int) {
+    for (std::size_t j; !stop && (j = next++) < order.size();) {
+      ImageWrite& w = writes[order[j]];
+      try {
+        if (env.interrupted()) throw Cancelled();
+        w.options.threads = 1;
+        write_image(w.path, *w.image, w.options);
+      } catch (...) {
+        failed[order[j]] = std::current_exception();
+        stop = true;
+      }
+    }
+  });
+  for (const std::exception_ptr& e : failed)
+    if (e) std::rethrow_exception(e);
+}
+
 // The maps, the masks and the cage, each to its temporary file in `outputs`.
 void write_outputs(const JobEnv& env, OutputSet& outputs, const Args& a, const BakeOptions& o, const BakeResult& r,
                    const UdimBake* udim, const Mesh& low, int bits) {
@@ -154,33 +203,32 @@ void write_outputs(const JobEnv& env, OutputSet& outputs, const Args& a, const B
   wo.threads = o.threads;
   const std::vector<MapFiles> files = map_files(a, o, r, udim);
   if (udim) check_tile_files(a, files);
+  std::vector<ImageWrite> writes;
   for (const MapFiles& f : files) {
-    check_signal();
     if (!f.map.empty()) {
       wo.temp_path = outputs.add(f.map);
-      write_image(f.map, f.result->map, wo);
+      writes.push_back({f.map, &f.result->map, wo});
     }
     for (std::size_t i = 0; i < f.extra.size(); ++i) {
       const BakedMap& m = f.result->maps[i];
       if (m.image.pixels.empty()) continue;  // skipped (a warning says why)
-      check_signal();
       WriteOptions mo = wo;
       mo.metadata = extra_metadata(o, m);
       mo.dither = wo.dither && !map_is_flat(m.kind);  // an ID's colour is exact
       mo.temp_path = outputs.add(f.extra[i]);
-      write_image(f.extra[i], m.image, mo);
+      writes.push_back({f.extra[i], &m.image, mo});
     }
     for (const auto& [path, image] :
          {std::pair{&f.miss_mask, &f.result->miss_mask}, std::pair{&f.suspect_mask, &f.result->suspect_mask}}) {
       if (path->empty()) continue;
-      check_signal();
       WriteOptions mo;
       mo.bits = default_bits_for(*path);
       mo.threads = o.threads;
       mo.temp_path = outputs.add(*path);
-      write_image(*path, *image, mo);
+      writes.push_back({*path, image, mo});
     }
   }
+  if (!writes.empty()) write_images(env, writes, o.threads);
   if (!a.save_cage.empty()) {
     check_signal();
     Mesh cage_mesh;
@@ -220,7 +268,7 @@ nlohmann::json maps_report(const Args& a, const BakeOptions& o, const BakeResult
         break;
       case MapKind::thickness:
         j["thickness_distance"] = m.distance;
-        j["rays_per_texel"] = o.maps.ao_rays;
+        j["rays_per_texel"] = o.maps.ao_rays_auto ? nlohmann::json("auto") : nlohmann::json(o.maps.ao_rays);
         break;
       case MapKind::height:
         j["height_range"] = {m.range_min, m.range_max};
@@ -242,6 +290,16 @@ nlohmann::json maps_report(const Args& a, const BakeOptions& o, const BakeResult
         break;
       }
       default: break;
+    }
+    if (m.rays_mean >= 0.0) {  // --ao-rays auto: its threshold and the rays it spent, over every tile
+      double sum = 0.0, texels = 0.0, most = 0.0;
+      for (const BakeResult* p : parts) {
+        const double n = double(p->stats.trace.texels_covered);
+        sum += p->maps[extra].rays_mean * n, texels += n;
+        most = std::max(most, p->maps[extra].rays_max);
+      }
+      j["max_ao_error"] = o.maps.max_ao_error;
+      j["rays"] = {{"mean", texels > 0.0 ? sum / texels : 0.0}, {"max", most}};
     }
     if (m.error_mean >= 0.0) {
       double sum = 0.0, texels = 0.0, p95 = 0.0;

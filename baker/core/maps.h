@@ -41,18 +41,26 @@ bool map_casts_rays(MapKind kind);
 
 constexpr int kDefaultAoRays = 64;
 constexpr int kMaxAoRays = 65536;
+// --ao-rays auto: the default --max-ao-error (measured so that auto's AO error matches a fixed
+// 256-ray bake's on the accuracy bench's sculpts: bench/accuracy_ao.cpp) and the most rays per texel.
+constexpr double kDefaultMaxAoError = 0.02;
+constexpr int kMaxAutoAoRays = 1024;
 
 struct MapOptions {
   std::vector<MapKind> maps{MapKind::normal};  // in the order asked; each once
   // AO and bent normals: a ray that meets the high-poly within this distance (scene units) is
   // occluded; <= 0: automatic (kAutoAoDistance of the scene's diagonal).
   double ao_distance = 0.0;
-  int ao_rays = kDefaultAoRays;  // rays per texel for ao, bent-normal and thickness
-  // --ao-rays auto: per texel, rays in rounds until the AO's standard error is below max_ao_error
-  // (at most ao_rays_max). Not built yet: validate_options refuses it.
+  int ao_rays = kDefaultAoRays;  // rays per texel for ao, bent-normal and thickness (unused with ao_rays_auto)
+  // --ao-rays auto: per texel, a first round of 32 rays, then rounds of more while the texel's
+  // standard error (AO's for ao and bent-normal, thickness's own for thickness) is above
+  // max_ao_error (a share: AO and thickness are in [0, 1]), at most ao_rays_max rays per texel.
   bool ao_rays_auto = false;
-  double max_ao_error = 0.01;
-  int ao_rays_max = 1024;
+  double max_ao_error = kDefaultMaxAoError;
+  int ao_rays_max = kMaxAutoAoRays;
+  // The secondary rays' random streams (keyed by texel, sample and this): 0 gives the maps every
+  // release bakes; another value, rays independent of them (the accuracy bench's reference).
+  std::uint64_t ray_seed = 0;
   bool ao_occluders_all = false;  // with --match names: every object occludes, not only the group's
   // Height: the distance mapped to 0 and to 1 (scene units); not given: the bake's own range,
   // symmetric about 0.

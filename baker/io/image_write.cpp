@@ -28,15 +28,20 @@ constexpr std::size_t kQuantizeChunk = std::size_t(1) << 18;  // values per chun
 // 65535, so v + 0.5 is exact in double wherever it can reach 1. Negative and NaN values clamp to 0
 // either way.
 template <typename T>
+void quantize_values(const float* values, std::size_t n, double scale, T* out) {
+  for (std::size_t i = 0; i < n; ++i) {
+    double v = static_cast<double>(values[i]) * scale + 0.5;
+    if (!(v > 0.0)) v = 0.0;
+    if (v > scale) v = scale;
+    out[i] = static_cast<T>(v);  // truncation of a value in [0, scale]
+  }
+}
+
+template <typename T>
 Samples<T> quantize(const Image::Pixels& values, double scale, int threads) {
   Samples<T> out(values.size());  // left unset: every value is written below, on every core
   parallel_chunks(threads, values.size(), kQuantizeChunk, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      double v = static_cast<double>(values[i]) * scale + 0.5;
-      if (!(v > 0.0)) v = 0.0;
-      if (v > scale) v = scale;
-      out[i] = static_cast<T>(v);  // truncation of a value in [0, scale]
-    }
+    quantize_values(values.data() + begin, end - begin, scale, out.data() + begin);
   });
   return out;
 }
@@ -54,18 +59,15 @@ double unit_hash(std::uint64_t key) {
 // 8-bit values with triangular noise of one step added before rounding (WriteOptions::dither):
 // the sum of two uniform values in [0, 1) minus 1, seeded by the value's index, so that a gradient
 // finer than a step shows no bands and the average over many texels keeps the float value.
-Samples<std::uint8_t> quantize_dithered(const Image::Pixels& values, int threads) {
-  Samples<std::uint8_t> out(values.size());
-  parallel_chunks(threads, values.size(), kQuantizeChunk, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      const double noise = unit_hash(2 * std::uint64_t(i)) + unit_hash(2 * std::uint64_t(i) + 1) - 1.0;
-      double v = static_cast<double>(values[i]) * 255.0 + 0.5 + noise;
-      if (!(v > 0.0)) v = 0.0;
-      if (v > 255.0) v = 255.0;
-      out[i] = static_cast<std::uint8_t>(v);
-    }
-  });
-  return out;
+void quantize_dithered(const float* values, std::size_t first, std::size_t n, std::uint8_t* out) {
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t i = first + k;
+    const double noise = unit_hash(2 * std::uint64_t(i)) + unit_hash(2 * std::uint64_t(i) + 1) - 1.0;
+    double v = static_cast<double>(values[k]) * 255.0 + 0.5 + noise;
+    if (!(v > 0.0)) v = 0.0;
+    if (v > 255.0) v = 255.0;
+    out[k] = static_cast<std::uint8_t>(v);
+  }
 }
 
 // A reason that is memory running out (the PNG encoder's "insufficient memory", ENOMEM): exit 4, not 3.
@@ -94,8 +96,20 @@ int check_write(const std::string& path, const Image& image, const WriteOptions&
 }
 
 Samples<std::uint8_t> quantize8(const Image::Pixels& values, bool dither, int threads) {
-  return dither ? quantize_dithered(values, threads) : quantize<std::uint8_t>(values, 255.0, threads);
+  if (!dither) return quantize<std::uint8_t>(values, 255.0, threads);
+  Samples<std::uint8_t> out(values.size());
+  parallel_chunks(threads, values.size(), kQuantizeChunk, [&](std::size_t begin, std::size_t end) {
+    quantize_dithered(values.data() + begin, begin, end - begin, out.data() + begin);
+  });
+  return out;
 }
+
+void quantize8_run(const float* values, std::size_t first, std::size_t n, bool dither, std::uint8_t* out) {
+  if (dither) quantize_dithered(values, first, n, out);
+  else quantize_values(values, n, 255.0, out);
+}
+
+void quantize16_run(const float* values, std::size_t n, std::uint16_t* out) { quantize_values(values, n, 65535.0, out); }
 
 Samples<std::uint16_t> quantize16(const Image::Pixels& values, int threads) {
   return quantize<std::uint16_t>(values, 65535.0, threads);

@@ -23,6 +23,10 @@ template <typename T>
 using Samples = std::vector<T, DefaultInitAllocator<T>>;
 Samples<std::uint8_t> quantize8(const Image::Pixels& values, bool dither, int threads = 1);
 Samples<std::uint16_t> quantize16(const Image::Pixels& values, int threads = 1);
+// The same for a run of `n` values, the first of them value number `first` of its image (dither's
+// seed): what quantize8 and quantize16 give those values.
+void quantize8_run(const float* values, std::size_t first, std::size_t n, bool dither, std::uint8_t* out);
+void quantize16_run(const float* values, std::size_t n, std::uint16_t* out);
 
 // "YYYY:MM:DD HH:MM:SS" (UTC) of SOURCE_DATE_EPOCH, or "" when it is unset or malformed.
 std::string reproducible_date_time();

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
 #include <new>
 
 #include "core/parallel.h"
@@ -39,18 +40,16 @@ int paeth(int a, int b, int c) {
   return pb <= pc ? b : c;
 }
 
-// One row's bytes as PNG stores them (16-bit samples big-endian).
-void raw_row(const unsigned char* rows, std::size_t row_bytes, int bits, int y, unsigned char* out) {
-  const unsigned char* in = rows + std::size_t(y) * row_bytes;
-  if (bits == 8) {
-    std::memcpy(out, in, row_bytes);
-    return;
-  }
-  for (std::size_t i = 0; i < row_bytes; i += 2) {
+// Row y's bytes as PNG stores them (row_bytes of them; 16-bit samples big-endian), into `out`.
+using RowSource = std::function<void(int y, unsigned char* out)>;
+
+// Native-endian 16-bit samples to PNG's big-endian bytes, in place.
+void big_endian16(unsigned char* bytes, std::size_t n) {
+  for (std::size_t i = 0; i < n; i += 2) {
     std::uint16_t v;
-    std::memcpy(&v, in + i, 2);
-    out[i] = static_cast<unsigned char>(v >> 8);
-    out[i + 1] = static_cast<unsigned char>(v & 0xffu);
+    std::memcpy(&v, bytes + i, 2);
+    bytes[i] = static_cast<unsigned char>(v >> 8);
+    bytes[i + 1] = static_cast<unsigned char>(v & 0xffu);
   }
 }
 
@@ -84,25 +83,25 @@ void filter_row(int type, const unsigned char* cur, const unsigned char* prior, 
 // One band's raw deflate stream (ended by a sync flush, or finished for the last band) and the
 // Adler-32 of what it compresses. Returns null, or zlib's reason it failed.
 struct Band {
-  std::vector<unsigned char> bytes;
+  std::vector<unsigned char, DefaultInitAllocator<unsigned char>> bytes;  // deflateBound's room, not zeroed
   uLong adler = 1;
   std::size_t length = 0;  // bytes compressed
 };
 
-const char* deflate_band(const unsigned char* rows, std::size_t row_bytes, int bits, std::size_t bpp, int type, int y0, int y1,
-                         bool last, const PngSettings& settings, Band& band) {
+const char* deflate_band(const RowSource& row, std::size_t row_bytes, std::size_t bpp, int type, int y0, int y1, bool last,
+                         const PngSettings& settings, Band& band) {
   z_stream zs{};
   const int init = deflateInit2(&zs, settings.level, Z_DEFLATED, -15, 8, settings.strategy);
   if (init == Z_MEM_ERROR) return "insufficient memory";
   if (init != Z_OK) return "invalid compression settings";
   std::vector<unsigned char> prior(row_bytes, 0), cur(row_bytes), filtered(row_bytes + 1);
-  if (y0 > 0) raw_row(rows, row_bytes, bits, y0 - 1, prior.data());
+  if (y0 > 0) row(y0 - 1, prior.data());
   band.bytes.resize(deflateBound(&zs, uLong(std::size_t(y1 - y0) * (row_bytes + 1))) + 64);
   zs.next_out = band.bytes.data();
   zs.avail_out = uInt(band.bytes.size());
   bool ok = true;
   for (int y = y0; y < y1 && ok; ++y) {
-    raw_row(rows, row_bytes, bits, y, cur.data());
+    row(y, cur.data());
     filter_row(type, cur.data(), prior.data(), row_bytes, bpp, filtered.data());
     band.adler = adler32(band.adler, filtered.data(), uInt(filtered.size()));
     band.length += filtered.size();
@@ -161,11 +160,10 @@ bool time_bytes(const std::string& text, unsigned char t[7]) {
   return true;
 }
 
-}  // namespace
-
-std::vector<unsigned char> encode_png(const void* rows, int width, int height, int channels, int bits,
-                                      const std::vector<std::pair<std::string, std::string>>& metadata,
-                                      const PngSettings& settings, int threads, std::string* error) {
+// encode_png with its rows from `row`, called from every thread (each row of a band in order).
+std::vector<unsigned char> encode_rows(const RowSource& row, int width, int height, int channels, int bits,
+                                       const std::vector<std::pair<std::string, std::string>>& metadata,
+                                       const PngSettings& settings, int threads, std::string* error) {
   const int type = filter_type(settings.filters);
   if (type < 0) {
     *error = "filters: one of 0x08, 0x10, 0x20, 0x40, 0x80 expected, not " + std::to_string(settings.filters);
@@ -183,7 +181,6 @@ std::vector<unsigned char> encode_png(const void* rows, int width, int height, i
   static constexpr unsigned char kColorTypes[] = {0, 4, 2, 6};
   const std::size_t bpp = std::size_t(channels) * std::size_t(bits / 8);
   const std::size_t row_bytes = std::size_t(width) * bpp;
-  const auto* in = static_cast<const unsigned char*>(rows);
   try {
     const int bands = std::max(1, std::min(kBands, height));
     std::vector<Band> band(static_cast<std::size_t>(bands));
@@ -191,7 +188,7 @@ std::vector<unsigned char> encode_png(const void* rows, int width, int height, i
     parallel_chunks(threads, band.size(), 1, [&](std::size_t b, std::size_t) {
       const int y0 = int(std::int64_t(height) * std::int64_t(b) / bands),
                 y1 = int(std::int64_t(height) * std::int64_t(b + 1) / bands);
-      failed[b] = deflate_band(in, row_bytes, bits, bpp, type, y0, y1, b + 1 == band.size(), settings, band[b]);
+      failed[b] = deflate_band(row, row_bytes, bpp, type, y0, y1, b + 1 == band.size(), settings, band[b]);
     });
     for (const char* f : failed)
       if (f) {
@@ -237,6 +234,23 @@ std::vector<unsigned char> encode_png(const void* rows, int width, int height, i
   }
 }
 
+}  // namespace
+
+std::vector<unsigned char> encode_png(const void* rows, int width, int height, int channels, int bits,
+                                      const std::vector<std::pair<std::string, std::string>>& metadata,
+                                      const PngSettings& settings, int threads, std::string* error) {
+  const auto* in = static_cast<const unsigned char*>(rows);
+  const std::size_t row_bytes = std::size_t(std::max(width, 0)) * std::size_t(std::max(channels, 0)) * std::size_t(bits / 8);
+  const RowSource row = [&](int y, unsigned char* out) {
+    std::memcpy(out, in + std::size_t(y) * row_bytes, row_bytes);
+    if (bits == 16) big_endian16(out, row_bytes);
+  };
+  return encode_rows(row, width, height, channels, bits, metadata, settings, threads, error);
+}
+
+// The image's float values are quantized row by row inside the bands' encoders (the values
+// quantize8 / quantize16 give), not into a whole 8- or 16-bit copy first: one pass over the image
+// and no buffer of its size.
 void write_png_image(const std::string& path, const Image& image, const WriteOptions& options) {
   const int bits = image_write::check_write(path, image, options);
   std::vector<std::pair<std::string, std::string>> metadata = options.metadata;
@@ -245,17 +259,20 @@ void write_png_image(const std::string& path, const Image& image, const WriteOpt
     for (const auto& item : metadata) given = given || item.first == "DateTime";
     if (!given) metadata.emplace_back("DateTime", date);
   }
+  const std::size_t values = std::size_t(image.width) * std::size_t(image.channels);
+  const RowSource row = [&](int y, unsigned char* out) {
+    const std::size_t first = std::size_t(y) * values;
+    if (bits == 8) {
+      image_write::quantize8_run(image.pixels.data() + first, first, values, options.dither, out);
+      return;
+    }
+    std::uint16_t* samples = reinterpret_cast<std::uint16_t*>(out);  // row_bytes = 2 * values
+    image_write::quantize16_run(image.pixels.data() + first, values, samples);
+    big_endian16(out, 2 * values);
+  };
   std::string error;
-  std::vector<unsigned char> bytes;
-  if (bits == 8) {
-    const auto rows = image_write::quantize8(image.pixels, options.dither, options.threads);
-    bytes =
-        encode_png(rows.data(), image.width, image.height, image.channels, 8, metadata, PngSettings{}, options.threads, &error);
-  } else {
-    const auto rows = image_write::quantize16(image.pixels, options.threads);
-    bytes =
-        encode_png(rows.data(), image.width, image.height, image.channels, 16, metadata, PngSettings{}, options.threads, &error);
-  }
+  const std::vector<unsigned char> bytes =
+      encode_rows(row, image.width, image.height, image.channels, bits, metadata, PngSettings{}, options.threads, &error);
   if (bytes.empty()) image_write::fail_write(path, error);
   image_write::write_file_bytes(path, bytes, options);
 }

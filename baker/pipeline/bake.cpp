@@ -264,7 +264,10 @@ void validate_options(const BakeOptions& o) {
       if (m.maps[i] == m.maps[j]) throw UsageError(std::string("--maps: ") + map_name(m.maps[i]) + " is given twice");
   if (m.ao_rays < 1 || m.ao_rays > kMaxAoRays)
     throw UsageError("--ao-rays must be between 1 and " + std::to_string(kMaxAoRays) + ", got " + std::to_string(m.ao_rays));
-  if (m.ao_rays_auto) throw UsageError("--ao-rays auto is not available yet in this version; give a number of rays");
+  if (m.ao_rays_auto && !(m.max_ao_error > 0.0 && m.max_ao_error < 0.5))
+    throw UsageError("--max-ao-error must be a standard error above 0 and below 0.5");
+  if (m.ao_rays_auto && (m.ao_rays_max < 1 || m.ao_rays_max > kMaxAoRays))
+    throw UsageError("the most rays of --ao-rays auto must be between 1 and " + std::to_string(kMaxAoRays));
   for (const auto& [d, name] :
        {std::pair{m.ao_distance, "--ao-distance"}, std::pair{m.thickness_distance, "--thickness-distance"},
         std::pair{m.curvature_scale, "--curvature-scale"}})

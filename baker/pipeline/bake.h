@@ -257,6 +257,9 @@ struct BakedMap {
   // -1 for the other maps.
   double error_mean = -1.0, error_p95 = -1.0;
   Image error;  // ao, thickness: per texel the standard error of its value (1 channel, covered texels; else 0)
+  // ao, bent-normal, thickness with --ao-rays auto: the rays per texel spent, mean and most over
+  // the covered texels; -1 otherwise.
+  double rays_mean = -1.0, rays_max = -1.0;
   // Not written, and why (vertex-color of a high-poly without colours): `image` is then empty.
   std::string skipped;
 };

@@ -7,10 +7,13 @@
 
 #include "core/curvature.h"
 #include "core/padding.h"
+#include "core/parallel.h"
 
 namespace nmbake {
 
 namespace {
+
+constexpr std::size_t kTexelChunk = 1 << 16;  // texels a thread takes at once in finish_maps
 
 std::string number(double v) {
   char text[40];
@@ -58,6 +61,16 @@ void error_summary(const Image& err, const std::vector<std::uint8_t>& coverage, 
   const std::size_t k = std::min(v.size() - 1, std::size_t(std::ceil(0.95 * double(v.size()))) - 1);
   std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(k), v.end());
   out.error_p95 = v[k];
+}
+
+// Mean and most of the covered texels of a rays-per-texel image (--ao-rays auto); none: -1.
+void rays_summary(const Image& rays, const std::vector<std::uint8_t>& coverage, BakedMap& out) {
+  if (rays.pixels.empty()) return;
+  const std::vector<double> v = covered_values(rays, coverage);
+  double sum = 0.0, most = 0.0;
+  for (double n : v) sum += n, most = std::max(most, n);
+  out.rays_mean = v.empty() ? 0.0 : sum / double(v.size());
+  out.rays_max = most;
 }
 
 // The names of the high-poly's objects (one: the file's name) and materials (none: one, "").
@@ -175,9 +188,11 @@ std::vector<BakedMap> finish_maps(const BakeOptions& opt, const Prepared& s, con
     m.kind = kind;
     m.metadata.push_back({"nmbake:map", map_name(kind)});
     Image img = std::move(raw.raw[k]);
-    const auto each = [&](auto&& f) {
-      for (std::size_t i = 0; i < coverage.size(); ++i)
-        if (coverage[i]) f(&img.pixels[i * std::size_t(img.channels)]);
+    const auto each = [&](auto&& f) {  // every covered texel, on every thread (each texel on its own)
+      parallel_chunks(threads, coverage.size(), kTexelChunk, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+          if (coverage[i]) f(&img.pixels[i * std::size_t(img.channels)]);
+      });
     };
     switch (kind) {
       case MapKind::object_normal:
@@ -186,6 +201,7 @@ std::vector<BakedMap> finish_maps(const BakeOptions& opt, const Prepared& s, con
           for (int c = 0; c < 3; ++c) p[c] = p[c] * 0.5f + 0.5f;
         });
         if (kind == MapKind::bent_normal) {
+          rays_summary(raw.ao_rays, coverage, m);
           m.distance = in.ao_distance;
           m.metadata.push_back({"nmbake:ao_distance", number(in.ao_distance)});
         }
@@ -194,12 +210,14 @@ std::vector<BakedMap> finish_maps(const BakeOptions& opt, const Prepared& s, con
         m.distance = in.ao_distance;
         m.metadata.push_back({"nmbake:ao_distance", number(in.ao_distance)});
         error_summary(raw.ao_error, coverage, m);
+        rays_summary(raw.ao_rays, coverage, m);
         m.error = std::move(raw.ao_error);
         break;
       case MapKind::thickness:
         m.distance = in.thickness_distance;
         m.metadata.push_back({"nmbake:thickness_distance", number(in.thickness_distance)});
         error_summary(raw.thickness_error, coverage, m);
+        rays_summary(raw.thickness_rays, coverage, m);
         m.error = std::move(raw.thickness_error);
         break;
       case MapKind::height: {

@@ -14,6 +14,14 @@ namespace {
 constexpr std::size_t kRayBatch = 4096;  // secondary rays cast together
 constexpr std::size_t kAhead = 8;        // samples ahead whose hit data is fetched early
 
+// --ao-rays auto: the first round's rays per texel, the fewest a later round adds, and the rays of
+// each outcome (open, occluded) its stopping rule adds to a texel's AO count (Laplace's rule of
+// succession; on the bench's sculpts 1 spent its rays better than 0 or 0.5, and 2 about as well:
+// bench/accuracy_ao.h).
+constexpr int kAutoFirstRays = 32;
+constexpr int kAutoRoundRays = 16;
+constexpr double kAutoPrior = 1.0;
+
 // What a covered texel whose samples all miss gets: open, thick, flat, on the low-poly surface
 // (height 0, position the low-poly point), no colour, no ID.
 constexpr double kMissAo = 1.0, kMissThickness = 1.0;
@@ -83,6 +91,9 @@ MapTargets allocate_map_targets(const MapOptions& maps, int width, int height) {
   for (MapKind k : maps.maps) out.raw.push_back(k == MapKind::normal ? Image() : Image(width, height, map_channels(k), 0.0f));
   if (maps.wants(MapKind::ao)) out.ao_error = Image(width, height, 1, 0.0f);
   if (maps.wants(MapKind::thickness)) out.thickness_error = Image(width, height, 1, 0.0f);
+  if (maps.ao_rays_auto && (maps.wants(MapKind::ao) || maps.wants(MapKind::bent_normal)))
+    out.ao_rays = Image(width, height, 1, 0.0f);
+  if (maps.ao_rays_auto && maps.wants(MapKind::thickness)) out.thickness_rays = Image(width, height, 1, 0.0f);
   return out;
 }
 
@@ -99,6 +110,17 @@ struct TexelMaps::Impl {
   std::vector<std::int64_t> object_id, material_id;
   RayQueue queue[2];  // AO's (occlusion only), thickness's (first hits)
   std::vector<double> thick_sum, thick_sq;
+  // Per sample of the pass, what its secondary rays start from: the hit point, the geometric
+  // normal on the hit normal's side, the match group; per kind (0: AO's, 1: thickness's) its
+  // random stream (keyed by texel and sample) and the rays cast so far.
+  std::vector<glm::dvec3> hit_point, hit_face;
+  std::vector<std::uint32_t> ray_group;
+  std::vector<SampleStream> stream[2];
+  std::vector<std::uint32_t> rays_cast[2];
+  // --ao-rays auto, per tile texel: its hit samples, rays, sums of their values (and squares), and
+  // the rays each of its hit samples gets in the next round.
+  std::vector<std::uint32_t> texel_hits, texel_more;
+  std::vector<double> texel_rays, texel_sum, texel_sq;
   std::vector<std::uint32_t> seen;
   std::vector<std::int64_t> vote;
   std::vector<std::uint32_t> start, order, fill;   // the ID vote's counting sort
@@ -117,6 +139,7 @@ struct TexelMaps::Impl {
       use(s);
       if (k == MapKind::position) use(s_miss_position);
     }
+    if (in.maps->wants(MapKind::bent_normal)) use(s_ao);  // the rays a texel's bent normal spent
     use(s_hits);
     use(s_samples);
     sums.assign(std::size_t(stride) * texels, 0.0);
@@ -134,6 +157,83 @@ struct TexelMaps::Impl {
   bool has(Slot s) const { return offset[s] >= 0; }
 
   std::uint32_t source_tri(std::uint32_t t) const { return in.source ? in.source[t] : t; }
+
+  // Queues `count` more rays of kind `k` (0: AO's, over the hit normal's hemisphere; 1: thickness's,
+  // over the inverted normal's) from sample r, continuing its stream: the first rays of a sample are
+  // the same whatever the rounds that follow.
+  void queue_rays(int k, std::size_t r, std::size_t count) {
+    const bool thick = k == 1;
+    RayQueue& q = queue[k];
+    const glm::dvec3 axis = thick ? -hit_normal[r] : hit_normal[r];
+    const glm::dvec3 org = hit_point[r] + (thick ? -in.epsilon : in.epsilon) * hit_face[r];
+    SampleStream& st = stream[k][r];
+    for (std::size_t j = 0; j < count; ++j) {
+      const double u1 = st.next(), u2 = st.next();
+      const glm::dvec3 d = cosine_direction(axis, u1, u2);
+      raycast::Ray ray;
+      ray.origin = glm::vec3(org);
+      ray.direction = glm::vec3(d);
+      ray.tnear = 0.0f;
+      ray.tfar = float(thick ? in.thickness_distance : in.ao_distance);
+      q.rays.set(q.n, ray);
+      q.sample[q.n] = std::uint32_t(r);
+      if (!q.group.empty()) q.group[q.n] = ray_group[r];
+      if (++q.n == kRayBatch) flush(k);
+    }
+    rays_cast[k][r] += std::uint32_t(count);
+  }
+
+  // --ao-rays auto: rounds of more rays of kind `k` for the texels whose standard error is still
+  // above MapOptions::max_ao_error, until none is (or has ao_rays_max rays). A texel's samples
+  // share its round's rays; everything is per texel, so the rounds do not depend on the tiling's
+  // threads.
+  void cast_rounds(int k, const Samples& smp) {
+    const MapOptions& mo = *in.maps;
+    const double e2 = mo.max_ao_error * mo.max_ao_error;
+    const double cap = double(mo.ao_rays_max);
+    const std::size_t n = smp.count;
+    for (;;) {
+      texel_hits.assign(texels, 0);
+      texel_rays.assign(texels, 0.0);
+      texel_sum.assign(texels, 0.0);
+      texel_sq.assign(texels, 0.0);
+      texel_more.assign(texels, 0);
+      for (std::size_t r = 0; r < n; ++r) {
+        if (smp.hit_tri[r] == raycast::no_hit) continue;
+        const std::size_t i = smp.texel[r];
+        ++texel_hits[i];
+        texel_rays[i] += double(rays_cast[k][r]);
+        texel_sum[i] += k == 0 ? double(open_rays[r]) : thick_sum[r];
+        if (k == 1) texel_sq[i] += thick_sq[r];
+      }
+      bool more = false;
+      for (std::size_t i = 0; i < texels; ++i) {
+        const double rays = texel_rays[i], hits = double(texel_hits[i]);
+        if (hits == 0.0 || rays >= cap) continue;
+        double var;  // of one ray's value
+        if (k == 0) {
+          // The open share with kAutoPrior rays of each outcome added: a texel whose first rays
+          // all agree is not taken for certain (32 open rays leave p = 0.97 quite likely).
+          const double p = (texel_sum[i] + kAutoPrior) / (rays + 2.0 * kAutoPrior);
+          var = p * (1.0 - p) * rays / std::max(1.0, rays - 1.0);
+        } else {
+          const double mean = texel_sum[i] / rays;
+          var = rays > 1.0 ? std::max(0.0, (texel_sq[i] - rays * mean * mean) / (rays - 1.0)) : 0.0;
+        }
+        if (var <= e2 * rays) continue;  // standard error sqrt(var / rays) at most E
+        // The rays that would bring it to E, at least a round's worth, at most the cap.
+        const double want = std::min(cap - rays, std::max(double(kAutoRoundRays), std::ceil(var / e2 - rays)));
+        const double per = std::min(std::ceil(want / hits), std::floor((cap - rays) / hits));
+        if (per < 1.0) continue;
+        texel_more[i] = std::uint32_t(per);
+        more = true;
+      }
+      if (!more) return;
+      for (std::size_t r = 0; r < n; ++r)
+        if (smp.hit_tri[r] != raycast::no_hit && texel_more[smp.texel[r]]) queue_rays(k, r, texel_more[smp.texel[r]]);
+      flush(k);
+    }
+  }
 
   // Casts queue `k`'s rays (0: AO's, occlusion; 1: thickness's, first hits of either facing) and
   // adds their results to their samples, in queue order.
@@ -192,14 +292,25 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
   const HighScene& sc = *in.scene;
   const std::size_t n = smp.count;
   std::fill(m.sums.begin(), m.sums.end(), 0.0);
-  m.hit_normal.assign(n, glm::dvec3(0.0));
-  m.bent_sum.assign(n, glm::dvec3(0.0));
-  m.open_rays.assign(n, 0);
-  m.thick_sum.assign(n, 0.0);
-  m.thick_sq.assign(n, 0.0);
+  const bool rays = m.rays_ao || m.rays_thickness;
+  if (rays) {  // the secondary rays' per-sample state and sums, only where a map casts them
+    m.hit_normal.assign(n, glm::dvec3(0.0));
+    m.bent_sum.assign(n, glm::dvec3(0.0));
+    m.open_rays.assign(n, 0);
+    m.thick_sum.assign(n, 0.0);
+    m.thick_sq.assign(n, 0.0);
+    m.hit_point.assign(n, glm::dvec3(0.0));
+    m.hit_face.assign(n, glm::dvec3(0.0));
+    m.ray_group.assign(n, 0);
+    for (int k = 0; k < 2; ++k) {
+      m.stream[k].assign(n, SampleStream(0));
+      m.rays_cast[k].assign(n, 0);
+    }
+  }
   if (m.ids) m.object_id.assign(n, -1), m.material_id.assign(n, -1);
   m.seen.assign(m.texels, 0);
-  const int rays_per_texel = in.maps->ao_rays;
+  // Fixed: ao_rays per texel; auto: its first round.
+  const int rays_per_texel = in.maps->ao_rays_auto ? std::min(kAutoFirstRays, in.maps->ao_rays_max) : in.maps->ao_rays;
   const std::size_t per_sample = std::max<std::size_t>(1, (std::size_t(rays_per_texel) + per_texel - 1) / per_texel);
 
   for (std::size_t r = 0; r < n; ++r) {
@@ -253,7 +364,7 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
       }
       nh = len > 0.0 ? nh / len : low_normal();
     }
-    m.hit_normal[r] = nh;
+    if (rays) m.hit_normal[r] = nh;
     *m.at(i, s_hits) += 1.0;
     if (m.has(s_object_normal))
       for (int c = 0; c < 3; ++c) m.at(i, s_object_normal)[c] += nh[c];
@@ -276,52 +387,43 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
       m.material_id[r] = in.material.empty() ? 0 : std::int64_t(in.material[ht]);
     }
     // Secondary rays from just off the surface, on the side the rays go to.
-    if (!m.rays_ao && !m.rays_thickness) continue;
+    if (!rays) continue;
     const double face_len = glm::length(face);
     glm::dvec3 ng = face_len > 0.0 ? face / face_len : nh;
     if (glm::dot(ng, nh) < 0.0) ng = -ng;
-    const std::uint32_t group = m.queue[0].group.empty() ? 0u : in.groups->low[tri];
     const std::size_t texel = std::size_t(tile_y0 + int(i / std::size_t(side))) * std::size_t(width) +
                               std::size_t(tile_x0 + int(i % std::size_t(side)));
+    m.hit_point[r] = x;
+    m.hit_face[r] = ng;
+    m.ray_group[r] = m.queue[0].group.empty() ? 0u : in.groups->low[tri];
     for (int kind = 0; kind < 2; ++kind) {
-      const bool thick = kind == 1;
-      if (thick ? !m.rays_thickness : !m.rays_ao) continue;
-      SampleStream stream(sample_key(texel, std::uint64_t(level) << 32 | appearance, std::uint64_t(kind)));
-      RayQueue& queue = m.queue[kind];
-      const glm::dvec3 axis = thick ? -nh : nh;
-      const glm::dvec3 org = x + (thick ? -in.epsilon : in.epsilon) * ng;
-      for (std::size_t j = 0; j < per_sample; ++j) {
-        const double u1 = stream.next(), u2 = stream.next();
-        const glm::dvec3 d = cosine_direction(axis, u1, u2);
-        raycast::Ray ray;
-        ray.origin = glm::vec3(org);
-        ray.direction = glm::vec3(d);
-        ray.tnear = 0.0f;
-        ray.tfar = float(thick ? in.thickness_distance : in.ao_distance);
-        queue.rays.set(queue.n, ray);
-        queue.sample[queue.n] = std::uint32_t(r);
-        if (!queue.group.empty()) queue.group[queue.n] = group;
-        if (++queue.n == kRayBatch) m.flush(kind);
-      }
+      if (kind == 1 ? !m.rays_thickness : !m.rays_ao) continue;
+      m.stream[kind][r] = SampleStream(
+          sample_key(texel, std::uint64_t(level) << 32 | appearance, std::uint64_t(kind) + (in.maps->ray_seed << 8)));
+      m.queue_rays(kind, r, per_sample);
     }
   }
   m.flush(0);
   m.flush(1);
+  if (in.maps->ao_rays_auto) {
+    if (m.rays_ao) m.cast_rounds(0, smp);
+    if (m.rays_thickness) m.cast_rounds(1, smp);
+  }
 
   // Per sample: AO, bent normal and thickness into its texel, in sample order.
-  for (std::size_t r = 0; r < n; ++r) {
+  for (std::size_t r = 0; rays && r < n; ++r) {
     const std::size_t i = smp.texel[r];
     const bool hit = smp.hit_tri[r] != raycast::no_hit;
     const std::size_t tri = std::size_t(smp.low_tri[r]);
     const double b[3] = {smp.b[0][r], smp.b[1][r], smp.b[2][r]};
     if (m.has(s_ao) && hit) {
       m.at(i, s_ao)[0] += double(m.open_rays[r]);
-      m.at(i, s_ao)[1] += double(per_sample);
+      m.at(i, s_ao)[1] += double(m.rays_cast[0][r]);
     }
     if (m.has(s_thickness) && hit) {
       m.at(i, s_thickness)[0] += m.thick_sum[r];
       m.at(i, s_thickness)[1] += m.thick_sq[r];
-      m.at(i, s_thickness)[2] += double(per_sample);  // every ray queued is cast
+      m.at(i, s_thickness)[2] += double(m.rays_cast[1][r]);  // every ray queued is cast
     }
     if (m.has(s_bent)) {
       const PixelFrame frame = interpolate_frame(s.low_tris[tri].n, s.low_tris[tri].t, b, in.bitangent);
@@ -339,24 +441,29 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
     }
   }
 
-  // The ID maps: per texel the index most of its hit samples take.
+  // The ID maps: per texel the index most of its hit samples take. Samples grouped by texel, in
+  // sample order (a counting sort, once for both maps); a texel of one sample takes its index.
   if (m.ids) {
+    std::vector<std::uint32_t>&start = m.start, &order = m.order, &fill = m.fill;
+    start.assign(m.texels + 1, 0);
+    order.resize(n);
+    for (std::size_t r = 0; r < n; ++r) ++start[std::size_t(smp.texel[r]) + 1];
+    for (std::size_t t = 1; t <= m.texels; ++t) start[t] += start[t - 1];
+    fill.assign(start.begin(), start.end() - 1);
+    for (std::size_t r = 0; r < n; ++r) order[fill[smp.texel[r]]++] = std::uint32_t(r);
     for (int which = 0; which < 2; ++which) {
       const Slot slot = which == 0 ? s_object_id : s_material_id;
       if (!m.has(slot)) continue;
       const std::vector<std::int64_t>& id = which == 0 ? m.object_id : m.material_id;
-      // Samples grouped by texel, in sample order (a counting sort).
-      std::vector<std::uint32_t>&start = m.start, &order = m.order, &fill = m.fill;
-      start.assign(m.texels + 1, 0);
-      order.resize(n);
-      for (std::size_t r = 0; r < n; ++r) ++start[std::size_t(smp.texel[r]) + 1];
-      for (std::size_t t = 1; t <= m.texels; ++t) start[t] += start[t - 1];
-      fill.assign(start.begin(), start.end() - 1);
-      for (std::size_t r = 0; r < n; ++r) order[fill[smp.texel[r]]++] = std::uint32_t(r);
       for (std::size_t t = 0; t < m.texels; ++t) {
-        if (start[t] == start[t + 1]) continue;
+        const std::uint32_t first = start[t], end = start[t + 1];
+        if (first == end) continue;
+        if (end - first == 1) {
+          *m.at(t, slot) = id[order[first]] >= 0 ? double(id[order[first]]) : -1.0;
+          continue;
+        }
         m.vote.clear();
-        for (std::uint32_t k = start[t]; k < start[t + 1]; ++k)
+        for (std::uint32_t k = first; k < end; ++k)
           if (id[order[k]] >= 0) m.vote.push_back(id[order[k]]);
         *m.at(t, slot) = most_frequent(m.vote);
       }
@@ -422,6 +529,8 @@ void TexelMaps::write(MapTargets& out, int x0, int y0, int w, int h, int side, i
           default: break;
         }
       }
+      if (!out.ao_rays.pixels.empty()) out.ao_rays.pixels[g] = float(m.at(i, s_ao)[1]);
+      if (!out.thickness_rays.pixels.empty()) out.thickness_rays.pixels[g] = float(m.at(i, s_thickness)[2]);
     }
 }
 

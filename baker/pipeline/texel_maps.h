@@ -59,6 +59,10 @@ struct MapTargets {
   // Per texel, the standard error of the ao / thickness value (its samples' spread over sqrt of
   // their count); empty unless the map is asked for.
   Image ao_error, thickness_error;
+  // With --ao-rays auto (MapOptions::ao_rays_auto), per texel the AO's / thickness's rays cast
+  // (summed over its samples); empty otherwise, or unless the map (ao or bent-normal / thickness) is
+  // asked for.
+  Image ao_rays, thickness_rays;
 };
 
 // The images of `maps` (raw, 1 or 3 channels) and the error images, sized as the map.

@@ -1,0 +1,160 @@
+// --ao-rays auto (MapOptions::ao_rays_auto) and the bent normal against known answers: beside a
+// wall auto's AO reaches the standard error asked and its noise is what it reports; it spends its
+// rays where occlusion is partial; it does not depend on the thread count. The bent normal beside
+// a tall wall tilts away from it by atan(2 / pi) (cosine-weighted rays, no distance limit), in
+// tangent space with either green convention; on open ground it is the normal.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+
+#include "pipeline/bake.h"
+#include "test_support.h"
+
+namespace nmbake {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Two flat-shaded triangles a, b, c and a, c, d (counter-clockwise), no UVs.
+void add_quad(Mesh& m, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d) {
+  const glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
+  for (const auto& t : {std::array<glm::vec3, 3>{a, b, c}, std::array<glm::vec3, 3>{a, c, d}}) {
+    const std::uint32_t p = std::uint32_t(m.positions.size());
+    for (const glm::vec3& v : t) m.positions.push_back(v);
+    m.normals.push_back(n);
+    for (std::uint32_t k = 0; k < 3; ++k) {
+      m.position_index.push_back(p + k);
+      m.normal_index.push_back(std::uint32_t(m.normals.size() - 1));
+    }
+    m.source_face.push_back(std::uint32_t(m.source_face.size()));
+  }
+}
+
+// The ground z = 0 for y in [0, 4] (x in [-half, half]) beside a wall y = 0 facing +y, `height` tall.
+Mesh wall_scene(float half, float height) {
+  Mesh m;
+  m.source = "wall_high";
+  add_quad(m, {-half, 0, 0}, {half, 0, 0}, {half, 4, 0}, {-half, 4, 0});
+  add_quad(m, {half, 0, 0}, {-half, 0, 0}, {-half, 0, height}, {half, 0, height});
+  return m;
+}
+
+BakeOptions options(int size, std::vector<MapKind> maps) {
+  BakeOptions o;
+  o.width = o.height = size;
+  o.front = o.rear = 0.1f;
+  o.padding = 0;
+  o.threads = 2;
+  o.maps.maps = std::move(maps);
+  return o;
+}
+
+const BakedMap& baked(const BakeResult& r, MapKind kind) {
+  for (const BakedMap& m : r.maps)
+    if (m.kind == kind) return m;
+  throw std::runtime_error("no such map");
+}
+
+// AO beside an infinite wall, distance limit R, at distance d (notes: maps.md).
+double wall_ao(double d, double r) {
+  const double a = d / r;
+  return a >= 1.0 ? 1.0 : 1.0 - (std::acos(a) - a * std::sqrt(1.0 - a * a)) / kPi;
+}
+
+// The low-poly [-2, 2] x [y0, y1] (u along x, v along y): row `row` of a `size` map lies at y.
+double row_y(int row, int size, double y0, double y1) { return y0 + (y1 - y0) * (1.0 - (row + 0.5) / size); }
+
+TEST(MapsAoAuto, BesideAWallReachesTheErrorAsked) {
+  const double e = 0.02;
+  BakeOptions o = options(64, {MapKind::ao});
+  o.maps.ao_distance = 1.0;
+  o.maps.ao_rays_auto = true;
+  o.maps.max_ao_error = e;
+  const BakeResult r = bake_normal_map(test::make_grid(8, 8, -2, 2, 0, 4), wall_scene(8, 2), nullptr, o);
+  const BakedMap& ao = baked(r, MapKind::ao);
+  double sq_resid = 0.0, sq_se = 0.0, n = 0.0;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 16; x < 48; ++x) {  // away from the wall's ends
+      const std::size_t i = std::size_t(y) * 64 + std::size_t(x);
+      const double expect = wall_ao(row_y(y, 64, 0, 4), 1.0);
+      EXPECT_LE(ao.error.pixels[i], e + 1e-6);  // every texel stopped at E (the cap, 1024 rays, is not reached here)
+      if (expect > 0.9) continue;               // the partial texels, where rays were added
+      const double d = ao.image.pixels[i] - expect;
+      sq_resid += d * d, sq_se += double(ao.error.pixels[i]) * ao.error.pixels[i], n += 1.0;
+    }
+  ASSERT_GT(n, 300.0);
+  const double rms = std::sqrt(sq_resid / n), reported = std::sqrt(sq_se / n);
+  EXPECT_LT(rms, 1.15 * e);         // 300+ texels: the RMS of their errors is within 10% of its own value
+  EXPECT_GT(rms / reported, 0.75);  // the noise is what the map reports it to be
+  EXPECT_LT(rms / reported, 1.25);
+  EXPECT_GT(ao.rays_mean, 32.0);
+  EXPECT_LE(ao.rays_max, 1024.0);
+}
+
+TEST(MapsAoAuto, FewerRaysOnOpenTexelsThanOnPartialOnes) {
+  BakeOptions o = options(32, {MapKind::ao});
+  o.maps.ao_distance = 1.0;
+  o.maps.ao_rays_auto = true;
+  const Mesh high = wall_scene(8, 2);
+  // Open: beyond the AO distance from the wall. Partial: within half of it (AO 0.5 to 0.82).
+  const BakeResult open = bake_normal_map(test::make_grid(4, 4, -2, 2, 1.5, 4), high, nullptr, o);
+  const BakeResult partial = bake_normal_map(test::make_grid(4, 4, -2, 2, 0.01f, 0.5), high, nullptr, o);
+  const BakedMap &a = baked(open, MapKind::ao), &b = baked(partial, MapKind::ao);
+  // An open texel: 32 rays, all open; its stopping share 33/34 gives a standard error of 0.030 > E,
+  // and the 42 more rays that would reach E by it; then 75/76 gives 0.013: stop at 74.
+  EXPECT_EQ(a.rays_max, 74.0);
+  EXPECT_EQ(a.rays_mean, 74.0);
+  EXPECT_GT(b.rays_mean, 4.0 * a.rays_mean);
+  for (float v : a.image.pixels) EXPECT_EQ(v, 1.0f);
+}
+
+// Beside a tall, long wall (no distance limit) the unoccluded rays are those heading away from it:
+// the mean of cosine-weighted directions over that half of the hemisphere is (0, 4 / (3 pi), 2 / 3),
+// tilted atan(2 / pi) = 32.48 degrees from the normal, away from the wall (+y: green up, G > 0.5).
+TEST(MapsBentNormal, BesideATallWallTiltsAwayByTheAnalyticAngle) {
+  const double tilt = std::atan(2.0 / kPi);
+  EXPECT_NEAR(tilt * 180.0 / kPi, 32.48, 0.01);
+  for (bool green_down : {false, true}) {
+    BakeOptions o = options(32, {MapKind::bent_normal});
+    o.maps.ao_distance = 1e4;
+    o.maps.ao_rays = 256;
+    o.green_down = green_down;
+    // Ground within 0.05 to 0.25 of a wall 100 long and 50 tall: the rays passing it are about 0.5%.
+    const BakeResult r = bake_normal_map(test::make_grid(4, 4, -2, 2, 0.05f, 0.25f), wall_scene(50, 50), nullptr, o);
+    const Image& b = baked(r, MapKind::bent_normal).image;
+    glm::dvec3 mean(0.0);
+    for (std::size_t i = 0; i < b.pixels.size() / 3; ++i) {
+      const glm::dvec3 v(2.0 * b.pixels[3 * i] - 1.0, 2.0 * b.pixels[3 * i + 1] - 1.0, 2.0 * b.pixels[3 * i + 2] - 1.0);
+      EXPECT_NEAR(glm::length(v), 1.0, 2e-3);
+      // Each texel's 256 rays: its lateral noise about 0.25 / sqrt(128) of a unit.
+      EXPECT_NEAR(std::atan2(green_down ? -v.y : v.y, v.z), tilt, 0.15) << i;
+      mean += v;
+    }
+    mean /= double(b.pixels.size() / 3);
+    EXPECT_NEAR(mean.x, 0.0, 0.01);
+    EXPECT_NEAR(std::atan2(green_down ? -mean.y : mean.y, mean.z), tilt, 0.01) << "green down " << green_down;
+    EXPECT_EQ(mean.y > 0.0, !green_down);
+  }
+}
+
+TEST(MapsBentNormal, OnOpenGroundIsTheNormal) {
+  BakeOptions o = options(32, {MapKind::bent_normal, MapKind::ao});
+  o.maps.ao_distance = 1.0;
+  o.maps.ao_rays = 256;
+  const BakeResult r = bake_normal_map(test::make_grid(4, 4, -2, 2, 1.5, 4), wall_scene(8, 2), nullptr, o);
+  const Image& b = baked(r, MapKind::bent_normal).image;
+  glm::dvec3 mean(0.0);
+  for (std::size_t i = 0; i < b.pixels.size() / 3; ++i) {
+    const glm::dvec3 v(2.0 * b.pixels[3 * i] - 1.0, 2.0 * b.pixels[3 * i + 1] - 1.0, 2.0 * b.pixels[3 * i + 2] - 1.0);
+    EXPECT_GT(v.z, std::cos(0.2)) << i;  // within the noise of 256 rays' mean
+    mean += v;
+  }
+  mean = glm::normalize(mean);
+  EXPECT_NEAR(mean.x, 0.0, 0.01);
+  EXPECT_NEAR(mean.y, 0.0, 0.01);
+  for (float v : baked(r, MapKind::ao).image.pixels) EXPECT_EQ(v, 1.0f);
+}
+
+}  // namespace
+}  // namespace nmbake
