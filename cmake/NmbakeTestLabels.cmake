@@ -23,3 +23,20 @@ function(nmbake_label_tests)
     set_tests_properties(${name} PROPERTIES LABELS ${labels})
   endforeach()
 endfunction()
+
+# A GoogleTest program of its own (the viewer's): one ctest entry running all its tests
+# (NMBAKE_TEST_PER_PROGRAM, one process start), or one per test. nmbake_gtest_program(TARGET
+# TIMEOUT LABEL [COST N]).
+function(nmbake_gtest_program target timeout label)
+  cmake_parse_arguments(ARG "" "COST" "" ${ARGN})
+  set(cost)
+  if(ARG_COST)
+    set(cost COST ${ARG_COST})
+  endif()
+  if(NMBAKE_TEST_PER_PROGRAM)
+    add_test(NAME ${target} COMMAND ${target})
+    set_tests_properties(${target} PROPERTIES TIMEOUT ${timeout} LABELS ${label} ${cost})
+  else()
+    gtest_discover_tests(${target} DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT ${timeout} LABELS ${label} ${cost})
+  endif()
+endfunction()

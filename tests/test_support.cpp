@@ -1,6 +1,8 @@
 #include "test_support.h"
 
+#include <fcntl.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -12,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include "cli/command.h"
 #include "core/rasterize.h"
 #include "core/tangent_frames.h"
 #include "io/mesh_io.h"
@@ -71,14 +74,98 @@ void write_file(const std::string& path, const std::string& bytes) {
   if (!out.flush()) throw std::runtime_error("cannot write " + path);
 }
 
+std::vector<std::string> shell_words(const std::string& line) {
+  std::vector<std::string> words;
+  std::string word;
+  bool in_word = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (c == ' ' || c == '\t' || c == '\n') {
+      if (in_word) words.push_back(word), word.clear(), in_word = false;
+      continue;
+    }
+    in_word = true;
+    if (c == '\'' || c == '"') {
+      const std::size_t end = line.find(c, i + 1);
+      if (end == std::string::npos) throw std::invalid_argument("shell_words: unclosed quote in: " + line);
+      const std::string quoted = line.substr(i + 1, end - i - 1);
+      if (c == '"' && quoted.find_first_of("$`\\") != std::string::npos)
+        throw std::invalid_argument("shell_words: $, ` or \\ inside double quotes in: " + line);
+      word += quoted;
+      i = end;
+    } else if (c == '\\' && i + 1 < line.size()) {
+      word += line[++i];
+    } else if (std::string("|&;<>()$`*?[]{}~#").find(c) != std::string::npos) {
+      throw std::invalid_argument(std::string("shell_words: unquoted '") + c + "' in: " + line);
+    } else {
+      word += c;
+    }
+  }
+  if (in_word) words.push_back(word);
+  return words;
+}
+
+namespace {
+
+// Points descriptor `fd` at `path` until destroyed, then back where it pointed before.
+class Redirect {
+ public:
+  Redirect(int fd, const std::string& path, int flags) : fd_(fd), saved_(::dup(fd)) {
+    const int file = ::open(path.c_str(), flags, 0644);
+    if (saved_ < 0 || file < 0) throw std::runtime_error("cannot redirect to " + path);
+    ::dup2(file, fd);
+    ::close(file);
+  }
+  ~Redirect() {
+    ::dup2(saved_, fd_);
+    ::close(saved_);
+  }
+  Redirect(const Redirect&) = delete;
+  Redirect& operator=(const Redirect&) = delete;
+
+ private:
+  int fd_, saved_;
+};
+
+}  // namespace
+
+int run_nmbake_in(const std::vector<std::string>& words, const std::string& dir, const std::string& out_name,
+                  const std::string& err_name) {
+  std::vector<std::string> args{"nmbake"};
+  args.insert(args.end(), words.begin(), words.end());
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  std::fflush(stdout);
+  std::fflush(stderr);
+  const std::filesystem::path cwd = std::filesystem::current_path();
+  std::filesystem::current_path(dir);
+  int code = -1;
+  {
+    const Redirect in(0, "/dev/null", O_RDONLY);
+    const Redirect out(1, out_name, O_WRONLY | O_CREAT | O_TRUNC);
+    const Redirect err(2, err_name, O_WRONLY | O_CREAT | O_TRUNC);
+    code = nmbake_command(int(args.size()), argv.data());
+    std::fflush(stdout);
+    std::fflush(stderr);
+  }
+  std::filesystem::current_path(cwd);
+  return code;
+}
+
 CliRun run_nmbake(const std::string& args, const std::string& prefix, const std::string& dir) {
   CliRun r;
   r.dir = dir.empty() ? scratch_dir() : dir;
   std::filesystem::remove(r.dir + "/r.json");
-  const std::string exe = std::string(NMBAKE_BINARY_DIR) + "/baker/nmbake";
-  const std::string cmd = "cd '" + r.dir + "' && " + prefix + " '" + exe + "' " + args + " >out.txt 2>err.txt";
-  const int status = std::system(("bash -c \"" + cmd + "\"").c_str());
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  const char* process = std::getenv("NMBAKE_TEST_PROCESS");
+  if (prefix.empty() && !(process && std::string(process) == "1")) {
+    r.code = run_nmbake_in(shell_words(args), r.dir);
+  } else {
+    const std::string exe = std::string(NMBAKE_BINARY_DIR) + "/baker/nmbake";
+    const std::string cmd = "cd '" + r.dir + "' && " + prefix + " '" + exe + "' " + args + " >out.txt 2>err.txt";
+    const int status = std::system(("bash -c \"" + cmd + "\"").c_str());
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
   r.out = read_file(r.dir + "/out.txt");
   r.err = read_file(r.dir + "/err.txt");
   if (exists(r.dir + "/r.json")) r.report = nlohmann::json::parse(read_file(r.dir + "/r.json"));

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
@@ -41,7 +42,7 @@ void write_file(const std::string& path, const std::string& bytes);  // created 
 // A fresh empty folder under the build tree, named after the running test.
 std::string scratch_dir();
 
-// One run of the nmbake binary: its exit code (-1 when it did not exit normally), stdout, stderr,
+// One run of the nmbake command: its exit code (-1 when it did not exit normally), stdout, stderr,
 // the folder it ran in, and the report it wrote to r.json there (null when it wrote none).
 struct CliRun {
   int code = -1;
@@ -49,11 +50,26 @@ struct CliRun {
   nlohmann::json report;
 };
 
-// Runs <build>/baker/nmbake with `args` (shell words; relative paths are relative to the folder)
-// in `dir`, or in a fresh scratch_dir() when `dir` is empty, after the shell command `prefix`
-// (e.g. "ulimit -v 3000000 &&"). stdout and stderr go to out.txt and err.txt in the folder; an
-// r.json left there by an earlier run is removed first. Prints the command and what it printed.
+// Runs the nmbake command with `args` (shell words; relative paths are relative to the folder) in
+// `dir`, or in a fresh scratch_dir() when `dir` is empty. stdout and stderr go to out.txt and
+// err.txt in the folder, stdin reads /dev/null; an r.json left there by an earlier run is removed
+// first. Prints the command and what it printed.
+// Without a `prefix` the command runs in this process (cli/command.h: the code of the binary's
+// main(), without a process start's ~0.4 s of loading OpenImageIO's libraries); with one (a shell
+// command such as "ulimit -v 3000000 &&"), or with NMBAKE_TEST_PROCESS=1 in the environment, the
+// binary <build>/baker/nmbake runs in a shell. The cli.nmbake.* tests run the binary too.
 CliRun run_nmbake(const std::string& args, const std::string& prefix = "", const std::string& dir = "");
+
+// Runs the nmbake command (cli/command.h) in this process with the arguments `words` (without the
+// program's name), in folder `dir`: stdin reads /dev/null, stdout and stderr go to the files
+// `out_name` and `err_name` there; the working directory and the three descriptors are restored
+// after. Returns the exit status.
+int run_nmbake_in(const std::vector<std::string>& words, const std::string& dir, const std::string& out_name = "out.txt",
+                  const std::string& err_name = "err.txt");
+
+// The words of a command line as bash splits them: single and double quotes and backslashes; an
+// unquoted shell operator, glob or $ throws std::invalid_argument (nothing here runs a shell).
+std::vector<std::string> shell_words(const std::string& line);
 
 // Whether `what` occurs in `s`.
 bool contains(const std::string& s, const std::string& what);

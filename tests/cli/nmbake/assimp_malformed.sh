@@ -5,7 +5,7 @@
 # (`nmbake FILE FILE`) and as the high-poly behind the bundled torus low-poly.
 #   assimp_malformed.sh NMBAKE REPO SHARED_DATA WORK [SHARD SHARDS]
 # With SHARD and SHARDS only the cases k (from 0) with k % SHARDS == SHARD run.
-# Each run has 10 s (timeout) and must
+# Each run has 10 s and must
 #   - exit 2 with exactly one stderr line, "error: ..." naming the file (its base name), nothing
 #     on stdout, and nothing left in the output folder (neither the map nor a temporary), or
 #   - for a file that is valid (the list says why), exit 0 with the map written and no temporary;
@@ -14,7 +14,8 @@
 #     either code (checked as above for that code) and is printed as a known gap; a gap that now
 #     exits 2 fails the script, so that the list is updated.
 # A crash (exit >= 128), a hang (124, 137) or any other code fails. Exit 0 when every run passes,
-# 1 when one fails, 77 (skipped) when the shared data is absent.
+# 1 when one fails, 77 (skipped) when the shared data is absent. The runs go through
+# ../run_cases.sh: under ctest all in one process (nmbake_cases), else one nmbake each.
 set -u
 nmbake=$(realpath "$1") repo=$(realpath "$2") shared=$3 work=$4 shard=${5:-0} shards=${6:-1}
 assimp=$shared/meshes/assimp
@@ -103,22 +104,29 @@ cases=$(
 EOF
 )
 
-# One run: check_run ROLE EXPECTED FILE DIR ARGS... ; prints one line, returns 1 on a failure.
-check_run() {
-  local role=$1 expect=$2 file=$3 dir=$4
-  shift 4
-  mkdir -p "$dir/out"
-  local start got ms name problems=() note=""
-  start=$(date +%s%N)
+source "$(dirname "$0")/../run_cases.sh"
+cases_file=$work/cases.txt
+: >"$cases_file"
+
+# One run: queue_run DIR ARGS... adds it to the cases; check_run ROLE EXPECTED FILE DIR checks it
+# after run_cases: prints one line, returns 1 on a failure.
+queue_run() {
+  local dir=$1
+  shift
+  mkdir -p "$dir"
   # Reading each file is the point: a model unrelated to the sample, or with every face on the whole
   # UV square, is not refused as a mistaken pair here (test_pair_checks covers that).
-  (cd "$dir/out" && timeout -k 2 "$limit" "$nmbake" "$@" -o out.png --size 64 --allow-mismatch --allow-overlap \
-     >../stdout.txt 2>../stderr.txt </dev/null)
-  got=$?
-  ms=$((($(date +%s%N) - start) / 1000000))
+  cases=$cases_file case_line "$(realpath "$dir")" "$@" -o out.png --size 64 --allow-mismatch --allow-overlap
+}
+check_run() {
+  local role=$1 expect=$2 file=$3 dir=$4
+  local got ms name problems=() note=""
+  case_result "$dir"
   name=$(basename "$file")
-  if [ "$got" = 124 ] || [ "$got" = 137 ]; then
-    problems+=("hung: killed after ${limit}s")
+  if [ "$got" = none ]; then
+    problems+=("never ended (crash or hang of the run before)")
+  elif [ "$got" = 124 ] || [ "$got" = 137 ] || [ "$ms" -gt $((limit * 1000)) ]; then
+    problems+=("hung: over ${limit}s")
   elif [ "$got" -ge 128 ]; then
     problems+=("crashed: exit $got")
   elif [ "$expect" = gap ]; then
@@ -129,10 +137,10 @@ check_run() {
     problems+=("exit code $got, expected $expect")
   fi
   local left
-  left=$(cd "$dir/out" && ls -A | grep -v -x out.png)
+  left=$(cd "$dir" && ls -A | grep -v -x -e out.png -e stdout.txt -e stderr.txt -e code.txt)
   [ -z "$left" ] || problems+=("left in the output folder: $left")
   if [ "$got" = 0 ]; then
-    [ -s "$dir/out/out.png" ] || problems+=("no map written")
+    [ -s "$dir/out.png" ] || problems+=("no map written")
   else
     local lines first
     lines=$(wc -l <"$dir/stderr.txt")
@@ -141,7 +149,7 @@ check_run() {
     case "$first" in "error: "*) ;; *) problems+=("stderr does not start with 'error: '") ;; esac
     case "$first" in *"$name"*) ;; *) problems+=("the error does not name $name") ;; esac
     [ ! -s "$dir/stdout.txt" ] || problems+=("printed on stdout")
-    [ ! -e "$dir/out/out.png" ] || problems+=("a map was written")
+    [ ! -e "$dir/out.png" ] || problems+=("a map was written")
   fi
   if [ ${#problems[@]} -eq 0 ]; then
     [ "$got" = 0 ] || note=$(head -n 1 "$dir/stderr.txt" | cut -c1-200)
@@ -152,11 +160,12 @@ check_run() {
     IFS=';'
     echo "${problems[*]}"
   )"
-  sed 's/^/     stderr: /' "$dir/stderr.txt" | head -n 5
+  sed 's/^/     stderr: /' "$dir/stderr.txt" 2>/dev/null | head -n 5
   return 1
 }
 
 failed=0 ran=0 missing=0 n=0
+checks=()
 while read -r self high path reason; do
   n=$((n + 1))
   [ $(((n - 1) % shards)) = "$shard" ] || continue
@@ -166,9 +175,15 @@ while read -r self high path reason; do
     missing=$((missing + 1))
     continue
   fi
-  check_run self "$self" "$file" "$work/case$n.self" "$file" "$file" || failed=$((failed + 1))
-  check_run high "$high" "$file" "$work/case$n.high" "$low_sample" "$file" || failed=$((failed + 1))
-  ran=$((ran + 2))
+  queue_run "$work/case$n.self" "$file" "$file"
+  queue_run "$work/case$n.high" "$low_sample" "$file"
+  checks+=("self $self $work/case$n.self $file" "high $high $work/case$n.high $file")
 done <<<"$cases"
+run_cases "$nmbake" "$cases_file" "$limit"
+for c in "${checks[@]}"; do
+  read -r role expect dir file <<<"$c"
+  check_run "$role" "$expect" "$file" "$dir" || failed=$((failed + 1))
+  ran=$((ran + 1))
+done
 echo "assimp_malformed: $ran runs, $failed failed, $missing files missing"
 [ "$failed" = 0 ] && [ "$missing" = 0 ]

@@ -13,7 +13,8 @@
 # A failing case must print exactly one line on stderr, "error: ..." naming the file (its base
 # name), contain TEXT, and leave nothing behind in its work folder (neither the map, the miss mask
 # nor the report, nor a temporary); a successful one must write all three. Every case must end within the time limit
-# (NMBAKE_HOSTILE_SECONDS, default 20; a hang is killed by timeout and fails).
+# (NMBAKE_HOSTILE_SECONDS, default 20; a hang is killed by timeout and fails). The cases run
+# through ../run_cases.sh: under ctest all in one process (nmbake_cases), else one nmbake each.
 # Exit 0 when every case passes, 1 when one fails, 77 (skipped) when the list only names shared
 # files and ../shared is absent.
 set -u
@@ -23,7 +24,11 @@ limit=${NMBAKE_HOSTILE_SECONDS:-20}
 low_sample=$repo/data/sample/torus_low.obj
 high_sample=$repo/data/sample/torus_high.ply
 rm -rf "$work" && mkdir -p "$work"
+source "$(dirname "$0")/../run_cases.sh"
+cases=$work/cases.txt
+: >"$cases"
 failed=0 ran=0 skipped=0 n=0
+roles=() codes=() paths=() texts=() files=() dirs=()
 while read -r role code path text; do
   case "$role" in ''|\#*) continue ;; esac
   n=$((n + 1))
@@ -34,20 +39,23 @@ while read -r role code path text; do
     *) file=$repo/$path ;;
   esac
   if [ "${path#shared:}" != "$path" ] && [ ! -e "$file" ]; then skipped=$((skipped + 1)); continue; fi
-  dir=$work/case$n
+  dir=$(realpath -m "$work/case$n")
   mkdir -p "$dir"
   if [ "$role" = low ]; then args=("$file" "$high_sample"); else args=("$low_sample" "$file"); fi
   # The cases are about reading each file: a file unrelated to the sample is not a mistaken pair
   # here (the pair's checks have their own tests, test_pair_checks).
-  args+=(--allow-mismatch --allow-overlap)
-  start=$(date +%s%N)
-  (cd "$dir" && timeout -k 5 "$limit" "$nmbake" "${args[@]}" -o map.png --size 32 --padding 2 --miss-mask miss.png --report report.json \
-     >stdout.txt 2>stderr.txt </dev/null)
-  got=$?
-  ms=$(( ($(date +%s%N) - start) / 1000000 ))
+  case_line "$dir" "${args[@]}" --allow-mismatch --allow-overlap -o map.png --size 32 --padding 2 --miss-mask miss.png \
+    --report report.json
+  roles+=("$role") codes+=("$code") paths+=("$path") texts+=("$text") files+=("$file") dirs+=("$dir")
+done <"$list"
+run_cases "$nmbake" "$cases" "$limit"
+for k in "${!dirs[@]}"; do
+  role=${roles[k]} code=${codes[k]} path=${paths[k]} text=${texts[k]} file=${files[k]} dir=${dirs[k]}
+  case_result "$dir"
   ran=$((ran + 1))
   problems=()
-  [ "$got" = 124 ] || [ "$got" = 137 ] && problems+=("hung: killed after ${limit}s")
+  [ "$got" = none ] && problems+=("never ended (crash or hang of the run before)")
+  [ "$got" = 124 ] || [ "$got" = 137 ] || [ "$ms" -gt $((limit * 1000)) ] && problems+=("hung: over ${limit}s")
   [ "$got" = "$code" ] || problems+=("exit code $got, expected $code")
   name=$(basename "$file")
   if [ "$code" = 0 ]; then
@@ -60,7 +68,7 @@ while read -r role code path text; do
     case "$first" in "error: "*) ;; *) problems+=("stderr does not start with 'error: '") ;; esac
     case "$first" in *"$name"*) ;; *) problems+=("error does not name $name") ;; esac
     case "$first" in *"$text"*) ;; *) problems+=("error lacks: $text") ;; esac
-    left=$(cd "$dir" && ls -A | grep -v -e '^stderr.txt$' -e '^stdout.txt$' || true)
+    left=$(cd "$dir" && ls -A | grep -v -e '^stderr.txt$' -e '^stdout.txt$' -e '^code.txt$' || true)
     [ -z "$left" ] || problems+=("files left behind: $left")
   fi
   if [ ${#problems[@]} -eq 0 ]; then
@@ -68,9 +76,9 @@ while read -r role code path text; do
   else
     failed=$((failed + 1))
     printf 'FAIL %-5s %s (%s ms): %s\n' "$role" "$path" "$ms" "$(IFS=';'; echo "${problems[*]}")"
-    sed 's/^/     stderr: /' "$dir/stderr.txt" | head -n 5
+    sed 's/^/     stderr: /' "$dir/stderr.txt" 2>/dev/null | head -n 5
   fi
-done <"$list"
+done
 echo "hostile: $ran cases run, $failed failed, $skipped skipped (../shared absent)"
 if [ "$ran" = 0 ] && [ "$skipped" -gt 0 ]; then exit 77; fi
 [ "$failed" = 0 ]
