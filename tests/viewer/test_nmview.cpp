@@ -28,6 +28,7 @@
 #include "io/image_io.h"
 #include "io/mesh_io.h"
 #include "scene_maker.h"
+#include "tool_run.h"
 #include "test_support.h"
 
 namespace {
@@ -35,40 +36,11 @@ namespace {
 namespace fs = std::filesystem;
 using nmbake::test::scratch_dir;
 
-struct Result {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void headless_environment() {
-  unsetenv("DISPLAY");
-  unsetenv("WAYLAND_DISPLAY");
-  setenv("LIBGL_ALWAYS_SOFTWARE", "1", 1);
-}
+using Result = nmview::test::ToolRun;
+using nmview::test::quote;
 
 Result run(const std::string& dir, const std::string& program, const std::string& args) {
-  headless_environment();
-  const std::string out = dir + "/stdout.txt", err = dir + "/stderr.txt";
-  const std::string command = quote(program) + " " + args + " >" + quote(out) + " 2>" + quote(err) + " </dev/null";
-  int status = std::system(command.c_str());
-  Result r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
+  return nmview::test::run_tool(dir, program, args);
 }
 
 Result nmview(const std::string& dir, const std::string& args) { return run(dir, NMVIEW_EXE, args); }

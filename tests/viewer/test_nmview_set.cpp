@@ -25,6 +25,7 @@
 #include "interactive.h"
 #include "io/image_io.h"
 #include "test_support.h"
+#include "tool_run.h"
 #include "texture_set.h"
 #include "view.h"
 
@@ -39,30 +40,10 @@ using nmbake::test::write_file;
 
 constexpr int kPane = 128;  // screenshots are 2 panes of kPane x kPane
 
-struct Result {
-  int exit_code = -1;
-  std::string out, err;
-};
+using Result = nmview::test::ToolRun;
+using nmview::test::quote;
 
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-Result nmview(const std::string& dir, const std::string& args) {
-  unsetenv("DISPLAY");
-  unsetenv("WAYLAND_DISPLAY");
-  setenv("LIBGL_ALWAYS_SOFTWARE", "1", 1);
-  const std::string out = dir + "/stdout.txt", err = dir + "/stderr.txt";
-  const std::string command = quote(NMVIEW_EXE) + " " + args + " >" + quote(out) + " 2>" + quote(err) + " </dev/null";
-  const int status = std::system(command.c_str());
-  Result r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = read_file(out);
-  r.err = read_file(err);
-  return r;
-}
+Result nmview(const std::string& dir, const std::string& args) { return nmview::test::run_tool(dir, NMVIEW_EXE, args); }
 
 // The plane as low- and high-poly (the same file twice is fine for the viewer).
 std::string write_plane(const std::string& dir) {

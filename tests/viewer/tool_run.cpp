@@ -1,0 +1,31 @@
+#include "tool_run.h"
+
+#include <sys/wait.h>
+
+#include <cstdlib>
+
+#include "test_support.h"
+
+namespace nmview::test {
+
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+ToolRun run_tool(const std::string& dir, const std::string& program, const std::string& args) {
+  unsetenv("DISPLAY");
+  unsetenv("WAYLAND_DISPLAY");
+  setenv("LIBGL_ALWAYS_SOFTWARE", "1", 1);
+  const std::string out = dir + "/stdout.txt", err = dir + "/stderr.txt";
+  const std::string command = quote(program) + " " + args + " >" + quote(out) + " 2>" + quote(err) + " </dev/null";
+  const int status = std::system(command.c_str());
+  ToolRun r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = nmbake::test::read_file(out);
+  r.err = nmbake::test::read_file(err);
+  return r;
+}
+
+}  // namespace nmview::test
