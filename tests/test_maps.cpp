@@ -312,7 +312,8 @@ TEST(MapsCurvature, PlaneSphereAndTheInsideOfACylinder) {
     const Image& c = baked(inside, MapKind::curvature).image;
     for (int y = 16; y < 48; ++y)
       for (int x = 0; x < 64; ++x)
-        EXPECT_NEAR(c.pixels[std::size_t(y) * 64 + std::size_t(x)], 0.5 - 0.125, 0.01) << x << "," << y << " smoothing " << smoothing;
+        EXPECT_NEAR(c.pixels[std::size_t(y) * 64 + std::size_t(x)], 0.5 - 0.125, 0.01)
+            << x << "," << y << " smoothing " << smoothing;
   }
 }
 
