@@ -233,11 +233,8 @@ MapDiffStats compare_maps(const Image& a, const Image& b_in, const MapDiffOption
   s.max = tally.max;
   s.worst_x = tally.worst_x, s.worst_y = tally.worst_y;
   if (!tally.values.empty()) {
-    const double n = static_cast<double>(tally.values.size());
-    s.mean = tally.sum / n;
-    s.rms = std::sqrt(tally.sum_sq / n);
-    s.p95 = percentile(tally.values, 0.95);
-    s.p99 = percentile(tally.values, 0.99);
+    const DiffTally::Summary m = tally.summary();
+    s.mean = m.mean, s.rms = m.rms, s.p95 = m.p95, s.p99 = m.p99;
   }
   if (s.texels_compared > 0) s.share_differing = double(s.texels_differing) / double(s.texels_compared);
   const MapTolerances& t = options.tolerances;

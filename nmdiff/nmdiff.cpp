@@ -171,12 +171,10 @@ DiffStats compare_normal_maps(const Image& a, const Image& b_in, const DiffOptio
   s.worst_x = tally.worst_x, s.worst_y = tally.worst_y;
   if (!tally.values.empty()) {
     const double n = static_cast<double>(tally.values.size());
-    s.mean_deg = tally.sum / n;
-    s.rms_deg = std::sqrt(tally.sum_sq / n);
     s.over_1deg = static_cast<double>(over1) / n;
     s.over_5deg = static_cast<double>(over5) / n;
-    s.p95_deg = percentile(tally.values, 0.95);
-    s.p99_deg = percentile(tally.values, 0.99);
+    const DiffTally::Summary m = tally.summary();
+    s.mean_deg = m.mean, s.rms_deg = m.rms, s.p95_deg = m.p95, s.p99_deg = m.p99;
   }
   const Tolerances& t = options.tolerances;
   // A map holding NaN is broken whatever the tolerances.

@@ -33,6 +33,17 @@ void DiffTally::add(std::size_t i, int width, double d) {
   values.push_back(static_cast<float>(d));
 }
 
+DiffTally::Summary DiffTally::summary() {
+  Summary m;
+  if (values.empty()) return m;
+  const double n = static_cast<double>(values.size());
+  m.mean = sum / n;
+  m.rms = std::sqrt(sum_sq / n);
+  m.p95 = percentile(values, 0.95);
+  m.p99 = percentile(values, 0.99);
+  return m;
+}
+
 double percentile(std::vector<float>& values, double p) {
   if (values.empty()) return 0.0;
   const std::size_t rank = static_cast<std::size_t>(std::ceil(p * static_cast<double>(values.size())));

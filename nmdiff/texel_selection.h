@@ -42,6 +42,13 @@ struct DiffTally {
   int worst_x = -1, worst_y = -1;
   // Texel `i` of a map `width` texels wide differs by `d` (>= 0, in the comparison's units).
   void add(std::size_t i, int width, double d);
+
+  // Mean, root mean square and the 95th and 99th nearest-rank percentiles of the values (values
+  // reordered); all 0 when there are none.
+  struct Summary {
+    double mean = 0.0, rms = 0.0, p95 = 0.0, p99 = 0.0;
+  };
+  Summary summary();
 };
 
 // Nearest-rank percentile (p in [0, 1]) of unsorted values, reordered in place; 0 when empty.
