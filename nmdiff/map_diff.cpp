@@ -13,8 +13,6 @@
 namespace nmbake::diff {
 namespace {
 
-std::string size_text(const Image& m) { return std::to_string(m.width) + "x" + std::to_string(m.height); }
-
 // Parses exactly `count` finite numbers separated by `sep` (surrounding spaces allowed).
 bool parse_numbers(const std::string& text, char sep, int count, double* out) {
   const char* p = text.c_str();
@@ -164,16 +162,11 @@ MapDiffStats compare_maps(const Image& a, const Image& b_in, const MapDiffOption
                        with_article(map_name(kind)) + " map needs " + (needed == 1 ? "one" : "RGB"));
   }
   const bool resized = a.width != b_in.width || a.height != b_in.height;
-  if (resized && options.resample == Resample::none)
-    throw InputError("sizes differ: " + size_text(a) + " vs " + size_text(b_in) + " (use --resample nearest|bilinear|box)");
   // An ID colour is never blended: the nearest texel whatever mode was asked.
   const Resample mode = family == MapFamily::id ? Resample::nearest : options.resample;
-  const Image resampled = resized ? resample_image(b_in, a.width, a.height, mode) : Image();
-  const Image& b = resized ? resampled : b_in;
+  Image resampled;
+  const Image& b = comparable_b(a, b_in, options.resample, mode, options.mask, resampled);
   const std::size_t texels = static_cast<std::size_t>(a.width) * a.height;
-  if (!options.mask.empty() && options.mask.size() != texels)
-    throw InputError("mask has " + std::to_string(options.mask.size()) + " texels, the map " + size_text(a) + " has " +
-                     std::to_string(texels));
 
   // A map without its range (e.g. re-saved by an editor) is taken to share the other's.
   const MapDecoding& given_a = options.decoding_a;

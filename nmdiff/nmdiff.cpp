@@ -111,18 +111,26 @@ std::vector<std::uint8_t> uv_layout_mask(const Mesh& low, int width, int height)
   return mask;
 }
 
+const Image& comparable_b(const Image& a, const Image& b, Resample asked, Resample mode, const std::vector<std::uint8_t>& mask,
+                          Image& storage) {
+  const bool resized = a.width != b.width || a.height != b.height;
+  if (resized && asked == Resample::none)
+    throw InputError("sizes differ: " + size_text(a) + " vs " + size_text(b) + " (use --resample nearest|bilinear|box)");
+  const std::size_t texels = static_cast<std::size_t>(a.width) * a.height;
+  if (!mask.empty() && mask.size() != texels)
+    throw InputError("mask has " + std::to_string(mask.size()) + " texels, the map " + size_text(a) + " has " +
+                     std::to_string(texels));
+  if (!resized) return b;
+  storage = resample_image(b, a.width, a.height, mode);
+  return storage;
+}
+
 DiffStats compare_normal_maps(const Image& a, const Image& b_in, const DiffOptions& options, AngleField* field) {
   check_normal_map(a, "map A");
   check_normal_map(b_in, "map B");
-  if ((a.width != b_in.width || a.height != b_in.height) && options.resample == Resample::none)
-    throw InputError("sizes differ: " + size_text(a) + " vs " + size_text(b_in) + " (use --resample nearest|bilinear|box)");
-  const Image resampled =
-      (a.width != b_in.width || a.height != b_in.height) ? resample_image(b_in, a.width, a.height, options.resample) : Image();
-  const Image& b = resampled.pixels.empty() ? b_in : resampled;
+  Image resampled;
+  const Image& b = comparable_b(a, b_in, options.resample, options.resample, options.mask, resampled);
   const std::size_t texels = static_cast<std::size_t>(a.width) * a.height;
-  if (!options.mask.empty() && options.mask.size() != texels)
-    throw InputError("mask has " + std::to_string(options.mask.size()) + " texels, the map " + size_text(a) + " has " +
-                     std::to_string(texels));
 
   DiffStats s;
   s.width = a.width;

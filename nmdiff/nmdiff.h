@@ -85,6 +85,12 @@ bool decode_normal(const float* rgb, GreenAxis green, double n[3]);
 // `src` resampled onto a width x height grid (all channels). Resample::none requires equal sizes.
 Image resample_image(const Image& src, int width, int height, Resample mode);
 
+// B at A's size, as both comparisons take it: `b` itself when the sizes agree, else `b` resampled
+// with `mode` into `storage`. Throws InputError when the sizes differ and `asked` (the user's
+// --resample) is Resample::none, or when `mask` is neither empty nor one byte per texel of A.
+const Image& comparable_b(const Image& a, const Image& b, Resample asked, Resample mode, const std::vector<std::uint8_t>& mask,
+                          Image& storage);
+
 // Texels of a width x height map covered by `low`'s UV layout (the baker's rasterizer: a texel
 // counts when its centre is inside a UV triangle). Throws InputError when `low` has no UVs.
 std::vector<std::uint8_t> uv_layout_mask(const Mesh& low, int width, int height);

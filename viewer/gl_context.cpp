@@ -13,8 +13,6 @@
 namespace nmview {
 namespace {
 
-[[noreturn]] void fail(const std::string& what) { throw nmbake::Error(nmbake::ExitCode::output, what); }
-
 bool has_extension(const char* list, const char* name) {
   if (!list) return false;
   const std::size_t n = std::strlen(name);
@@ -101,8 +99,8 @@ HeadlessContext::HeadlessContext() {
   }
   if (tried.empty())
     tried = "no EGL surfaceless or device platform (client extensions: " + std::string(client ? client : "none") + ")";
-  fail("cannot create a headless OpenGL 3.3 context (" + tried +
-       "); install Mesa's EGL and DRI drivers (libegl-mesa0, libgl1-mesa-dri)");
+  throw nmbake::OutputError("cannot create a headless OpenGL 3.3 context (" + tried +
+                            "); install Mesa's EGL and DRI drivers (libegl-mesa0, libgl1-mesa-dri)");
 }
 
 HeadlessContext::~HeadlessContext() {
@@ -116,8 +114,8 @@ Window::Window(int width, int height, const std::string& title) {
   if (!glfwInit()) {
     const char* description = nullptr;
     glfwGetError(&description);
-    fail(std::string("cannot open a window (") + (description ? description : "GLFW init failed") +
-         "); use --screenshot FILE or --compare to render without a display");
+    throw nmbake::OutputError(std::string("cannot open a window (") + (description ? description : "GLFW init failed") +
+                              "); use --screenshot FILE or --compare to render without a display");
   }
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
@@ -128,7 +126,8 @@ Window::Window(int width, int height, const std::string& title) {
     const char* description = nullptr;
     glfwGetError(&description);
     glfwTerminate();
-    fail(std::string("cannot create an OpenGL 3.3 core window (") + (description ? description : "unknown") + ")");
+    throw nmbake::OutputError(std::string("cannot create an OpenGL 3.3 core window (") + (description ? description : "unknown") +
+                              ")");
   }
   glfwMakeContextCurrent(window_);
   glfwSwapInterval(1);

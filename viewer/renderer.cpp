@@ -14,8 +14,6 @@
 namespace nmview {
 namespace {
 
-[[noreturn]] void fail(const std::string& what) { throw nmbake::Error(nmbake::ExitCode::output, what); }
-
 GLuint compile(GLenum type, const std::string& source, const char* name) {
   GLuint shader = glCreateShader(type);
   const char* text = source.c_str();
@@ -27,7 +25,7 @@ GLuint compile(GLenum type, const std::string& source, const char* name) {
     char log[2048] = {};
     glGetShaderInfoLog(shader, sizeof(log), nullptr, log);
     glDeleteShader(shader);
-    fail(std::string("shader ") + name + " does not compile: " + log);
+    throw nmbake::OutputError(std::string("shader ") + name + " does not compile: " + log);
   }
   return shader;
 }
@@ -48,7 +46,7 @@ GLuint link(const char* vertex, const char* fragment, const char* name, bool lig
     char log[2048] = {};
     glGetProgramInfoLog(program, sizeof(log), nullptr, log);
     glDeleteProgram(program);
-    fail(std::string("shader program ") + name + " does not link: " + log);
+    throw nmbake::OutputError(std::string("shader program ") + name + " does not link: " + log);
   }
   return program;
 }
@@ -93,8 +91,9 @@ GLuint upload_map(const nmbake::Image& map, const char* name, bool exact) {
   GLint max_size = 0;
   glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
   if (map.width > max_size || map.height > max_size)
-    fail(std::string("the ") + name + " map is " + std::to_string(map.width) + "x" + std::to_string(map.height) +
-         ", larger than this OpenGL's texture limit " + std::to_string(max_size));
+    throw nmbake::OutputError(std::string("the ") + name + " map is " + std::to_string(map.width) + "x" +
+                              std::to_string(map.height) + ", larger than this OpenGL's texture limit " +
+                              std::to_string(max_size));
   const std::vector<float> rgb = display_rgb(map);
   GLuint texture = 0;
   glGenTextures(1, &texture);
@@ -129,7 +128,8 @@ Framebuffer::Framebuffer(int width, int height) {
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color_);
   bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  if (!complete) fail("cannot create a " + std::to_string(width) + "x" + std::to_string(height) + " framebuffer");
+  if (!complete)
+    throw nmbake::OutputError("cannot create a " + std::to_string(width) + "x" + std::to_string(height) + " framebuffer");
 }
 
 Framebuffer::~Framebuffer() {
@@ -179,7 +179,8 @@ Renderer::Renderer(const LowVertices& low, const HighVertices& high, const nmbak
   samples_ = std::clamp(max_samples, 1, 4);
   if (GLenum error = glGetError(); error == GL_OUT_OF_MEMORY)
     throw nmbake::ResourceError("out of memory uploading the meshes to OpenGL (GL_OUT_OF_MEMORY)");
-  else if (error != GL_NO_ERROR) fail("OpenGL error " + std::to_string(error) + " while uploading the meshes");
+  else if (error != GL_NO_ERROR)
+    throw nmbake::OutputError("OpenGL error " + std::to_string(error) + " while uploading the meshes");
 }
 
 void Renderer::add_set_map(nmbake::MapKind kind, const nmbake::Image& image) {
@@ -191,7 +192,8 @@ void Renderer::add_set_map(nmbake::MapKind kind, const nmbake::Image& image) {
     throw nmbake::ResourceError(std::string("out of memory uploading the ") + nmbake::map_name(kind) +
                                 " map to OpenGL (GL_OUT_OF_MEMORY)");
   else if (error != GL_NO_ERROR)
-    fail("OpenGL error " + std::to_string(error) + " while uploading the " + nmbake::map_name(kind) + " map");
+    throw nmbake::OutputError("OpenGL error " + std::to_string(error) + " while uploading the " + nmbake::map_name(kind) +
+                              " map");
 }
 
 bool Renderer::has_map(nmbake::MapKind kind) const { return kind == nmbake::MapKind::normal || set_textures_[int(kind)] != 0; }
@@ -248,7 +250,8 @@ void Renderer::ensure_pane_size(int width, int height) {
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, p.msaa_color);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, p.msaa_depth);
     if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-      fail("cannot create a " + std::to_string(width) + "x" + std::to_string(height) + " multisampled framebuffer");
+      throw nmbake::OutputError("cannot create a " + std::to_string(width) + "x" + std::to_string(height) +
+                                " multisampled framebuffer");
 
     glBindTexture(GL_TEXTURE_2D, p.texture);
     glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
@@ -257,7 +260,7 @@ void Renderer::ensure_pane_size(int width, int height) {
     glBindFramebuffer(GL_FRAMEBUFFER, p.fbo);
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, p.texture, 0);
     if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-      fail("cannot create a " + std::to_string(width) + "x" + std::to_string(height) + " framebuffer");
+      throw nmbake::OutputError("cannot create a " + std::to_string(width) + "x" + std::to_string(height) + " framebuffer");
   }
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
