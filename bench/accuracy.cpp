@@ -39,11 +39,8 @@
 using namespace nmbake;
 using namespace nmbake::bench;
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
 
 namespace {
-
-double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 struct Args {
   bool quick = false;
@@ -145,9 +142,9 @@ Args parse_args(int argc, char** argv) {
 // RMSE from the last "psnr=... rmse=... within2=..." line, or < 0 when nmview failed.
 double appearance_rmse(const std::string& nmview, const std::string& low, const std::string& map, const std::string& high) {
   // nmview --compare writes no image without --screenshot: the working folder does not matter.
-  const std::string out = run_capture(shell_quote(nmview) + " " + shell_quote(fs::absolute(low).string()) + " " +
-                                      shell_quote(fs::absolute(map).string()) + " " + shell_quote(fs::absolute(high).string()) +
-                                      " --compare --size 800x400 2>/dev/null");
+  const std::string out = command_output(shell_quote(nmview) + " " + shell_quote(fs::absolute(low).string()) + " " +
+                                         shell_quote(fs::absolute(map).string()) + " " +
+                                         shell_quote(fs::absolute(high).string()) + " --compare --size 800x400 2>/dev/null");
   const auto pos = out.rfind("rmse=");
   if (pos == std::string::npos || out.rfind("psnr=") == std::string::npos) return -1.0;
   return std::atof(out.c_str() + pos + 5);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "bench_support.h"
 #include "core/parallel.h"
 #include "core/rasterize.h"
 
@@ -10,7 +11,6 @@ namespace nmbake::bench {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = 180.0 / kPi;
 
 double angle_deg(const glm::dvec3& a, const glm::dvec3& b) {

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <fstream>
 
+#include "bench_support.h"
 #include "pipeline/bake.h"
 #include "core/errors.h"
 #include "hard_asset_answers.h"
@@ -14,16 +15,6 @@
 namespace nmbake::bench {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-std::string fmt(const char* f, double v) {
-  char b[64];
-  std::snprintf(b, sizeof b, f, v);
-  return b;
-}
 
 // The low-poly with every position moved `push` along its ray normal: a uniformly inflated cage.
 Mesh push_cage(const Mesh& low, double push) {

@@ -14,22 +14,6 @@ namespace nmbake::bench {
 
 namespace fs = std::filesystem;
 
-std::string fmt(const char* f, double v) {
-  char b[64];
-  std::snprintf(b, sizeof b, f, v);
-  return b;
-}
-
-std::string run_capture(const std::string& cmd) {
-  std::string out;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return out;
-  char buf[4096];
-  for (std::size_t n; (n = fread(buf, 1, sizeof buf, p)) > 0;) out.append(buf, n);
-  pclose(p);
-  return out;
-}
-
 std::string shell_quote(const std::string& s) {
   std::string q = "'";
   for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
@@ -43,16 +27,9 @@ std::string cpu_model() {
   return "unknown";
 }
 
-std::string load_average() {
-  std::ifstream in("/proc/loadavg");
-  std::string a, b, c;
-  in >> a >> b >> c;
-  return in ? a + " " + b + " " + c : std::string("unknown");
-}
-
 std::string git_commit() {
-  std::string c = run_capture("git -C " + shell_quote(NMBAKE_SOURCE_DIR) + " describe --always --dirty --abbrev=12 2>/dev/null");
-  while (!c.empty() && (c.back() == '\n' || c.back() == '\r')) c.pop_back();
+  const std::string c =
+      command_output("git -C " + shell_quote(NMBAKE_SOURCE_DIR) + " describe --always --dirty --abbrev=12 2>/dev/null");
   return c.empty() ? "unknown (not a git checkout)" : c;
 }
 

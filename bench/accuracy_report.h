@@ -10,6 +10,7 @@
 
 #include "accuracy_error.h"
 #include "accuracy_hard_assets.h"
+#include "bench_support.h"
 
 namespace nmbake::bench {
 
@@ -50,17 +51,12 @@ struct RunInfo {
   bool nmview = false;        // appearance figures were measured
 };
 
-// printf-style formatting of one number.
-std::string fmt(const char* f, double v);
-
-// Output of a shell command (stdout), empty when it cannot run; and `s` quoted for the shell.
-std::string run_capture(const std::string& cmd);
+// `s` quoted for the shell. fmt, command_output and load_average: bench_support.h.
 std::string shell_quote(const std::string& s);
 
-std::string cpu_model();     // /proc/cpuinfo's model name, or "unknown"
-std::string load_average();  // the 1, 5 and 15 minute load averages, or "unknown"
-std::string git_commit();    // git describe of the source tree, or "unknown (not a git checkout)"
-std::string utc_now();       // "YYYY-MM-DD HH:MM UTC"
+std::string cpu_model();   // /proc/cpuinfo's model name, or "unknown"
+std::string git_commit();  // git describe of the source tree, or "unknown (not a git checkout)"
+std::string utc_now();     // "YYYY-MM-DD HH:MM UTC"
 
 // `out`/accuracy.csv (when there are rows), `out`/hard_assets.csv (when the hard assets ran),
 // `out`/accuracy.md or hard_assets.md, and `out`/accuracy.png drawn with the TTF `font`. Returns the

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <map>
 
+#include "bench_support.h"
 #include "core/errors.h"
 #include "io/mesh_io.h"
 #include "procedural.h"
@@ -18,8 +19,6 @@ namespace nmbake::bench {
 namespace fs = std::filesystem;
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // A grid of nx x ny quads over [-1,1]^2 at z = height(x,y) with normals normal(x,y); UVs onto [0,1]^2.
 Mesh make_height_field(int nx, int ny, const std::function<double(double, double)>& height,

@@ -51,6 +51,23 @@ struct Scenes {
   Mesh t3_low, t3_high;                         // torus_s3, loaded once
 };
 
+// Blender's side of the whole-command comparisons (bench_blender.cpp, bench_maps.cpp): its bake
+// script (bench/blender_bake.py) and the cage extrusion both bakers get, scene units (the script's
+// top comment).
+std::string blender_script();
+constexpr const char* kBlenderExtrusion = "0.05";
+
+// One side of a whole-command comparison: its figures over the rounds.
+struct Side {
+  std::vector<double> wall, rss;  // seconds, MiB per round
+  std::string failed;             // why it stopped, empty while it runs
+  bool ok() const { return failed.empty() && !wall.empty(); }
+};
+
+// Runs one round of `command` for `side` (none once it has failed; `log` takes its output); on a failure copies the log into
+// the scratch folder (the run's folder is removed), says why in side.failed and returns false.
+bool run_side(const BenchRun& run, Side& side, const std::vector<std::string>& command, const std::string& log);
+
 const char* verdict(bool met);  // "MET" or "NOT MET"
 void flush();                   // stdout, so a long run shows each row as it is measured
 

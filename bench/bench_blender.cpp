@@ -37,8 +37,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr const char* kScript = NMBAKE_SOURCE_DIR "/bench/blender_bake.py";
-constexpr const char* kExtrusion = "0.05";  // Blender's cage extrusion, scene units (blender_bake.py's top comment)
 constexpr const char* kMeasured = "bench-measured:";
 
 // The helper is this very program, so it needs no path of its own.
@@ -61,34 +59,12 @@ std::vector<char*> c_argv(const std::vector<std::string>& args) {
   return v;
 }
 
-// One side's figures over the rounds.
-struct Side {
-  std::vector<double> wall, rss;  // seconds, MiB per round
-  std::string failed;             // why it stopped, empty while it runs
-  bool ok() const { return failed.empty() && !wall.empty(); }
-};
-
 // Both sides of one scene, and Blender's own split per round (seconds).
 struct Pair {
   std::string scene;
   Side nm, bl;
   std::vector<double> load, bake, save;
 };
-
-// Runs one round of `side`; on failure keeps its log in the scratch folder (the run's folder is removed).
-bool run_side(const BenchRun& run, Side& side, const std::vector<std::string>& command, const std::string& log) {
-  const Measured m = measure(command, log);
-  if (m.ok) {
-    side.wall.push_back(m.wall);
-    side.rss.push_back(m.rss_mib);
-    return true;
-  }
-  const std::string kept = run.args.scratch + "/" + fs::path(log).filename().string();
-  std::error_code ec;
-  fs::copy_file(log, kept, fs::copy_options::overwrite_existing, ec);
-  side.failed = m.why + "; log: " + (ec ? log : kept);
-  return false;
-}
 
 // Blender's "blender-bake: load L bake B save S" line from its log.
 void read_split(const std::string& log, Pair& p) {
@@ -110,8 +86,9 @@ Pair measure_pair(const BenchRun& run, const Scenes& scenes, const std::string& 
   p.scene = scene;
   const std::string low = scenes.s4 + "/low.obj", dir = run.run_dir + "/";
   const std::vector<std::string> nm = {run.args.exe, low, high, "-o", dir + tag + "_nmbake.png", "--size", "2048", "--quiet"};
-  std::vector<std::string> bl = {blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python", kScript, "--"};
-  bl.insert(bl.end(), {low, high, dir + tag + "_blender.png", "2048", "1", kExtrusion});
+  std::vector<std::string> bl = {blender, "-b",       "--factory-startup", "--python-exit-code",
+                                 "1",     "--python", blender_script(),    "--"};
+  bl.insert(bl.end(), {low, high, dir + tag + "_blender.png", "2048", "1", kBlenderExtrusion});
   const std::string nm_log = dir + tag + "_nmbake.log", bl_log = dir + tag + "_blender.log";
   for (int round = 0; round < run.args.rounds; ++round) {
     if (p.nm.failed.empty()) run_side(run, p.nm, nm, nm_log);
@@ -184,6 +161,23 @@ void judge(BenchRun& run, const Pair& p, bool m1, const std::string& no_blender)
 }
 
 }  // namespace
+
+std::string blender_script() { return NMBAKE_SOURCE_DIR "/bench/blender_bake.py"; }
+
+bool run_side(const BenchRun& run, Side& side, const std::vector<std::string>& command, const std::string& log) {
+  if (!side.failed.empty()) return false;
+  const Measured m = measure(command, log);
+  if (m.ok) {
+    side.wall.push_back(m.wall);
+    side.rss.push_back(m.rss_mib);
+    return true;
+  }
+  const std::string kept = run.args.scratch + "/" + fs::path(log).filename().string();
+  std::error_code ec;
+  fs::copy_file(log, kept, fs::copy_options::overwrite_existing, ec);
+  side.failed = m.why + "; log: " + (ec ? log : kept);
+  return false;
+}
 
 std::string find_blender(std::string& why) {
   const char* env = std::getenv("NMBAKE_BLENDER");
@@ -269,8 +263,8 @@ void run_blender(BenchRun& run, const Scenes& scenes) {
   std::printf("## 10. Blender side by side (the whole nmbake command against Blender's Cycles bake of the same pair)\n\n");
   std::string no_blender;
   std::string blender = find_blender(no_blender);
-  if (!blender.empty() && !fs::exists(kScript)) {
-    no_blender = std::string(kScript) + " not found";
+  if (!blender.empty() && !fs::exists(blender_script())) {
+    no_blender = blender_script() + " not found";
     blender.clear();
   }
   std::string name = "Blender";
@@ -283,7 +277,7 @@ void run_blender(BenchRun& run, const Scenes& scenes) {
         "suz_L4 low.obj onto each high-poly, 2048^2 8-bit .png, 1 sample, every core. nmbake: `nmbake LOW HIGH -o OUT.png --size "
         "2048 --quiet` (automatic cage). Blender (%s): `blender -b --factory-startup --python bench/blender_bake.py -- LOW HIGH "
         "OUT.png 2048 1 %s` (selected-to-active NORMAL bake, tangent space, fixed cage extrusion %s, margin 16).\n\n",
-        blender.c_str(), kExtrusion, kExtrusion);
+        blender.c_str(), kBlenderExtrusion, kBlenderExtrusion);
   }
   const Measured floor = measure({"true"}, run.run_dir + "/floor.log");
   std::printf(

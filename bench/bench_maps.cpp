@@ -23,29 +23,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr const char* kScript = NMBAKE_SOURCE_DIR "/bench/blender_bake.py";
-constexpr const char* kExtrusion = "0.05";  // Blender's cage extrusion (blender_bake.py's top comment)
 // The AO distance both bakers get: nmbake's automatic one on this pair (0.1 of the scene's
 // bounding-box diagonal, 2.761), given explicitly so that Blender's world AO distance is the same.
 constexpr const char* kAoDistance = "0.2761";
 constexpr const char* kCheapMaps = "normal,height,position,curvature,object-id,material-id";
-
-struct Side {
-  std::vector<double> wall, rss;
-  std::string failed;
-  bool ok() const { return failed.empty() && !wall.empty(); }
-};
-
-void run_once(Side& side, const std::vector<std::string>& command, const std::string& log) {
-  if (!side.failed.empty()) return;
-  const Measured m = measure(command, log);
-  if (m.ok) {
-    side.wall.push_back(m.wall);
-    side.rss.push_back(m.rss_mib);
-  } else {
-    side.failed = m.why + "; log: " + log;
-  }
-}
 
 std::string rounds_text(const std::vector<double>& v) {
   std::string s;
@@ -81,8 +62,8 @@ void cheap_maps(BenchRun& run, const Scenes& scenes) {
   set.insert(set.end(), {"--maps", kCheapMaps});
   Side a, b;
   for (int round = 0; round < run.args.rounds; ++round) {
-    run_once(a, plain, dir + "set_plain.log");
-    run_once(b, set, dir + "set_cheap.log");
+    run_side(run, a, plain, dir + "set_plain.log");
+    run_side(run, b, set, dir + "set_cheap.log");
   }
   std::printf(
       "a. Cheap maps. 2048^2 .png, 1 sample, every core, whole commands (writes included) alternated over %d round%s: "
@@ -114,23 +95,24 @@ void ao_against_blender(BenchRun& run, const Scenes& scenes) {
       "--maps",     "normal,ao", "--ao-rays",   "64", "--ao-distance",      kAoDistance, "--quiet"};
   std::string why;
   std::string blender = find_blender(why);
-  if (!blender.empty() && !fs::exists(kScript)) why = std::string(kScript) + " not found", blender.clear();
-  std::vector<std::string> bl = {blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python", kScript, "--"};
-  bl.insert(bl.end(), {low, scenes.m1_ply, dir + "ao_blender.png", size, "64", kExtrusion, "ao", kAoDistance});
+  if (!blender.empty() && !fs::exists(blender_script())) why = blender_script() + " not found", blender.clear();
+  std::vector<std::string> bl = {blender, "-b",       "--factory-startup", "--python-exit-code",
+                                 "1",     "--python", blender_script(),    "--"};
+  bl.insert(bl.end(), {low, scenes.m1_ply, dir + "ao_blender.png", size, "64", kBlenderExtrusion, "ao", kAoDistance});
   // Blender's AO bake takes minutes at 2048^2: one round each unless --rounds asks for more than 3.
   const int rounds = run.args.rounds > 3 ? run.args.rounds : 1;
   Side a, b;
   for (int round = 0; round < rounds; ++round) {
-    run_once(a, nm, dir + "ao_nmbake.log");
-    if (!blender.empty()) run_once(b, bl, dir + "ao_blender.log");
+    run_side(run, a, nm, dir + "ao_nmbake.log");
+    if (!blender.empty()) run_side(run, b, bl, dir + "ao_blender.log");
   }
   std::printf(
       "b. AO against Blender. %s^2 .png, 1 sample, every core, alternated over %d round%s: `nmbake LOW HIGH -o OUT_<MAP>.png "
       "--size %s --maps normal,ao --ao-rays 64 --ao-distance %s --quiet` (automatic cage) and `blender -b --factory-startup "
       "--python bench/blender_bake.py -- LOW HIGH OUT.png %s 64 %s ao %s` (Cycles AO bake, selected-to-active, 64 samples, "
       "world AO distance %s, fixed cage extrusion %s)%s.\n\n",
-      size.c_str(), rounds, rounds == 1 ? "" : "s", size.c_str(), kAoDistance, size.c_str(), kExtrusion, kAoDistance, kAoDistance,
-      kExtrusion, blender.empty() ? (": Blender not run, " + why).c_str() : "");
+      size.c_str(), rounds, rounds == 1 ? "" : "s", size.c_str(), kAoDistance, size.c_str(), kBlenderExtrusion, kAoDistance,
+      kAoDistance, kBlenderExtrusion, blender.empty() ? (": Blender not run, " + why).c_str() : "");
   std::printf("| command | median wall s | median max RSS MiB | per round wall s |\n|---|---|---|---|\n");
   print_side("nmbake --maps normal,ao --ao-rays 64", a);
   if (!blender.empty()) print_side("Blender AO bake, 64 samples", b);

@@ -78,7 +78,7 @@ std::string load_average() {
   std::ifstream in("/proc/loadavg");
   std::string a, b, c;
   in >> a >> b >> c;
-  return a + " " + b + " " + c;
+  return in ? a + " " + b + " " + c : std::string("unknown");
 }
 
 Machine describe_machine(const std::string& source_dir) {

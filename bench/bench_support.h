@@ -16,6 +16,8 @@
 
 namespace nmbake::bench {
 
+constexpr double kPi = 3.14159265358979323846;
+
 using Clock = std::chrono::steady_clock;
 
 double since(Clock::time_point t0);
@@ -43,7 +45,7 @@ struct Machine {
   double memory_gib = 0;
 };
 Machine describe_machine(const std::string& source_dir);
-std::string load_average();  // /proc/loadavg's first three figures
+std::string load_average();  // /proc/loadavg's first three figures, or "unknown"
 
 // Output of a shell command (stdout), empty when it cannot run.
 std::string command_output(const std::string& cmd);

@@ -12,16 +12,16 @@
 #include <string>
 #include <vector>
 
+#include "bench_support.h"
 #include "core/curvature.h"
 #include "core/maps.h"
 #include "io/mesh_io.h"
 #include "pipeline/bake.h"
 
 using namespace nmbake;
+using bench::kPi;
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // A closed torus around +Z (major radius R, tube r), nu x nv quads split in two, wound outwards,
 // one position per grid point; with `jitter` > 0 each point moves along the surface by up to that

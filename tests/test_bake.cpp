@@ -17,7 +17,7 @@ using test::decode_rgb;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using nmbake::test::kPi;
 
 BakeOptions options(int size, int samples = 1) {
   BakeOptions o;

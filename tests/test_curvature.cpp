@@ -20,7 +20,7 @@ using nmbake::test::make_torus;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using nmbake::test::kPi;
 
 void add_triangle(Mesh& m, std::uint32_t a, std::uint32_t b, std::uint32_t c) {
   for (std::uint32_t v : {a, b, c}) m.position_index.push_back(v);

@@ -18,7 +18,7 @@ using test::decode_rgb;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using nmbake::test::kPi;
 
 BakeOptions options(int size, int samples) {
   BakeOptions o;

@@ -10,12 +10,16 @@
 #include "pipeline/bake.h"
 #include "pipeline/map_set.h"
 #include "pipeline/udim.h"
+#include "maps_test_helpers.h"
 #include "test_support.h"
 
 namespace nmbake {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using test::baked;
+using test::kPi;
+using test::map_options;
+using test::wall_ao;
 
 // Flat-shaded triangles and quads (each face its own normal), UVs optional.
 struct Builder {
@@ -51,36 +55,13 @@ const Image& map_of(const BakeResult& r, MapKind kind) {
     if (m.kind == kind) return m.image;
   throw std::runtime_error("no such map");
 }
-const BakedMap& baked(const BakeResult& r, MapKind kind) {
-  for (const BakedMap& m : r.maps)
-    if (m.kind == kind) return m;
-  throw std::runtime_error("no such map");
-}
-
-BakeOptions options(int size, std::vector<MapKind> maps, float front = 0.1f, float rear = 0.1f) {
-  BakeOptions o;
-  o.width = o.height = size;
-  o.front = front;
-  o.rear = rear;
-  o.padding = 0;
-  o.threads = 2;
-  o.maps.maps = std::move(maps);
-  return o;
-}
-
-// AO beside an infinite wall, distance limit R, at distance d (a = d / R < 1).
-double wall_ao(double d, double r) {
-  const double a = d / r;
-  return a >= 1.0 ? 1.0 : 1.0 - (std::acos(a) - a * std::sqrt(1.0 - a * a)) / kPi;
-}
-
 // The ground [0, 4] x [-2, 2] (low-poly, UVs: u along x) beside a wall x = 0, y in [-4, 4], z in [0, 2].
 TEST(MapsAo, BesideAWallMatchesTheAnalyticShare) {
   Builder high("wall_high");
   high.quad({0, -4, 0}, {4, -4, 0}, {4, 4, 0}, {0, 4, 0});
   high.quad({0, -4, 0}, {0, 4, 0}, {0, 4, 2}, {0, -4, 2});  // facing +x
   const Mesh low = test::make_grid(8, 8, 0, 4, -2, 2);
-  BakeOptions o = options(128, {MapKind::normal, MapKind::ao});
+  BakeOptions o = map_options(128, {MapKind::normal, MapKind::ao});
   o.maps.ao_distance = 1.0;
   o.maps.ao_rays = 256;
   const BakeResult r = bake_normal_map(low, high.done(false), nullptr, o);
@@ -119,7 +100,7 @@ TEST(MapsAo, AtTheBottomOfARoundWell) {
     high.quad(p1, p0, p0 + glm::vec3(0, 0, float(h)), p1 + glm::vec3(0, 0, float(h)));  // the wall, facing in
   }
   const Mesh low = test::make_grid(1, 1, -0.02f, 0.02f, -0.02f, 0.02f);
-  BakeOptions o = options(16, {MapKind::ao});
+  BakeOptions o = map_options(16, {MapKind::ao});
   o.maps.ao_distance = 100.0;
   o.maps.ao_rays = 1024;
   const BakeResult r2 = bake_normal_map(low, high.done(false), nullptr, o);
@@ -160,7 +141,7 @@ TEST(MapsAo, ConvexObjectOnAGroundPlane) {
   Builder ground("ground");
   ground.quad({-400, -400, 0}, {400, -400, 0}, {400, 400, 0}, {-400, 400, 0});
   high = merge_meshes({high, ground.done(false)});
-  BakeOptions o = options(96, {MapKind::ao, MapKind::object_normal}, 0.02f, 0.02f);
+  BakeOptions o = map_options(96, {MapKind::ao, MapKind::object_normal}, 0.02f, 0.02f);
   o.maps.ao_distance = 1e4;
   o.maps.ao_rays = 256;
   const BakeResult r = bake_normal_map(low, high, nullptr, o);
@@ -189,7 +170,7 @@ TEST(MapsThickness, OfASlab) {
   high.quad({-5, -5, 0}, {5, -5, 0}, {5, 5, 0}, {-5, 5, 0});                                  // top, facing up
   high.quad({-5, -5, float(-t)}, {-5, 5, float(-t)}, {5, 5, float(-t)}, {5, -5, float(-t)});  // bottom, facing down
   const Mesh low = test::make_grid(4, 4, -1, 1, -1, 1);
-  BakeOptions o = options(32, {MapKind::thickness});
+  BakeOptions o = map_options(32, {MapKind::thickness});
   o.maps.thickness_distance = d;
   o.maps.ao_rays = 256;
   const BakeResult r = bake_normal_map(low, high.done(false), nullptr, o);
@@ -209,7 +190,7 @@ TEST(MapsHeight, OfASineField) {
         return glm::normalize(n);
       });
   const Mesh low = test::make_grid(4, 4);
-  BakeOptions o = options(64, {MapKind::height}, 0.2f, 0.2f);
+  BakeOptions o = map_options(64, {MapKind::height}, 0.2f, 0.2f);
   o.maps.height_range_given = true;
   o.maps.height_min = -0.1, o.maps.height_max = 0.1;
   const BakeResult r = bake_normal_map(low, high, nullptr, o);
@@ -228,7 +209,7 @@ TEST(MapsHeight, OfASineField) {
 TEST(MapsHeight, OwnRangeIsSymmetric) {
   const Mesh high = test::make_height_field(
       64, 64, [](double x, double) { return 0.03 * x + 0.01; }, [](double, double) { return glm::dvec3(0, 0, 1); });
-  const BakeResult r = bake_normal_map(test::make_grid(4, 4), high, nullptr, options(32, {MapKind::height}, 0.1f, 0.1f));
+  const BakeResult r = bake_normal_map(test::make_grid(4, 4), high, nullptr, map_options(32, {MapKind::height}, 0.1f, 0.1f));
   const BakedMap& m = baked(r, MapKind::height);
   EXPECT_NEAR(m.range_max, 0.04, 1e-3);
   EXPECT_EQ(m.range_min, -m.range_max);
@@ -238,7 +219,7 @@ TEST(MapsHeight, OwnRangeIsSymmetric) {
 // Position on a plane: R follows x, G follows y over the high-poly's box; B (a flat box) is 0.5.
 TEST(MapsPosition, NormalisedToTheHighPolysBox) {
   const Mesh plane = test::make_grid(4, 4);
-  const BakeResult r = bake_normal_map(plane, plane, nullptr, options(16, {MapKind::position}, 0.1f, 0.1f));
+  const BakeResult r = bake_normal_map(plane, plane, nullptr, map_options(16, {MapKind::position}, 0.1f, 0.1f));
   const BakedMap& m = baked(r, MapKind::position);
   for (int y = 0; y < 16; ++y)
     for (int x = 0; x < 16; ++x) {
@@ -259,7 +240,7 @@ TEST(MapsIds, TwoMaterialsGiveTwoFlatColours) {
     const float cx = (high.corner_position(t, 0).x + high.corner_position(t, 1).x + high.corner_position(t, 2).x) / 3.0f;
     high.triangle_material.push_back(cx < 0.1f ? 0u : 1u);
   }
-  BakeOptions o = options(32, {MapKind::material_id}, 0.1f, 0.1f);
+  BakeOptions o = map_options(32, {MapKind::material_id}, 0.1f, 0.1f);
   o.samples = 16;
   const BakeResult r = bake_normal_map(test::make_grid(4, 4), high, nullptr, o);
   const BakedMap& m = baked(r, MapKind::material_id);
@@ -282,11 +263,11 @@ TEST(MapsIds, TwoMaterialsGiveTwoFlatColours) {
 // of a cylinder below it.
 TEST(MapsCurvature, PlaneSphereAndTheInsideOfACylinder) {
   const Mesh plane = test::make_grid(8, 8);
-  const BakeResult flat = bake_normal_map(plane, plane, nullptr, options(16, {MapKind::curvature}, 0.1f, 0.1f));
+  const BakeResult flat = bake_normal_map(plane, plane, nullptr, map_options(16, {MapKind::curvature}, 0.1f, 0.1f));
   for (float v : baked(flat, MapKind::curvature).image.pixels) EXPECT_EQ(v, 0.5f);
 
   const Mesh sphere = uv_sphere(64, 32, {0, 0, 0});
-  BakeOptions o = options(64, {MapKind::curvature}, 0.05f, 0.05f);
+  BakeOptions o = map_options(64, {MapKind::curvature}, 0.05f, 0.05f);
   o.maps.curvature_scale = 2.0;  // mean curvature 1 (radius 1): 0.75
   const BakeResult round = bake_normal_map(sphere, sphere, nullptr, o);
   const Image& k = baked(round, MapKind::curvature).image;
@@ -323,7 +304,7 @@ TEST(MapsVertexColor, InterpolatedAtTheHit) {
   for (const glm::vec3& p : high.positions) high.colors.push_back({(p.x + 1.0f) / 2.0f, (p.y + 1.0f) / 2.0f, 0.25f, 1.0f});
   high.color_index = high.position_index;
   const Mesh low = test::make_grid(2, 2);
-  const BakeResult r = bake_normal_map(low, high, nullptr, options(16, {MapKind::vertex_color}, 0.1f, 0.1f));
+  const BakeResult r = bake_normal_map(low, high, nullptr, map_options(16, {MapKind::vertex_color}, 0.1f, 0.1f));
   const Image& c = baked(r, MapKind::vertex_color).image;
   for (int y = 0; y < 16; ++y)
     for (int x = 0; x < 16; ++x) {
@@ -332,7 +313,8 @@ TEST(MapsVertexColor, InterpolatedAtTheHit) {
       EXPECT_NEAR(p[1], 1.0 - (y + 0.5) / 16.0, 1e-5);
       EXPECT_NEAR(p[2], 0.25, 1e-6);
     }
-  const BakeResult none = bake_normal_map(low, test::make_grid(8, 8), nullptr, options(16, {MapKind::vertex_color}, 0.1f, 0.1f));
+  const BakeResult none =
+      bake_normal_map(low, test::make_grid(8, 8), nullptr, map_options(16, {MapKind::vertex_color}, 0.1f, 0.1f));
   EXPECT_FALSE(baked(none, MapKind::vertex_color).skipped.empty());
   EXPECT_TRUE(baked(none, MapKind::vertex_color).image.pixels.empty());
 }
@@ -342,10 +324,10 @@ TEST(MapsVertexColor, InterpolatedAtTheHit) {
 TEST(MapsThreads, IdenticalAcrossThreadCounts) {
   const Mesh low = test::make_torus(24, 12), high = test::make_torus(96, 48);
   for (bool automatic : {false, true}) {
-    BakeOptions o = options(48,
-                            {MapKind::normal, MapKind::ao, MapKind::bent_normal, MapKind::height, MapKind::thickness,
-                             MapKind::position, MapKind::object_id},
-                            -1.0f, -1.0f);
+    BakeOptions o = map_options(48,
+                                {MapKind::normal, MapKind::ao, MapKind::bent_normal, MapKind::height, MapKind::thickness,
+                                 MapKind::position, MapKind::object_id},
+                                -1.0f, -1.0f);
     o.samples = 4;
     o.maps.ao_rays = 16;
     o.maps.ao_rays_auto = automatic;
@@ -368,7 +350,7 @@ TEST(MapsThreads, IdenticalAcrossThreadCounts) {
 // A UDIM bake of a layout in one tile gives the single bake's maps.
 TEST(MapsUdim, OneTileEqualsTheSingleBake) {
   const Mesh low = test::make_torus(24, 12), high = test::make_torus(96, 48);
-  BakeOptions o = options(32, {MapKind::normal, MapKind::ao, MapKind::height, MapKind::curvature}, -1.0f, -1.0f);
+  BakeOptions o = map_options(32, {MapKind::normal, MapKind::ao, MapKind::height, MapKind::curvature}, -1.0f, -1.0f);
   o.maps.ao_rays = 8;
   const BakeResult single = bake_normal_map(low, high, nullptr, o);
   const UdimBake udim = bake_udim_tiles(low, high, nullptr, o);

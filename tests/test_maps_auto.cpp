@@ -9,12 +9,16 @@
 #include <cmath>
 
 #include "pipeline/bake.h"
+#include "maps_test_helpers.h"
 #include "test_support.h"
 
 namespace nmbake {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using test::baked;
+using test::kPi;
+using test::map_options;
+using test::wall_ao;
 
 // Two flat-shaded triangles a, b, c and a, c, d (counter-clockwise), no UVs.
 void add_quad(Mesh& m, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d) {
@@ -40,34 +44,12 @@ Mesh wall_scene(float half, float height) {
   return m;
 }
 
-BakeOptions options(int size, std::vector<MapKind> maps) {
-  BakeOptions o;
-  o.width = o.height = size;
-  o.front = o.rear = 0.1f;
-  o.padding = 0;
-  o.threads = 2;
-  o.maps.maps = std::move(maps);
-  return o;
-}
-
-const BakedMap& baked(const BakeResult& r, MapKind kind) {
-  for (const BakedMap& m : r.maps)
-    if (m.kind == kind) return m;
-  throw std::runtime_error("no such map");
-}
-
-// AO beside an infinite wall, distance limit R, at distance d (notes: maps.md).
-double wall_ao(double d, double r) {
-  const double a = d / r;
-  return a >= 1.0 ? 1.0 : 1.0 - (std::acos(a) - a * std::sqrt(1.0 - a * a)) / kPi;
-}
-
 // The low-poly [-2, 2] x [y0, y1] (u along x, v along y): row `row` of a `size` map lies at y.
 double row_y(int row, int size, double y0, double y1) { return y0 + (y1 - y0) * (1.0 - (row + 0.5) / size); }
 
 TEST(MapsAoAuto, BesideAWallReachesTheErrorAsked) {
   const double e = 0.02;
-  BakeOptions o = options(64, {MapKind::ao});
+  BakeOptions o = map_options(64, {MapKind::ao});
   o.maps.ao_distance = 1.0;
   o.maps.ao_rays_auto = true;
   o.maps.max_ao_error = e;
@@ -93,7 +75,7 @@ TEST(MapsAoAuto, BesideAWallReachesTheErrorAsked) {
 }
 
 TEST(MapsAoAuto, FewerRaysOnOpenTexelsThanOnPartialOnes) {
-  BakeOptions o = options(32, {MapKind::ao});
+  BakeOptions o = map_options(32, {MapKind::ao});
   o.maps.ao_distance = 1.0;
   o.maps.ao_rays_auto = true;
   const Mesh high = wall_scene(8, 2);
@@ -116,7 +98,7 @@ TEST(MapsBentNormal, BesideATallWallTiltsAwayByTheAnalyticAngle) {
   const double tilt = std::atan(2.0 / kPi);
   EXPECT_NEAR(tilt * 180.0 / kPi, 32.48, 0.01);
   for (bool green_down : {false, true}) {
-    BakeOptions o = options(32, {MapKind::bent_normal});
+    BakeOptions o = map_options(32, {MapKind::bent_normal});
     o.maps.ao_distance = 1e4;
     o.maps.ao_rays = 256;
     o.green_down = green_down;
@@ -139,7 +121,7 @@ TEST(MapsBentNormal, BesideATallWallTiltsAwayByTheAnalyticAngle) {
 }
 
 TEST(MapsBentNormal, OnOpenGroundIsTheNormal) {
-  BakeOptions o = options(32, {MapKind::bent_normal, MapKind::ao});
+  BakeOptions o = map_options(32, {MapKind::bent_normal, MapKind::ao});
   o.maps.ao_distance = 1.0;
   o.maps.ao_rays = 256;
   const BakeResult r = bake_normal_map(test::make_grid(4, 4, -2, 2, 1.5, 4), wall_scene(8, 2), nullptr, o);

@@ -19,7 +19,7 @@ namespace diff = nmbake::diff;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using nmbake::test::kPi;
 
 struct N3 {
   double x, y, z;

@@ -23,6 +23,8 @@ struct UvTileFilter;
 
 namespace nmbake::test {
 
+constexpr double kPi = 3.14159265358979323846;
+
 std::string data_path(const std::string& relative);         // <repo>/data/<relative>
 std::string shared_data_path(const std::string& relative);  // <repo>/../shared/data/<relative>
 // The bundled sample pair (data/sample): the torus low-poly (OBJ, with UVs) and its sculpt (PLY).

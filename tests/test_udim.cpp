@@ -24,7 +24,7 @@ using namespace nmbake;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using nmbake::test::kPi;
 
 // The low-poly's surface, a gentle dome, and the high-poly's: the dome with bumps on it.
 double dome(double x, double y) { return 0.15 * (1.0 - 0.5 * x * x - 0.3 * y * y); }

@@ -1,12 +1,12 @@
-// Internal to the hard assets (hard_assets.cpp and its helpers): pi and a value carried with its two
+// Internal to the hard assets (hard_assets.cpp and its helpers): a value carried with its two
 // partial derivatives, from which the detail functions get their exact normals.
 #pragma once
 
 #include <cmath>
 
-namespace nmbake::procedural::detail {
+#include "procedural.h"
 
-constexpr double kPi = 3.14159265358979323846;
+namespace nmbake::procedural::detail {
 
 struct Jet {
   double v = 0.0, du = 0.0, dv = 0.0;

@@ -8,7 +8,6 @@ namespace nmbake::procedural {
 
 Mesh make_sphere(int nphi, int ntheta, const std::function<double(double, double)>& radius,
                  const std::function<glm::dvec3(double, double)>& normal) {
-  constexpr double kPi = 3.14159265358979323846;
   Mesh m;
   m.source = "sphere";
   for (int j = 0; j <= ntheta; ++j)

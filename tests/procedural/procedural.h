@@ -10,6 +10,8 @@
 
 namespace nmbake::procedural {
 
+constexpr double kPi = 3.14159265358979323846;
+
 // A latitude-longitude sphere: nphi x ntheta quads (triangles at the poles), u = phi / 2 pi,
 // v = 1 - theta / pi, with radius(theta, phi) and per-vertex normal(theta, phi).
 Mesh make_sphere(int nphi, int ntheta, const std::function<double(double theta, double phi)>& radius,

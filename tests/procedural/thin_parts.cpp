@@ -4,11 +4,11 @@
 #include <cmath>
 #include <cstdint>
 
+#include "procedural.h"
+
 namespace nmbake::procedural {
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // One leg: a capsule around the bent axis c(s) = root + (splay f(s), bend f(s), s), f = (s/L)^2
 // on the straight part, continued straight beyond (the caps follow the axis's tangent).
