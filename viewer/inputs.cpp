@@ -163,7 +163,10 @@ InputFiles resolve_inputs(const std::vector<std::string>& files, const std::stri
                                  "-poly mesh was expected (the map is -m " + map_option + "): " + forms);
     return {files[0], map_option, files[1]};
   }
-  if (files.size() != 3) throw nmbake::UsageError("no map given: " + forms);
+  if (files.size() != 3) {
+    const bool has_image = std::find(kinds.begin(), kinds.end(), FileKind::image) != kinds.end();
+    throw nmbake::UsageError(std::string(has_image ? "no high-poly mesh given: " : "no map given: ") + forms);
+  }
 
   std::vector<std::size_t> images, undecided;
   for (std::size_t i = 0; i < 3; ++i) {

@@ -31,8 +31,8 @@ struct InputFiles {
 // - without: of three files the one image is the map and the two meshes are LOW then HIGH; where
 //   one file cannot be looked into (missing, a FIFO) and the two others are meshes, it is the map;
 //   otherwise (none or several undecided) the order LOW MAP HIGH stands and the loaders report.
-// Throws nmbake::UsageError (exit 1) for a form that names no map, two maps or a map in place of a
-// mesh, and nmbake::InputError (exit 2) for a file that is neither a mesh nor an image; each one
+// Throws nmbake::UsageError (exit 1) for a form that names no map, no high-poly, two maps or a map
+// in place of a mesh, and nmbake::InputError (exit 2) for a file that is neither a mesh nor an image; each one
 // line naming the file.
 InputFiles resolve_inputs(const std::vector<std::string>& files, const std::string& map_option);
 

@@ -165,7 +165,7 @@ namespace {
 int run_command_line(int argc, char** argv) {
   CLI::App app{
       "nmview: the low-poly with its baked tangent-space normal map beside the high-poly, "
-      "lit alike from one camera"};
+      "lit alike from one camera.\n  nmview LOW MAP HIGH [OPTIONS]\n  nmview LOW HIGH -m MAP [OPTIONS]   (nmbake's order)"};
   Options o;
   app.add_option("files", o.files,
                  "LOW MAP HIGH, or LOW HIGH with -m MAP (nmbake's order); the map may stand anywhere among three files: "
@@ -175,7 +175,8 @@ int run_command_line(int argc, char** argv) {
                  "name (crate_<MAP>.png: every map found is loaded, the normal map is required). HIGH: the high-poly "
                  "mesh (its normals, else computed ones)")
       ->expected(2, 3)
-      ->required();
+      ->required()
+      ->option_text("FILE x 2-3 REQUIRED");
   app.add_option("-m,--map", o.map_option, "The map (as MAP above), with LOW HIGH in nmbake's order");
   app.add_option("--screenshot", o.screenshot,
                  "Render without a display to FILE and exit (with --compare: write the worst view's difference "

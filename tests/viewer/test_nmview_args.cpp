@@ -52,7 +52,7 @@ void write_tilted_map(const std::string& path, const std::string& format = ".png
 
 std::string bytes(const char* data, std::size_t size) { return std::string(data, size); }
 
-TEST(NmviewInputs, MeshesAndImagesAreToldApartByContent) {
+TEST(NmviewFileKinds, MeshesAndImagesAreToldApartByContent) {
   const std::string dir = scratch_dir();
   const auto at = [&](const std::string& name) { return dir + "/" + name; };
   // Images: written by the baker's own writer, one named as no image is.
@@ -94,7 +94,7 @@ TEST(NmviewInputs, MeshesAndImagesAreToldApartByContent) {
   for (const auto& c : cases) EXPECT_EQ(int(nmview::classify_file(at(c.name))), int(c.kind)) << c.name;
 }
 
-TEST(NmviewInputs, EachFormResolvesToLowMapHigh) {
+TEST(NmviewFileKinds, EachFormResolvesToLowMapHigh) {
   const std::string dir = scratch_dir();
   const std::string low = dir + "/low.obj", high = dir + "/high.obj", map = dir + "/map.png", notes = dir + "/notes.txt";
   write_file(low, kPlaneObj);
@@ -128,6 +128,7 @@ TEST(NmviewInputs, EachFormResolvesToLowMapHigh) {
     }
   };
   usage({low, high}, "", "no map given");
+  usage({low, map}, "", "no high-poly mesh given");
   usage({low, high, low}, "", "are all meshes and no map is given");
   usage({low, map, map}, "", "are both images");
   usage({low, map, high}, map, "and three files");
