@@ -86,4 +86,29 @@ TEST(CliSpellings, CommandBakesTheSameMapForEitherSpelling) {
   EXPECT_EQ(bad_green.err, "error: --green: yplus not in {up,down} (see nmbake --help)\n");
 }
 
+// The jobs file --help shows is one nmbake --batch takes: valid JSON, its fields those of a jobs file.
+TEST(CliHelp, BatchExampleIsAJobsFile) {
+  const std::string text = nmbake::kBatchExample;
+  const std::size_t begin = text.find('{'), end = text.rfind('}');
+  ASSERT_NE(begin, std::string::npos);
+  const nlohmann::json jobs = nlohmann::json::parse(text.substr(begin, end - begin + 1));
+  ASSERT_TRUE(jobs["jobs"].is_array());
+  EXPECT_EQ(jobs["jobs"].size(), 2u);
+  EXPECT_TRUE(jobs["defaults"].is_object());
+  for (const nlohmann::json& job : jobs["jobs"]) {
+    EXPECT_TRUE(job["low"].is_string()) << job.dump();
+    EXPECT_TRUE(job["output"].is_string()) << job.dump();
+    EXPECT_TRUE(job.contains("high") || job.contains("highs")) << job.dump();
+  }
+  // Its fields and options pass the batch's checks: each job fails only on its missing meshes.
+  const std::string dir = nmbake::test::scratch_dir();
+  nmbake::test::write_file(dir + "/jobs.json", text.substr(begin, end - begin + 1));
+  const CliRun run = run_nmbake("--batch jobs.json", "", dir);
+  EXPECT_EQ(run.code, 2) << run.err;
+  EXPECT_TRUE(contains(run.err, "job 1 (crate_normal.png): crate_low.fbx: cannot open")) << run.err;
+  EXPECT_TRUE(contains(run.err, "job 2 (lid_dx.tga): lid_low.fbx: cannot open")) << run.err;
+  EXPECT_TRUE(contains(run_nmbake("--help").out, text)) << "nmbake --help shows the example";
+  EXPECT_TRUE(contains(run_nmbake("--batch --help").out, text)) << "nmbake --batch --help shows the example";
+}
+
 }  // namespace

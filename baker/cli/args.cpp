@@ -82,7 +82,7 @@ void add_options(CLI::App& app, Args& a) {
                  "Output map: .png (8-bit), .tga (8-bit), .tif/.tiff (16-bit), .exr (float); <UDIM> and <MAP> in the name: a map "
                  "per UDIM tile and per --maps name")
       ->required();
-  app.add_option("--size", a.size, "Map size N or WxH in texels, each side a number or 1k, 2k, 4k, 8k (x 1024; default 2048)");
+  app.add_option("--size", a.size, "Map size N or WxH in texels, a side also as Nk = N x 1024 (1k, 2k, 4k, 8k; default 2048)");
   app.add_option("--samples", a.samples,
                  "Sample points per texel, 1-1024, or auto: 4 per texel, 16 where those disagree, 64 where the 16 do "
                  "(default 1)");
