@@ -252,7 +252,8 @@ void add_arguments(CLI::App& app, CommandLine& cl) {
       ->check(CLI::IsMember({"normal", "object-normal", "ao", "bent-normal", "height", "thickness", "curvature", "position",
                              "object-id", "material-id", "vertex-color"}));
   app.add_option("--mask", cl.mask_path,
-                 "Low-poly mesh (OBJ, PLY, OFF, STL with UVs): compare only texels inside its UV layout, "
+                 "Low-poly mesh with UVs (OBJ, PLY, OFF, STL, glTF .gltf/.glb, FBX, DAE: what nmbake reads; its UV set 0): "
+                 "compare only texels inside its UV layout, "
                  "rasterized as the baker does, so padding is ignored");
   app.add_flag("--include-padding", options.include_padding,
                "Also compare texels outside the --mask layout and outside alpha coverage");

@@ -1,6 +1,7 @@
 // nmview: the low-poly with its baked normal map beside the high-poly, one camera, one light.
 //
 //   nmview LOW.obj normal.png HIGH.ply                 window: left low + map, right high
+//   nmview LOW.obj HIGH.ply -m normal.png              the same in nmbake's order (also --map)
 //   nmview LOW.obj normal.png HIGH.ply --screenshot cmp.png --size 1600x800 --view 30,20
 //   nmview LOW.obj normal.png HIGH.ply --compare       appearance difference over fixed views
 //   nmview LOW.obj 'crate_<MAP>.png' HIGH.ply          the texture set: AO lit, A and M keys, --show MAP
@@ -16,17 +17,20 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "cli/numbers.h"
 #include "cli/shell.h"
+#include "cli/spellings.h"
 #include "compare.h"
 #include "core/errors.h"
 #include "io/image_io.h"
 #include "io/mesh_io.h"
 #include "io/output_files.h"
 #include "gl_context.h"
+#include "inputs.h"
 #include "interactive.h"
 #include "renderer.h"
 #include "scene.h"
@@ -34,7 +38,9 @@
 namespace {
 
 struct Options {
-  std::string low, map, high;
+  std::vector<std::string> files;  // LOW MAP HIGH, or LOW HIGH with -m (inputs.h)
+  std::string map_option;          // -m, --map
+  std::string low, map, high;      // resolved
   std::string screenshot;
   std::string size = "1600x800";
   std::string view = "30,20";
@@ -159,15 +165,19 @@ namespace {
 int run_command_line(int argc, char** argv) {
   CLI::App app{
       "nmview: the low-poly with its baked tangent-space normal map beside the high-poly, "
-      "lit alike from one camera"};
+      "lit alike from one camera.\n  nmview LOW MAP HIGH [OPTIONS]\n  nmview LOW HIGH -m MAP [OPTIONS]   (nmbake's order)"};
   Options o;
-  app.add_option("low", o.low, "Low-poly mesh with UVs (OBJ, PLY, OFF, STL, glTF, FBX, DAE...), as given to nmbake")->required();
-  app.add_option("map", o.map,
-                 "Normal map baked for it (any size; its nmbake:* metadata says how it was baked), or the texture set "
-                 "as nmbake -o wrote it, with <MAP> for each map's name (crate_<MAP>.png: every map found is loaded, "
-                 "the normal map is required)")
-      ->required();
-  app.add_option("high", o.high, "High-poly mesh (its normals, else computed ones)")->required();
+  app.add_option("files", o.files,
+                 "LOW MAP HIGH, or LOW HIGH with -m MAP (nmbake's order); the map may stand anywhere among three files: "
+                 "meshes and images are told apart by their content. LOW: the low-poly mesh with UVs (OBJ, PLY, OFF, STL, "
+                 "glTF, FBX, DAE...), as given to nmbake. MAP: the normal map baked for it (any size; its nmbake:* "
+                 "metadata says how it was baked), or the texture set as nmbake -o wrote it, with <MAP> for each map's "
+                 "name (crate_<MAP>.png: every map found is loaded, the normal map is required). HIGH: the high-poly "
+                 "mesh (its normals, else computed ones)")
+      ->expected(2, 3)
+      ->required()
+      ->option_text("FILE x 2-3 REQUIRED");
+  app.add_option("-m,--map", o.map_option, "The map (as MAP above), with LOW HIGH in nmbake's order");
   app.add_option("--screenshot", o.screenshot,
                  "Render without a display to FILE and exit (with --compare: write the worst view's difference "
                  "image to FILE; without it --compare writes no image)");
@@ -191,7 +201,9 @@ int run_command_line(int argc, char** argv) {
                  "How the map was baked: tangent or object space (default: the map's nmbake:space metadata, "
                  "else tangent)");
   app.add_option("--green", o.decoding.green,
-                 "Tangent-space map's green: up = OpenGL, down = DirectX (default: nmbake:green metadata, else up)");
+                 "Tangent-space map's green: up = OpenGL, down = DirectX, also gl/opengl and dx/directx, any case "
+                 "(default: nmbake:green metadata, else up)")
+      ->transform([](const std::string& value) { return nmbake::canonical_green(value); });
   app.add_option("--bitangent", o.decoding.bitangent,
                  "Tangent-space map's bitangent: pixel = sign*cross(N,T) per pixel (MikkTSpace), vertex = "
                  "interpolated per-corner B (default: nmbake:bitangent metadata, else pixel)");
@@ -206,6 +218,10 @@ int run_command_line(int argc, char** argv) {
   nmbake::require_numbers(app);
 
   if (const std::optional<int> status = nmbake::parse_command_line(app, argc, argv, "nmview")) return *status;
+  const nmview::InputFiles inputs = nmview::resolve_inputs(o.files, o.map_option);
+  o.low = inputs.low;
+  o.map = inputs.map;
+  o.high = inputs.high;
   return run(o);
 }
 

@@ -9,6 +9,7 @@
 
 #include "cli/map_outputs.h"
 #include "cli/outputs.h"
+#include "cli/spellings.h"
 #include "core/errors.h"
 #include "core/object_match.h"
 #include "io/image_io.h"
@@ -17,11 +18,12 @@
 namespace nmbake {
 
 namespace {
+// N or WxH, each side a whole number of texels or a count of 1024s (4k: cli/spellings.h).
 void parse_size(const std::string& text, int& w, int& h) {
   auto parse_side = [&](const std::string& s) -> long long {
-    if (s.empty() || s.size() > 12 || s.find_first_not_of("0123456789") != std::string::npos)
-      throw UsageError("--size: expected N or WxH with whole numbers, got '" + text + "'");
-    return std::stoll(s);
+    long long texels = 0;
+    if (!parse_texel_count(s, texels)) throw UsageError("--size: expected N or WxH with whole numbers, got '" + text + "'");
+    return texels;
   };
   const auto x = text.find_first_of("xX");
   const long long a = parse_side(x == std::string::npos ? text : text.substr(0, x));
@@ -32,6 +34,15 @@ void parse_size(const std::string& text, int& w, int& h) {
 }
 
 }  // namespace
+
+const char* kBatchExample =
+    "Many bakes in one process: nmbake --batch jobs.json (nmbake --batch --help), with jobs.json e.g.\n"
+    "  {\"defaults\": {\"size\": 2048, \"samples\": 4},\n"
+    "   \"jobs\": [{\"low\": \"crate_low.fbx\", \"highs\": [\"crate_high.obj\"], \"output\": \"crate_normal.png\"},\n"
+    "            {\"low\": \"lid_low.fbx\", \"high\": \"lid_high.obj\", \"output\": \"lid_dx.tga\",\n"
+    "             \"options\": {\"green\": \"down\", \"report\": \"lid.json\"}}]}\n"
+    "Options are the long options without their dashes (a flag: true); a job's options override the\n"
+    "defaults; relative paths are relative to the file's folder. The format: docs/usage.md, \"Batch\".\n";
 
 const char* kExitCodes =
     "Exit codes:\n"
@@ -61,14 +72,17 @@ void add_options(CLI::App& app, Args& a) {
                          "what else Assimp reads. The low-poly must have UVs.\n"
                          "Maps use the OpenGL convention (green = +bitangent, \"Y+\") unless --green down;\n"
                          "tangent frames follow MikkTSpace (Blender, glTF, Substance, Unity, Unreal).\n"
-                         "-o normal.<UDIM>.png bakes one map per UDIM tile. Many bakes in one process:\n"
-                         "nmbake --batch jobs.json (nmbake --batch --help; the file's format is in README, \"Batch\").\n\n") +
-             kExitCodes);
+                         "-o normal.<UDIM>.png bakes one map per UDIM tile; -o crate_<MAP>.png --maps normal,ao one\n"
+                         "file per map. Spellings: --size 4k (= 4096; 1k, 2k, 8k), --green dx or gl.\n\n") +
+             kBatchExample + "\n" + kExitCodes);
   app.get_formatter()->column_width(34);
   app.add_option("low", a.low, "Low-poly mesh with UVs")->required();
   app.add_option("high", a.highs, "High-poly mesh (UVs not needed); several: baked as one")->required();
-  app.add_option("-o,--output", a.output, "Output map: .png (8-bit), .tif (16-bit), .exr (float)")->required();
-  app.add_option("--size", a.size, "Map size N or WxH in texels (default 2048)");
+  app.add_option("-o,--output", a.output,
+                 "Output map: .png (8-bit), .tga (8-bit), .tif/.tiff (16-bit), .exr (float); <UDIM> and <MAP> in the name: a map "
+                 "per UDIM tile and per --maps name")
+      ->required();
+  app.add_option("--size", a.size, "Map size N or WxH in texels, a side also as Nk = N x 1024 (1k, 2k, 4k, 8k; default 2048)");
   app.add_option("--samples", a.samples,
                  "Sample points per texel, 1-1024, or auto: 4 per texel, 16 where those disagree, 64 where the 16 do "
                  "(default 1)");
@@ -91,7 +105,9 @@ void add_options(CLI::App& app, Args& a) {
                  "back faces are skipped in both")
       ->check(CLI::IsMember({"cage-first", "closest"}));
   app.add_option("--space", a.space, "tangent (default) or object")->check(CLI::IsMember({"tangent", "object"}));
-  app.add_option("--green", a.green, "up = OpenGL/Blender/glTF (default), down = DirectX/Unreal")
+  app.add_option("--green", a.green,
+                 "up = OpenGL/Blender/glTF (default), down = DirectX/Unreal; also gl/opengl and dx/directx, any case")
+      ->transform([](const std::string& value) { return canonical_green(value); })
       ->check(CLI::IsMember({"up", "down"}));
   app.add_option("--bitangent", a.bitangent, "pixel = B from interpolated N,T (MikkTSpace, default); vertex = interpolated B")
       ->check(CLI::IsMember({"pixel", "vertex"}));
@@ -144,7 +160,7 @@ void add_options(CLI::App& app, Args& a) {
                "about 10% of a 2048^2 1-sample bake");
   app.add_option("--maps", a.maps,
                  "Maps to bake from the same hits, comma-separated (default normal): " + map_name_list() +
-                     ". Several need <MAP> in -o (crate_<MAP>.png); README, \"Texture sets\", defines each");
+                     ". Several need <MAP> in -o (crate_<MAP>.png); docs/usage.md, \"Texture sets\", defines each");
   app.add_option("--ao-rays", a.ao_rays,
                  "Rays per texel for ao, bent-normal and thickness, 1-65536 (default 64), or auto: 32 rays, then more in "
                  "rounds where the texel's standard error is above --max-ao-error (where occlusion is partial), at most 1024");

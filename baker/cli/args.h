@@ -15,6 +15,10 @@ namespace nmbake {
 // The exit codes, as --help lists them.
 extern const char* kExitCodes;
 
+// A jobs file for --batch with what its fields mean, as nmbake --help and nmbake --batch --help
+// show it.
+extern const char* kBatchExample;
+
 struct Args {
   std::string low, high, output, cage, miss_mask, report, save_cage, suspect_mask;
   std::vector<std::string> highs;  // every HIGH given; `high` names them in messages

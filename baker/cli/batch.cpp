@@ -119,7 +119,7 @@ bool wants_batch(int argc, char** argv) {
 }
 
 int parse_batch_args(int argc, char** argv, BatchArgs& b) {
-  CLI::App app{"nmbake --batch: bake the jobs of a JSON file in one process (README \"Batch\").", "nmbake"};
+  CLI::App app{"nmbake --batch: bake the jobs of a JSON file in one process (docs/usage.md, \"Batch\").", "nmbake"};
   app.add_option("--batch", b.file, "The jobs file")->required();
   app.add_option("--report", b.report, "Write the batch's JSON report: each job's report and a summary");
   app.add_option("--threads", b.threads, "Worker threads of every job (default: all cores)");
@@ -127,7 +127,7 @@ int parse_batch_args(int argc, char** argv, BatchArgs& b) {
   app.add_flag("--progress", b.progress, "Show the progress line even when stderr is not a terminal");
   app.add_flag("--strict", b.strict, "Any warning fails its job (exit 5 for the batch); the others still run");
   app.add_flag("--no-warnings", b.no_warnings, "Do not print warnings");
-  app.footer(std::string("\n") + kExitCodes);
+  app.footer(std::string("\n") + kBatchExample + "\n" + kExitCodes);
   require_numbers(app);
   for (int i = 1; i < argc; ++i)  // before parsing: `--batch --help` would read "--help" as the file
     if (std::strcmp(argv[i], "--help") == 0 || std::strcmp(argv[i], "-h") == 0) {
