@@ -43,7 +43,7 @@ Result run(const std::string& dir, const std::string& program, const std::string
   return nmview::test::run_tool(dir, program, args);
 }
 
-Result nmview(const std::string& dir, const std::string& args) { return run(dir, NMVIEW_EXE, args); }
+using nmview::test::nmview;
 
 void bake(const std::string& dir, const std::string& low, const std::string& high, const std::string& map,
           const std::string& options = "") {

@@ -147,12 +147,12 @@ TEST(NmviewFileKinds, EachFormResolvesToLowMapHigh) {
 
 // The binary: every accepted form renders the same screenshot, the map applied (it differs from
 // --no-map's); each refused form is one line naming the file, with the exit code of its kind.
-struct Scene {
+struct PlaneScene {
   std::string dir, low, high, map;
 };
 
-Scene make_scene() {
-  Scene s;
+PlaneScene make_plane_scene() {
+  PlaneScene s;
   s.dir = scratch_dir();
   // The map under a name that says nothing of what it is: only its content tells.
   s.low = s.dir + "/low.obj";
@@ -164,11 +164,11 @@ Scene make_scene() {
   return s;
 }
 
-nmview::test::ToolRun nmview_run(const Scene& s, const std::string& args) {
+nmview::test::ToolRun nmview_run(const PlaneScene& s, const std::string& args) {
   return nmview::test::run_tool(s.dir, NMVIEW_EXE, args);
 }
 
-std::string screenshot(const Scene& s, const std::string& name, const std::string& inputs) {
+std::string screenshot(const PlaneScene& s, const std::string& name, const std::string& inputs) {
   const std::string shot = s.dir + "/" + name + ".png";
   const nmview::test::ToolRun r =
       nmview_run(s, inputs + " --screenshot " + quote(shot) + " --size 64x32 --view 0,0 --light 20,10 --show nolabels");
@@ -179,7 +179,7 @@ std::string screenshot(const Scene& s, const std::string& name, const std::strin
 }
 
 TEST(NmviewArgs, BothOrdersAndMapOptionGiveTheSameScreenshot) {
-  const Scene s = make_scene();
+  const PlaneScene s = make_plane_scene();
   const std::string low = quote(s.low), high = quote(s.high), map = quote(s.map);
   const std::string present = screenshot(s, "present", low + " " + map + " " + high);
   ASSERT_FALSE(present.empty());
@@ -190,7 +190,7 @@ TEST(NmviewArgs, BothOrdersAndMapOptionGiveTheSameScreenshot) {
 }
 
 TEST(NmviewArgs, RefusedFormsNameTheFileInOneLine) {
-  const Scene s = make_scene();
+  const PlaneScene s = make_plane_scene();
   write_file(s.dir + "/notes.txt", "low first, then high\n");
   const std::string low = quote(s.low), high = quote(s.high), map = quote(s.map), notes = quote(s.dir + "/notes.txt"),
                     shot = s.dir + "/shot.png";

@@ -95,12 +95,12 @@ void expect_error(const Finished& f, int code, const std::string& line) {
   EXPECT_EQ(errors[0], line);
 }
 
-struct Scene {
+struct SphereScene {
   std::string dir, low, high, map;
 };
 
-Scene make_scene() {
-  Scene s;
+SphereScene make_sphere_scene() {
+  SphereScene s;
   s.dir = nmbake::test::scratch_dir();
   s.low = s.dir + "/low.obj";
   s.high = s.dir + "/high.obj";
@@ -118,33 +118,33 @@ std::vector<std::string> files_in(const std::string& dir) {
 }
 
 TEST(NmviewHostile, FifoMapIsRefusedAtOnce) {
-  const Scene s = make_scene();
+  const SphereScene s = make_sphere_scene();
   ASSERT_EQ(::mkfifo((s.dir + "/fifo.png").c_str(), 0600), 0);
   expect_error(run_nmview(s.dir, {s.low, "fifo.png", s.high, "--compare"}), 2, "error: fifo.png: not a regular file (a FIFO)");
 }
 
 TEST(NmviewHostile, LinkToAFifoIsRefused) {
-  const Scene s = make_scene();
+  const SphereScene s = make_sphere_scene();
   ASSERT_EQ(::mkfifo((s.dir + "/fifo").c_str(), 0600), 0);
   ASSERT_EQ(::symlink("fifo", (s.dir + "/link.png").c_str()), 0);
   expect_error(run_nmview(s.dir, {s.low, "link.png", s.high, "--compare"}), 2, "error: link.png: not a regular file (a FIFO)");
 }
 
 TEST(NmviewHostile, DeviceMapIsRefused) {
-  const Scene s = make_scene();
+  const SphereScene s = make_sphere_scene();
   expect_error(run_nmview(s.dir, {s.low, "/dev/zero", s.high, "--compare"}), 2,
                "error: /dev/zero: not a regular file (a character device)");
 }
 
 TEST(NmviewHostile, FifoMeshesAreRefused) {
-  const Scene s = make_scene();
+  const SphereScene s = make_sphere_scene();
   ASSERT_EQ(::mkfifo((s.dir + "/fifo.obj").c_str(), 0600), 0);
   expect_error(run_nmview(s.dir, {"fifo.obj", s.map, s.high, "--compare"}), 2, "error: fifo.obj: is not a regular file");
   expect_error(run_nmview(s.dir, {s.low, s.map, "/dev/zero", "--compare"}), 2, "error: /dev/zero: is not a regular file");
 }
 
 TEST(NmviewHostile, HeaderLargerThanItsFileIsRefused) {
-  const Scene s = make_scene();
+  const SphereScene s = make_sphere_scene();
   write_png_header(s.dir + "/big.png", 20000, 20000, 100);
   expect_error(run_nmview(s.dir, {s.low, "big.png", s.high, "--compare"}), 4,
                "error: big.png: header says 20000x20000 pixels (4.8 GB) but the file has 157 bytes");
@@ -153,7 +153,7 @@ TEST(NmviewHostile, HeaderLargerThanItsFileIsRefused) {
 // A closed stdout loses the messages and changes nothing else (io/output_files.h): the status is
 // the work's, never a SIGPIPE death (the three commands' streams: tests/test_closed_stdout.cpp).
 TEST(NmviewOutputs, ClosedStdoutLosesOnlyTheMessages) {
-  const Scene s = make_scene();
+  const SphereScene s = make_sphere_scene();
   const Finished f = run_nmview(s.dir, {s.low, s.map, s.high, "--compare", "--size", "200x100"}, true);
   EXPECT_FALSE(f.signalled) << "killed by a signal";
   EXPECT_EQ(f.code, 0) << f.err;
@@ -161,7 +161,7 @@ TEST(NmviewOutputs, ClosedStdoutLosesOnlyTheMessages) {
 }
 
 TEST(NmviewOutputs, CompareWritesNoImageUnlessAsked) {
-  const Scene s = make_scene();
+  const SphereScene s = make_sphere_scene();
   const std::string work = s.dir + "/work";
   fs::create_directories(work);
   Finished f = run_nmview(work, {s.low, s.map, s.high, "--compare", "--size", "200x100"});
@@ -183,7 +183,7 @@ TEST(NmviewLimits, UnderUlimitAMapTooBigForItIsExitFour) {
 #if defined(__SANITIZE_ADDRESS__)
   GTEST_SKIP() << "ulimit -v and AddressSanitizer do not mix (it reserves terabytes of shadow memory)";
 #endif
-  const Scene s = make_scene();
+  const SphereScene s = make_sphere_scene();
   // 20000^2 RGB in 4 MB of pixel data: a size the file could hold, 4.8 GB of floats.
   write_png_header(s.dir + "/plausible.png", 20000, 20000, 4u << 20);
   const std::string shot = s.dir + "/shot.png";

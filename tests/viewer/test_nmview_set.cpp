@@ -43,7 +43,7 @@ constexpr int kPane = 128;  // screenshots are 2 panes of kPane x kPane
 using Result = nmview::test::ToolRun;
 using nmview::test::quote;
 
-Result nmview(const std::string& dir, const std::string& args) { return nmview::test::run_tool(dir, NMVIEW_EXE, args); }
+using nmview::test::nmview;
 
 // The plane as low- and high-poly (the same file twice is fine for the viewer).
 std::string write_plane(const std::string& dir) {

@@ -28,4 +28,6 @@ ToolRun run_tool(const std::string& dir, const std::string& program, const std::
   return r;
 }
 
+ToolRun nmview(const std::string& dir, const std::string& args) { return run_tool(dir, NMVIEW_EXE, args); }
+
 }  // namespace nmview::test

@@ -19,4 +19,7 @@ std::string quote(const std::string& s);
 // stderr kept in stdout.txt and stderr.txt in `dir`.
 ToolRun run_tool(const std::string& dir, const std::string& program, const std::string& args);
 
+// run_tool of the nmview binary (NMVIEW_EXE).
+ToolRun nmview(const std::string& dir, const std::string& args);
+
 }  // namespace nmview::test
