@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "test_support.h"
 #include "trace/shade_batch.h"
 #include "core/tangent_frames.h"
 
@@ -13,9 +14,9 @@ using namespace nmbake;
 
 namespace {
 
-bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+using nmbake::test::same_bits;
 
-LowTriangle random_low_triangle(std::mt19937& rng) {
+LowTriangle random_shading_triangle(std::mt19937& rng) {
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
   LowTriangle lt;
   for (int c = 0; c < 3; ++c) {
@@ -36,7 +37,7 @@ TEST(ShadeBatch, BitIdenticalToOneAtATime) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::uniform_real_distribution<float> uf(-1.0f, 1.0f);
   std::vector<LowTriangle> low;
-  for (int i = 0; i < 6; ++i) low.push_back(random_low_triangle(rng));
+  for (int i = 0; i < 6; ++i) low.push_back(random_shading_triangle(rng));
   std::vector<glm::vec3> high_normals;
   for (int i = 0; i < 3 * 50; ++i) high_normals.push_back(glm::normalize(glm::vec3(uf(rng), uf(rng), 1.0f)));
   for (int c = 0; c < 3; ++c) {

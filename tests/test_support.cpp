@@ -1,5 +1,6 @@
 #include "test_support.h"
 
+#include <cstring>
 #include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -235,6 +236,9 @@ double angle_deg(const glm::dvec3& a, const glm::dvec3& b) {
   if (la == 0.0 || lb == 0.0) return 0.0;
   return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b)) * 180.0 / 3.14159265358979323846;
 }
+
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+bool same_bits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 glm::dvec3 decode_rgb(const float* c) {
   double n[3];

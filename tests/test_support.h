@@ -104,6 +104,10 @@ Mesh make_height_field(int nx, int ny, H height, N normal) {
 // Angle in degrees between two directions (0 when either is zero).
 double angle_deg(const glm::dvec3& a, const glm::dvec3& b);
 
+// a and b hold the same bits (+0 and -0 differ; a NaN equals itself).
+bool same_bits(double a, double b);
+bool same_bits(float a, float b);
+
 // Decodes an encoded map value c in [0,1]^3 to a unit tangent-space vector.
 glm::dvec3 decode_rgb(const float* c);
 

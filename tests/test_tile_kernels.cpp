@@ -10,14 +10,14 @@
 
 #include "core/rasterize.h"
 #include "pipeline/rays.h"
+#include "test_support.h"
 #include "trace/tile_kernels.h"
 
 using namespace nmbake;
 
 namespace {
 
-bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
-bool same_bits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+using nmbake::test::same_bits;
 
 // A rectangle of slots with the arrays SampleSlots points into (with `cage`, tfar, base and
 // prefer_lo too).
@@ -63,7 +63,7 @@ void reference_ray(const LowTriangle& lt, const double b[3], float front, glm::v
   dir = glm::vec3(-n);
 }
 
-LowTriangle random_low_triangle(std::mt19937& rng) {
+LowTriangle random_ray_triangle(std::mt19937& rng) {
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
   LowTriangle lt{};
   for (int c = 0; c < 3; ++c) {
@@ -141,7 +141,7 @@ TEST(TileKernels, CoverRectIsCoversBitForBit) {
     if (i % 4 == 0)  // corners on texel centres and edges through them: ties and edge insets
       for (glm::vec2& c : uv) c = (glm::floor(c * 40.0f) + 0.5f) / 40.0f;
     const TexelTriangle tt = setup_texel_triangle(uv[0], uv[1], uv[2], 40, 40);  // either winding
-    const LowTriangle lt = random_low_triangle(rng);
+    const LowTriangle lt = random_ray_triangle(rng);
     covered += check_triangle(tt, &lt, 0.01f * float(i % 7), i % 3 ? 0.5 : 0.125, i % 5 ? 0.5 : 0.875, &moved);
     covered += check_triangle(tt, nullptr, 0.0f, 0.5, 0.5, &moved);  // coverage alone
   }
@@ -192,7 +192,7 @@ TEST(TileKernels, CageRaysAreCageRayBitForBit) {
     if (i % 4 == 0)
       for (glm::vec2& c : uv) c = (glm::floor(c * 32.0f) + 0.5f) / 32.0f;
     const TexelTriangle tt = setup_texel_triangle(uv[0], uv[1], uv[2], 32, 32);
-    const LowTriangle lt = random_low_triangle(rng);
+    const LowTriangle lt = random_ray_triangle(rng);
     CageTriangle ct;
     for (int c = 0; c < 3; ++c) {
       // Every tenth cage lies on the low-poly (no direction); a third search no farther than the cage.
