@@ -504,8 +504,10 @@ TEST(BatchShard, TheMergeRefusesPartsThatDoNotMakeOneBatch) {
   const Case usage[] = {
       {"--merge-reports a0.json a1.json", 1, "-o FILE, the batch report to write, is required"},
       {"--merge-reports a0.json a1.json -o a0.json", 1, "a0.json; nothing written"},
-      {"--merge-reports a0.json a1.json -o out.json --shard 0/2", 1, "--merge-reports: --shard applies to --batch"},
-      {"--merge-reports a0.json a1.json -o out.json --batch farm/jobs.json", 1, "--batch applies to --batch"},
+      {"--merge-reports a0.json a1.json -o out.json --shard 0/2", 1,
+       "--merge-reports: --shard is an option of a batch's run (--batch), not of the merge"},
+      {"--merge-reports a0.json a1.json -o out.json --batch farm/jobs.json", 1,
+       "--merge-reports: --batch is an option of a batch's run"},
       {"--merge-reports -o out.json", 1, "--merge-reports"},
   };
   for (const Case& c : usage) {

@@ -171,7 +171,8 @@ int parse_batch_args(int argc, char** argv, BatchArgs& b) {
   }
   if (merging) {
     for (const char* other : {"--batch", "--shard", "--report", "--threads", "--progress", "--strict", "--no-warnings"})
-      if (app.count(other)) throw UsageError(std::string("--merge-reports: ") + other + " applies to --batch");
+      if (app.count(other))
+        throw UsageError(std::string("--merge-reports: ") + other + " is an option of a batch's run (--batch), not of the merge");
     if (b.merge.empty()) throw UsageError("--merge-reports: give the parts' reports, then -o FILE");
     if (b.merged.empty()) throw UsageError("--merge-reports: -o FILE, the batch report to write, is required");
     return -1;
