@@ -42,7 +42,9 @@ const char* kBatchExample =
     "            {\"low\": \"lid_low.fbx\", \"high\": \"lid_high.obj\", \"output\": \"lid_dx.tga\",\n"
     "             \"options\": {\"green\": \"down\", \"report\": \"lid.json\"}}]}\n"
     "Options are the long options without their dashes (a flag: true); a job's options override the\n"
-    "defaults; relative paths are relative to the file's folder. The format: docs/usage.md, \"Batch\".\n";
+    "defaults; relative paths are relative to the file's folder. The format: docs/usage.md, \"Batch\".\n"
+    "On a farm, task I of N bakes its part, nmbake --batch jobs.json --shard I/N --report partI.json, and\n"
+    "nmbake --merge-reports part*.json -o batch.json makes the whole report (\"Batches on a farm\").\n";
 
 const char* kExitCodes =
     "Exit codes:\n"

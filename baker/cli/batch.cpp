@@ -1,5 +1,6 @@
 #include "cli/batch.h"
 
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -112,21 +113,47 @@ std::vector<BatchJob> parse_batch(const std::string& path, const std::string& te
   return jobs;
 }
 
-bool wants_batch(int argc, char** argv) {
+namespace {
+
+// Whether argv holds the option `name` (alone, or as name=VALUE).
+bool has_batch_option(int argc, char** argv, const char* name) {
+  const std::size_t n = std::strlen(name);
   for (int i = 1; i < argc; ++i)
-    if (std::strcmp(argv[i], "--batch") == 0 || std::strncmp(argv[i], "--batch=", 8) == 0) return true;
+    if (std::strncmp(argv[i], name, n) == 0 && (argv[i][n] == '\0' || argv[i][n] == '=')) return true;
   return false;
 }
 
+}  // namespace
+
+bool wants_batch(int argc, char** argv) {
+  return has_batch_option(argc, argv, "--batch") || has_batch_option(argc, argv, "--shard") ||
+         has_batch_option(argc, argv, "--merge-reports");
+}
+
 int parse_batch_args(int argc, char** argv, BatchArgs& b) {
-  CLI::App app{"nmbake --batch: bake the jobs of a JSON file in one process (docs/usage.md, \"Batch\").", "nmbake"};
-  app.add_option("--batch", b.file, "The jobs file")->required();
+  const bool merging = has_batch_option(argc, argv, "--merge-reports");
+  if (!merging && !has_batch_option(argc, argv, "--batch"))
+    throw UsageError("--shard applies to --batch: nmbake --batch jobs.json --shard I/N [--report part.json]");
+  CLI::App app{
+      "nmbake --batch: bake the jobs of a JSON file in one process, or one part of them on a farm (--shard);\n"
+      "nmbake --merge-reports: the batch report of the parts' (docs/usage.md, \"Batch\", \"Batches on a farm\").",
+      "nmbake"};
+  std::string shard;
+  app.add_option("--batch", b.file, "The jobs file");
+  app.add_option("--shard", shard,
+                 "I/N: bake only part I (0 to N-1) of N of the jobs, those sharing a high-poly in one part, the same "
+                 "split on every machine; --report then writes the part's report (for a Slurm array: --shard "
+                 "$SLURM_ARRAY_TASK_ID/N)");
   app.add_option("--report", b.report, "Write the batch's JSON report: each job's report and a summary");
   app.add_option("--threads", b.threads, "Worker threads of every job (default: all cores)");
   app.add_flag("--quiet", b.quiet, "As nmbake's --quiet, for every job");
   app.add_flag("--progress", b.progress, "Show the progress line even when stderr is not a terminal");
   app.add_flag("--strict", b.strict, "Any warning fails its job (exit 5 for the batch); the others still run");
   app.add_flag("--no-warnings", b.no_warnings, "Do not print warnings");
+  app.add_option("--merge-reports", b.merge,
+                 "PART...: instead of a batch, merge the --report files of the parts of one --shard N into the report "
+                 "one process would write (-o FILE; exit: the first failed job's, as the batch's)");
+  app.add_option("-o,--output", b.merged, "With --merge-reports: the batch report to write");
   app.footer(std::string("\n") + kBatchExample + "\n" + kExitCodes);
   require_numbers(app);
   for (int i = 1; i < argc; ++i)  // before parsing: `--batch --help` would read "--help" as the file
@@ -134,13 +161,25 @@ int parse_batch_args(int argc, char** argv, BatchArgs& b) {
       std::printf("%s", app.help().c_str());
       return 0;
     }
+  const char* what = merging ? "--merge-reports: " : "--batch: ";
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    throw UsageError(std::string("--batch: ") + e.what());
+    throw UsageError(what + std::string(e.what()));
   }
+  if (merging) {
+    for (const char* other : {"--batch", "--shard", "--report", "--threads", "--progress", "--strict", "--no-warnings"})
+      if (app.count(other))
+        throw UsageError(std::string("--merge-reports: ") + other + " is an option of a batch's run (--batch), not of the merge");
+    if (b.merge.empty()) throw UsageError("--merge-reports: give the parts' reports, then -o FILE");
+    if (b.merged.empty()) throw UsageError("--merge-reports: -o FILE, the batch report to write, is required");
+    return -1;
+  }
+  if (app.count("--output")) throw UsageError("--batch: -o applies to --merge-reports; the batch's report is --report FILE");
+  if (b.file.empty()) throw UsageError("--batch: the jobs file is empty");
+  if (app.count("--shard")) b.shard = parse_shard(shard);
   return -1;
 }
 
@@ -217,17 +256,39 @@ nlohmann::json shared_options(const BatchArgs& b) {
 }  // namespace
 
 int run_batch(const BatchArgs& b, const std::function<bool()>& interrupted, const char** doing, Clock::time_point start) {
-  const std::vector<BatchJob> jobs = parse_batch(b.file, read_jobs_file(b.file), shared_options(b));
-  const std::vector<Args> args = check_jobs(b.file, jobs);
+  if (!b.merge.empty()) return run_merge_reports(b.merge, b.merged, b.quiet > 0);
+  const std::string text = read_jobs_file(b.file);
+  const std::vector<BatchJob> jobs = parse_batch(b.file, text, shared_options(b));
+  const std::vector<Args> args = check_jobs(b.file, jobs);  // every job, also other parts': each part refuses a wrong file
   if (!b.report.empty()) check_output_files({{"--batch", b.file, "the jobs"}}, {{"--report", b.report, "the batch report"}});
+  // The jobs to bake: all, or the part's (positions in `jobs`, in file order).
+  std::vector<std::size_t> take(jobs.size());
+  for (std::size_t i = 0; i < take.size(); ++i) take[i] = i;
+  const bool sharded = b.shard.count > 0;
+  std::string part;  // "part 1/3"
+  if (sharded) {
+    std::vector<ShardJob> costs(jobs.size());
+    for (std::size_t i = 0; i < jobs.size(); ++i) {
+      const BakeOptions o = bake_options(args[i]);  // checked by check_jobs
+      costs[i] = {args[i].highs, std::uint64_t(o.width) * std::uint64_t(o.height)};
+    }
+    take = split_jobs(costs, b.shard.count)[std::size_t(b.shard.index)];
+    part = "part " + std::to_string(b.shard.index) + "/" + std::to_string(b.shard.count);
+    if (take.empty() && b.quiet < 2)
+      std::fprintf(stderr, "nmbake: %s: --shard %d/%d gets no job (%zu jobs in %zu groups sharing a high-poly); nothing baked\n",
+                   b.file.c_str(), b.shard.index, b.shard.count, jobs.size(), count_job_groups(costs));
+  }
   Progress progress(!b.quiet && (b.progress || ::isatty(STDERR_FILENO)), start, interrupted);
   MeshCache cache;
   nlohmann::json reports = nlohmann::json::array();
   int first_failure = 0;
   std::size_t failed = 0;
-  for (std::size_t i = 0; i < jobs.size(); ++i) {
+  for (std::size_t k = 0; k < take.size(); ++k) {
+    const std::size_t i = take[k];
     const Args& a = args[i];
-    progress.label("job " + std::to_string(i + 1) + " of " + std::to_string(jobs.size()) + ": ");
+    progress.label(sharded ? "job " + std::to_string(jobs[i].index) + " (" + std::to_string(k + 1) + " of " +
+                                 std::to_string(take.size()) + " of " + part + "): "
+                           : "job " + std::to_string(i + 1) + " of " + std::to_string(jobs.size()) + ": ");
     nlohmann::json report;
     const JobEnv env{jobs[i].argv, interrupted, doing, progress, Clock::now(), &cache, true, &report};
     int code = 0;
@@ -262,22 +323,32 @@ int run_batch(const BatchArgs& b, const std::function<bool()>& interrupted, cons
   std::size_t bvh_reused = 0;
   for (const auto& [key, high] : cache.highs) bvh_reused += high->bvh.reused;
   if (!b.report.empty()) {
-    const nlohmann::json summary = {{"batch", b.file},
-                                    {"jobs", reports},
-                                    {"summary",
-                                     {{"jobs", jobs.size()},
-                                      {"baked", jobs.size() - failed},
-                                      {"failed", failed},
-                                      {"high_loads_saved", cache.hits},
-                                      {"bvh_reused", bvh_reused},
-                                      {"seconds", seconds}}}};
+    nlohmann::json summary = {{"batch", b.file},
+                              {"jobs", reports},
+                              {"summary",
+                               {{"jobs", take.size()},
+                                {"baked", take.size() - failed},
+                                {"failed", failed},
+                                {"high_loads_saved", cache.hits},
+                                {"bvh_reused", bvh_reused},
+                                {"seconds", seconds}}}};
+    if (sharded) {
+      nlohmann::json taken = nlohmann::json::array();
+      for (std::size_t i : take) taken.push_back(jobs[i].index);
+      summary["shard"] = {{"index", b.shard.index},
+                          {"count", b.shard.count},
+                          {"jobs", taken},
+                          {"jobs_in_file", jobs.size()},
+                          {"jobs_file", jobs_file_fingerprint(text)}};
+    }
     write_text_atomically(b.report, summary.dump(2) + "\n");
   }
   if (!b.quiet)
     std::printf(
-        "nmbake: batch %s: %zu jobs, %zu baked, %zu failed, %.2f s; high-poly files loaded once for %zu jobs, a BVH reused by "
+        "nmbake: batch %s%s: %zu jobs, %zu baked, %zu failed, %.2f s; high-poly files loaded once for %zu jobs, a BVH reused by "
         "%zu\n",
-        b.file.c_str(), jobs.size(), jobs.size() - failed, failed, seconds, cache.hits, bvh_reused);
+        b.file.c_str(), sharded ? (" " + part).c_str() : "", take.size(), take.size() - failed, failed, seconds, cache.hits,
+        bvh_reused);
   return first_failure;
 }
 
