@@ -17,15 +17,9 @@ using test::decode_rgb;
 
 namespace {
 
-using nmbake::test::kPi;
+using test::bake_options;
 
-BakeOptions options(int size, int samples = 1) {
-  BakeOptions o;
-  o.width = o.height = size;
-  o.samples = samples;
-  o.padding = 0;
-  return o;
-}
+using nmbake::test::kPi;
 
 long quantize(float c, int bits) { return std::lround(double(c) * ((1 << bits) - 1)); }
 
@@ -34,7 +28,7 @@ long quantize(float c, int bits) { return std::lround(double(c) * ((1 << bits) -
 TEST(Bake, MeshBakedOntoItselfIsExactlyFlat) {
   const Mesh m = test::make_torus(64, 32);
   for (int samples : {1, 4}) {
-    BakeOptions o = options(256, samples);
+    BakeOptions o = bake_options(256, samples);
     o.front = o.rear = 0.05f;
     const BakeResult r = bake_normal_map(m, m, nullptr, o);
     EXPECT_EQ(r.stats.trace.misses, 0u);
@@ -56,7 +50,7 @@ TEST(Bake, QuadAgainstTiltedPlaneGivesThePlaneNormal) {
   Mesh high = test::make_grid(3, 3, -1.5f, 1.5f, -1.5f, 1.5f);
   for (glm::vec3& p : high.positions) p.z = 0.2f * p.x + 0.1f * p.y + 0.05f;
   high.normals = {glm::vec3(glm::normalize(glm::dvec3(-0.2, -0.1, 1.0)))};
-  BakeOptions o = options(64);
+  BakeOptions o = bake_options(64);
   o.front = o.rear = 1.0f;
   const BakeResult r = bake_normal_map(low, high, nullptr, o);
   const glm::dvec3 expect = glm::normalize(glm::dvec3(-0.2, -0.1, 1.0));
@@ -85,7 +79,7 @@ TEST(Bake, HeightFieldMatchesAnalyticNormal) {
   };
   const Mesh high = test::make_height_field(512, 512, h, n);
   const Mesh low = test::make_grid(1, 1);
-  BakeOptions o = options(512);
+  BakeOptions o = bake_options(512);
   o.front = o.rear = 0.06f;
   const BakeResult r = bake_normal_map(low, high, nullptr, o);
   ASSERT_EQ(r.stats.trace.misses, 0u);
@@ -113,7 +107,7 @@ TEST(Bake, HeightFieldMatchesAnalyticNormal) {
 TEST(Bake, ResultsDoNotDependOnThreadCount) {
   const Mesh low = test::make_torus(24, 12);
   const Mesh high = test::make_torus(96, 48, 1.0f, 0.37f);
-  BakeOptions o = options(128, 4);
+  BakeOptions o = bake_options(128, 4);
   o.front = o.rear = 0.1f;
   o.padding = 4;
   o.threads = 1;
@@ -136,7 +130,7 @@ TEST(Bake, MissesAreCountedFlatAndMasked) {
   // The high-poly covers only x < 0.
   Mesh high = test::make_grid(1, 1, -1.2f, 0.0f, -1.2f, 1.2f);
   for (glm::vec3& p : high.positions) p.z = 0.01f;
-  BakeOptions o = options(32);
+  BakeOptions o = bake_options(32);
   o.front = o.rear = 0.1f;
   o.miss_mask = true;
   const BakeResult r = bake_normal_map(low, high, nullptr, o);
@@ -154,22 +148,22 @@ TEST(Bake, MissesAreCountedFlatAndMasked) {
 
 TEST(Bake, AbsurdOptionsAreRefused) {
   const Mesh m = test::make_grid(1, 1);
-  BakeOptions o = options(0);
+  BakeOptions o = bake_options(0);
   EXPECT_THROW(bake_normal_map(m, m, nullptr, o), UsageError);
-  o = options(100000);
+  o = bake_options(100000);
   EXPECT_THROW(bake_normal_map(m, m, nullptr, o), ResourceError);
-  o = options(16, 0);
+  o = bake_options(16, 0);
   EXPECT_THROW(bake_normal_map(m, m, nullptr, o), UsageError);
   Mesh no_uv = m;
   no_uv.uv_index.clear();
-  EXPECT_THROW(bake_normal_map(no_uv, m, nullptr, options(16)), InputError);
+  EXPECT_THROW(bake_normal_map(no_uv, m, nullptr, bake_options(16)), InputError);
 }
 
 TEST(Bake, AutoDistancesCoverTheOffset) {
   const Mesh low = test::make_grid(4, 4);
   Mesh high = test::make_grid(8, 8, -1.5f, 1.5f, -1.5f, 1.5f);
   for (glm::vec3& p : high.positions) p.z = 0.03f;
-  BakeOptions o = options(32);
+  BakeOptions o = bake_options(32);
   const BakeResult r = bake_normal_map(low, high, nullptr, o);
   EXPECT_TRUE(r.stats.distances.auto_distances);
   EXPECT_GE(r.stats.distances.front, 0.03f);
@@ -189,7 +183,7 @@ TEST(Bake, DisplacedSphereMatchesAnalyticNormal) {
   const Mesh low = make_sphere(
       48, 24, [](double, double) { return 1.0; }, unit);
   const Mesh high = make_sphere(768, 384, radius, normal);
-  BakeOptions o = options(512);
+  BakeOptions o = bake_options(512);
   o.height = 256;
   o.front = o.rear = 0.1f;
   const BakeResult r = bake_normal_map(low, high, nullptr, o);
@@ -253,7 +247,7 @@ TEST(Bake, MirroredUVHalvesDecodeToMirroredNormals) {
         sorted.normal_index.push_back(low.normal_index[3 * t + c]);
       }
     }
-  BakeOptions o = options(128);
+  BakeOptions o = bake_options(128);
   o.front = o.rear = 0.1f;
   const BakeResult r = bake_normal_map(sorted, high, nullptr, o);
   EXPECT_GT(r.stats.trace.overlapping_samples, 128u * 128u / 2);  // the halves share the layout

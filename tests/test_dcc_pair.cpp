@@ -61,7 +61,7 @@ struct Bake {
   std::vector<std::uint8_t> mask;  // texels covered by the low-poly's UV layout
 };
 
-Bake bake_files(const std::string& low_path, const std::string& high_path) {
+Bake bake_dcc_files(const std::string& low_path, const std::string& high_path) {
   const test::MeshPair pair = test::load_pair(low_path, high_path);
   BakeOptions o;
   o.width = o.height = kSize;
@@ -164,12 +164,12 @@ TEST(DccPair, SpiderFbxAndObjBakeTheSameMapAsHighPoly) {
   const std::string dir = test::scratch_dir();
   const std::string obj = obj_with_normals(dir);
   const std::string obj_low = smooth_copy(kObj, dir + "/obj_smooth.obj");
-  const Bake obj_on_obj = bake_files(obj_low, obj), obj_on_fbx = bake_files(obj_low, kFbx);
+  const Bake obj_on_obj = bake_dcc_files(obj_low, obj), obj_on_fbx = bake_dcc_files(obj_low, kFbx);
   // Enough in the map that a misplaced high-poly shows (AMisplacedHighPolyBakesAnotherMap).
   EXPECT_GE(mean_tilt(obj_on_obj), 0.5);
   EXPECT_LE(mean_difference(obj_on_fbx, obj_on_obj, "smooth OBJ low, FBX high vs OBJ high:"), 0.05);
   const std::string fbx_low = smooth_copy(kFbx, dir + "/fbx_smooth.obj");
-  const Bake fbx_on_obj = bake_files(fbx_low, obj), fbx_on_fbx = bake_files(fbx_low, kFbx);
+  const Bake fbx_on_obj = bake_dcc_files(fbx_low, obj), fbx_on_fbx = bake_dcc_files(fbx_low, kFbx);
   EXPECT_GE(mean_tilt(fbx_on_fbx), 0.5);
   EXPECT_LE(mean_difference(fbx_on_fbx, fbx_on_obj, "smooth FBX low, FBX high vs OBJ high:"), 0.05);
 }

@@ -20,7 +20,7 @@ namespace {
 
 using nmbake::test::kPi;
 
-BakeOptions options(int size, int samples) {
+BakeOptions estimate_options(int size, int samples) {
   BakeOptions o;
   o.width = o.height = size;
   o.samples = samples;
@@ -50,7 +50,7 @@ TEST(ErrorEstimate, TheBakesTracerGivesItsTexelsAgain) {
   const Mesh low = test::make_torus(24, 12);
   const Mesh high = test::make_torus(96, 48, 1.0f, 0.37f);
   for (int variant = 0; variant < 5; ++variant) {
-    BakeOptions o = options(96, variant == 1 || variant == 3 ? 1 : 4);
+    BakeOptions o = estimate_options(96, variant == 1 || variant == 3 ? 1 : 4);
     if (variant != 3) o.front = o.rear = 0.1f;
     if (variant == 1) o.policy = RayPolicy::closest;
     if (variant == 2) o.green_down = true;
@@ -71,7 +71,7 @@ TEST(ErrorEstimate, AHighPolyMovedForTheBakeIsKeptWithItsTrace) {
   Mesh high = with_origin(test::make_torus(96, 48, 1.0f, 0.37f), glm::dvec3(0.5, 0.25, 0.0));
   high.objects = {{"inner", ""}, {"outer", ""}};
   for (std::size_t t = 0; t < high.triangle_count(); ++t) high.triangle_object.push_back(std::uint32_t(t % 2));
-  BakeOptions o = options(64, 1);
+  BakeOptions o = estimate_options(64, 1);
   o.front = o.rear = 0.1f;
   o.cull_far = false;
   const BakeResult r = bake_normal_map(low, high, nullptr, o);
@@ -88,7 +88,7 @@ TEST(ErrorEstimate, AHighPolyMovedForTheBakeIsKeptWithItsTrace) {
 
 TEST(ErrorEstimate, OnlyABakeThatKeptItsTraceIsEstimated) {
   const Mesh m = test::make_torus(32, 16);
-  BakeOptions o = options(32, 1);
+  BakeOptions o = estimate_options(32, 1);
   o.keep_trace = false;
   const BakeResult r = bake_normal_map(m, m, nullptr, o);
   EXPECT_FALSE(r.trace_inputs);
@@ -97,7 +97,7 @@ TEST(ErrorEstimate, OnlyABakeThatKeptItsTraceIsEstimated) {
 
 TEST(ErrorEstimate, SelfBakeEstimatesZero) {
   const Mesh m = test::make_torus(64, 32);
-  BakeOptions o = options(128, 1);
+  BakeOptions o = estimate_options(128, 1);
   o.front = o.rear = 0.05f;
   const BakeResult r = bake_normal_map(m, m, nullptr, o);
   ErrorEstimateOptions eo;
@@ -115,7 +115,7 @@ TEST(ErrorEstimate, SelfBakeEstimatesZero) {
 TEST(ErrorEstimate, AliasedBakeEstimateIsCloseToTheTrueError) {
   const Mesh high = aliasing_height_field();
   const Mesh low = test::make_grid(1, 1);
-  BakeOptions o = options(128, 1);
+  BakeOptions o = estimate_options(128, 1);
   o.front = o.rear = 0.01f;
   const BakeResult r = bake_normal_map(low, high, nullptr, o);
   // True error: every texel against a full 64-sample bake.

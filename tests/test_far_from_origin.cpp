@@ -55,7 +55,7 @@ std::string write_moved(const Mesh& m, const glm::dvec3& offset, const std::stri
   return path;
 }
 
-BakeOptions options() {
+BakeOptions far_options() {
   BakeOptions o;
   o.width = o.height = 128;
   o.padding = 2;
@@ -83,7 +83,7 @@ BakeResult load_and_bake(const std::string& low_path, const std::string& high_pa
   const test::MeshPair pair = test::load_pair(low_path, high_path);
   EXPECT_EQ(pair.high.origin, pair.low.origin);
   if (origin) *origin = pair.low.origin;
-  return bake_normal_map(pair.low, pair.high, nullptr, options());
+  return bake_normal_map(pair.low, pair.high, nullptr, far_options());
 }
 
 TEST(FarFromOrigin, SavedInDoubleBakesAsAtTheOrigin) {

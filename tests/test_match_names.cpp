@@ -33,7 +33,7 @@ namespace {
 using test::contains;
 using test::run_nmbake;
 
-struct Box {
+struct NamedBox {
   std::string name;
   glm::vec3 lo, hi;
   int first_cell;     // UV cells first_cell .. first_cell + 5 of a 4 x 4 grid, one per face
@@ -41,13 +41,13 @@ struct Box {
 };
 
 // Boxes as OBJ text: one `o` per box, hard edges (a normal per face), a UV cell per face.
-std::string boxes_obj(const std::vector<Box>& boxes) {
+std::string boxes_obj(const std::vector<NamedBox>& boxes) {
   static const int faces[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {2, 3, 7, 6}, {1, 2, 6, 5}, {3, 0, 4, 7}};
   static const float normals[6][3] = {{0, 0, -1}, {0, 0, 1}, {0, -1, 0}, {0, 1, 0}, {1, 0, 0}, {-1, 0, 0}};
   std::string text;
   char line[200];
   int base_v = 0, base_t = 0, base_n = 0;
-  for (const Box& b : boxes) {
+  for (const NamedBox& b : boxes) {
     text += "o " + b.name + "\n";
     for (int k = 0; k < 8; ++k) {
       std::snprintf(line, sizeof line, "v %g %g %g\n", double((k == 1 || k == 2 || k == 5 || k == 6) ? b.hi.x : b.lo.x),
@@ -80,8 +80,8 @@ std::string boxes_obj(const std::vector<Box>& boxes) {
 const glm::vec3 kPlateLo(-1, -1, -0.1f), kPlateHi(1, 1, 0), kBoltLo(-0.2f, -0.2f, -0.5f), kBoltHi(0.2f, 0.2f, 0.5f);
 const glm::vec3 kPlateTilt(0.3f, 0, 0), kBoltTilt(0, -0.3f, 0);
 
-Box plate(const std::string& name, bool high) { return {name, kPlateLo, kPlateHi, 0, high ? kPlateTilt : glm::vec3(0)}; }
-Box bolt(const std::string& name, bool high) { return {name, kBoltLo, kBoltHi, 8, high ? kBoltTilt : glm::vec3(0)}; }
+NamedBox plate(const std::string& name, bool high) { return {name, kPlateLo, kPlateHi, 0, high ? kPlateTilt : glm::vec3(0)}; }
+NamedBox bolt(const std::string& name, bool high) { return {name, kBoltLo, kBoltHi, 8, high ? kBoltTilt : glm::vec3(0)}; }
 
 Mesh load_obj(const std::string& name, const std::string& text) {
   LoadOptions o;

@@ -133,7 +133,7 @@ void export_scene(const std::string& in, const std::string& format, const std::s
   ASSERT_EQ(exporter.Export(scene, format, out), AI_SUCCESS) << exporter.GetErrorString();
 }
 
-Image bake_files(const std::string& low_path, const std::string& high_path, double* unit_scale = nullptr) {
+Image bake_assimp_files(const std::string& low_path, const std::string& high_path, double* unit_scale = nullptr) {
   MeshLoadInfo info;
   const test::MeshPair pair = test::load_pair(low_path, high_path, &info);
   if (unit_scale) *unit_scale = info.unit_scale;
@@ -159,17 +159,17 @@ TEST(AssimpFormats, OneSceneInEveryFormatBakesTheSameMap) {
   export_scene(high, "fbxa", dir + "/high.fbx", 100.0);
   export_scene(low, "collada", dir + "/low.dae");
   export_scene(high, "collada", dir + "/high.dae");
-  const Image reference = bake_files(low, high);
+  const Image reference = bake_assimp_files(low, high);
   double scale = 0.0;
-  const Image glb = bake_files(dir + "/low.glb", dir + "/high.glb", &scale);
+  const Image glb = bake_assimp_files(dir + "/low.glb", dir + "/high.glb", &scale);
   EXPECT_EQ(scale, 1.0);
-  const Image fbx = bake_files(dir + "/low.fbx", dir + "/high.fbx", &scale);
+  const Image fbx = bake_assimp_files(dir + "/low.fbx", dir + "/high.fbx", &scale);
   EXPECT_DOUBLE_EQ(scale, 0.01);
-  const Image dae = bake_files(dir + "/low.dae", dir + "/high.dae");
+  const Image dae = bake_assimp_files(dir + "/low.dae", dir + "/high.dae");
   // Centimetres and metres line up: an FBX low-poly with a glTF high-poly, and the other way.
-  const Image fbx_glb = bake_files(dir + "/low.fbx", dir + "/high.glb");
-  const Image glb_fbx = bake_files(dir + "/low.glb", dir + "/high.fbx");
-  const Image obj_fbx = bake_files(low, dir + "/high.fbx");
+  const Image fbx_glb = bake_assimp_files(dir + "/low.fbx", dir + "/high.glb");
+  const Image glb_fbx = bake_assimp_files(dir + "/low.glb", dir + "/high.fbx");
+  const Image obj_fbx = bake_assimp_files(low, dir + "/high.fbx");
   EXPECT_LE(mean_difference(glb, reference), 0.05);
   EXPECT_LE(mean_difference(fbx, glb), 0.05);
   EXPECT_LE(mean_difference(dae, reference), 0.05);
@@ -197,7 +197,7 @@ TEST(AssimpFormats, NodeTransformsAreApplied) {
   EXPECT_NEAR(centre.x, 5.0, 0.05);
   EXPECT_NEAR(centre.y, -2.0, 0.05);
   EXPECT_NEAR(centre.z, 3.0, 0.05);
-  EXPECT_LE(mean_difference(bake_files(dir + "/low.glb", dir + "/high.glb"), bake_files(low, high)), 0.05);
+  EXPECT_LE(mean_difference(bake_assimp_files(dir + "/low.glb", dir + "/high.glb"), bake_assimp_files(low, high)), 0.05);
 }
 
 // Triangles whose winding (counter-clockwise from the front) agrees with their corners' normals.

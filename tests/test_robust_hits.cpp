@@ -20,19 +20,14 @@ using test::angle_deg;
 
 namespace {
 
+using test::bake_options;
+
 using Errors = procedural::KnownErrors;
 
 // The baked map's angular error against the analytic answer, over the covered texel centres of
 // the low-poly triangles whose part is in `parts` (all when empty).
 Errors measure(const HardAsset& a, const BakeResult& r, const std::vector<int>& parts = {}) {
   return procedural::measure_against_known(a, procedural::known_texels(a, r.map.width), r, parts);
-}
-
-BakeOptions options(int size) {
-  BakeOptions o;
-  o.width = o.height = size;
-  o.padding = 0;
-  return o;
 }
 
 void record(const std::string& name, const Errors& e, const BakeResult& r) {
@@ -51,7 +46,7 @@ TEST(RobustHits, CloseTubesWithABulgeBakeCleanByDefault) {
   // the next tube; the automatic cage does not.
   for (const auto& [gap, bulge] : {std::pair{0.012, 0.04}, std::pair{0.004, 0.04}, std::pair{0.012, 0.14}}) {
     const HardAsset a = procedural::make_close_tubes(gap, bulge);
-    const BakeResult r = bake_normal_map(a.low, a.high, nullptr, options(512));
+    const BakeResult r = bake_normal_map(a.low, a.high, nullptr, bake_options(512));
     const Errors e = measure(a, r);
     record(a.name, e, r);
     EXPECT_EQ(r.stats.distances.cage, BakeStats::CageSource::automatic);
@@ -65,7 +60,7 @@ TEST(RobustHits, CloseTubesWithABulgeBakeCleanByDefault) {
 
 TEST(RobustHits, ThinShellTakesNoNormalFromTheOtherSide) {
   const HardAsset a = procedural::make_thin_shell();
-  const BakeResult r = bake_normal_map(a.low, a.high, nullptr, options(512));
+  const BakeResult r = bake_normal_map(a.low, a.high, nullptr, bake_options(512));
   const Errors faces = measure(a, r, {0, 1});
   record(a.name + " faces", faces, r);
   EXPECT_GT(faces.texels, 30000u);
@@ -79,7 +74,7 @@ TEST(RobustHits, ThinShellTakesNoNormalFromTheOtherSide) {
 
 TEST(RobustHits, RodInABoreTakesNoNormalFromTheOtherPart) {
   const HardAsset a = procedural::make_cavity();
-  const BakeResult r = bake_normal_map(a.low, a.high, nullptr, options(512));
+  const BakeResult r = bake_normal_map(a.low, a.high, nullptr, bake_options(512));
   const Errors e = measure(a, r);
   record(a.name, e, r);
   EXPECT_GT(e.texels, 50000u);
@@ -90,7 +85,7 @@ TEST(RobustHits, RodInABoreTakesNoNormalFromTheOtherPart) {
 
 TEST(RobustHits, BevelledBoxFollowsTheBevels) {
   const HardAsset a = procedural::make_bevelled_box();
-  const BakeResult r = bake_normal_map(a.low, a.high, nullptr, options(512));
+  const BakeResult r = bake_normal_map(a.low, a.high, nullptr, bake_options(512));
   const Errors e = measure(a, r);
   record(a.name, e, r);
   EXPECT_GT(e.texels, 50000u);
@@ -103,10 +98,10 @@ TEST(RobustHits, FlippedWindingBakesLikeTheSoundMesh) {
   // A broken export: the high-poly wound the other way, with its (outward) normals kept, or
   // without normals (they are computed, inverted, from the winding; the probes find it inverted).
   const HardAsset sound = procedural::make_thin_shell();
-  const BakeResult ref = bake_normal_map(sound.low, sound.high, nullptr, options(256));
+  const BakeResult ref = bake_normal_map(sound.low, sound.high, nullptr, bake_options(256));
   for (bool keep_normals : {true, false}) {
     const HardAsset a = procedural::flip_high_winding(sound, keep_normals);
-    const BakeResult r = bake_normal_map(a.low, a.high, nullptr, options(256));
+    const BakeResult r = bake_normal_map(a.low, a.high, nullptr, bake_options(256));
     const Errors e = measure(a, r, {0, 1});
     record(a.name, e, r);
     EXPECT_EQ(r.stats.distances.high_facing, keep_normals ? BakeStats::HighFacing::sound : BakeStats::HighFacing::inverted)
@@ -124,7 +119,7 @@ TEST(RobustHits, SuspectTexelsAreCountedAndMasked) {
   // Rays from one tube into the next (back faces kept, one global distance long enough for the
   // bulge) tilt whole stripes of texels: suspect. The default bake has next to none.
   const HardAsset a = procedural::make_close_tubes(0.012, 0.04);
-  BakeOptions o = options(256);
+  BakeOptions o = bake_options(256);
   o.suspect_mask = true;
   o.samples = 4;
   const BakeResult r = bake_normal_map(a.low, a.high, nullptr, o);
@@ -167,7 +162,7 @@ TEST(RobustHits, SamplesThatDisagreeMakeATexelSuspect) {
     const float cx = high.corner_position(t, 0).x + high.corner_position(t, 1).x + high.corner_position(t, 2).x;
     for (int c = 0; c < 3; ++c) high.normal_index.push_back(cx > 3.0f / 64.0f ? 1u : 0u);
   }
-  BakeOptions o = options(64);
+  BakeOptions o = bake_options(64);
   o.samples = 16;
   o.front = o.rear = 2.0f;
   o.suspect_mask = true;
@@ -194,7 +189,7 @@ TEST(RobustHits, SculptsHaveAlmostNoTexelFacingAway) {
     LoadOptions lo;
     lo.require_uvs = true;
     const Mesh low = load_mesh(dir + "/low.obj", lo), high = load_mesh(dir + "/high.ply");
-    BakeOptions o = options(1024);
+    BakeOptions o = bake_options(1024);
     const BakeResult r = bake_normal_map(low, high, nullptr, o);
     const double share = double(r.stats.pad.texels_facing_away) / double(r.stats.trace.texels_covered);
     std::printf("measured: %s facing away %zu of %zu (%.4f%%), suspect %.4f%%, misses %llu of %llu samples\n", name,
@@ -243,7 +238,7 @@ TEST(RobustHits, CullingLeavesTheAutomaticCagesMapUnchanged) {
   for (std::uint32_t i : a.high.position_index) high.position_index.push_back(i + np);
   for (std::uint32_t i : a.high.normal_index) high.normal_index.push_back(i + nn);
   high.source_face.assign(high.triangle_count(), 0);
-  BakeOptions o = options(128);
+  BakeOptions o = bake_options(128);
   const BakeResult on = bake_normal_map(a.low, high, nullptr, o);
   o.cull_far = false;
   const BakeResult off = bake_normal_map(a.low, high, nullptr, o);
@@ -285,7 +280,7 @@ TEST(RobustHits, CageStopsBeforeANeighbouringPartsHighPoly) {
   };
   const Mesh low = join(sheet(0.0f, false, 0.0f), sheet(0.1f, true, 0.55f));
   const Mesh high = join(sheet(0.0f, false, 0.0f), sheet(0.03f, true, 0.55f));
-  const BakeResult r = bake_normal_map(low, high, nullptr, options(64));
+  const BakeResult r = bake_normal_map(low, high, nullptr, bake_options(64));
   ASSERT_EQ(r.cage_positions.size(), low.positions.size());
   std::printf("measured: scene front %.4f, A's cage at z %.5f\n", r.stats.distances.scene_front, double(r.cage_positions[0].z));
   EXPECT_GT(r.stats.distances.scene_front, 0.08);

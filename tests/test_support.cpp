@@ -176,6 +176,14 @@ CliRun run_nmbake(const std::string& args, const std::string& prefix, const std:
 
 bool contains(const std::string& s, const std::string& what) { return s.find(what) != std::string::npos; }
 
+BakeOptions bake_options(int size, int samples, int padding) {
+  BakeOptions o;
+  o.width = o.height = size;
+  o.samples = samples;
+  o.padding = padding;
+  return o;
+}
+
 Mesh make_grid(int nx, int ny, float x0, float x1, float y0, float y1) {
   Mesh m;
   m.source = "grid";

@@ -76,6 +76,9 @@ std::vector<std::string> shell_words(const std::string& line);
 // Whether `what` occurs in `s`.
 bool contains(const std::string& s, const std::string& what);
 
+// A size x size bake of the normal map with `samples` per texel and `padding` texels of padding.
+BakeOptions bake_options(int size, int samples = 1, int padding = 0);
+
 // A planar grid of nx x ny quads (two triangles each) covering [x0,x1] x [y0,y1] at z = 0,
 // normals +Z, UVs mapping the grid onto [0,1]^2 (u along x, v along y).
 Mesh make_grid(int nx, int ny, float x0 = -1, float x1 = 1, float y0 = -1, float y1 = 1);

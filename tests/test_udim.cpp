@@ -24,6 +24,8 @@ using namespace nmbake;
 
 namespace {
 
+using test::bake_options;
+
 using nmbake::test::kPi;
 
 // The low-poly's surface, a gentle dome, and the high-poly's: the dome with bumps on it.
@@ -143,28 +145,21 @@ std::size_t bumpy_texels(const BakeResult& r) {
   return n;
 }
 
-BakeOptions options(int size) {
-  BakeOptions o;
-  o.width = o.height = size;
-  o.padding = 4;
-  return o;
-}
-
 }  // namespace
 
 TEST(Udim, ThreeTilesEqualThreeSingleTileBakes) {
   const Mesh low = three_tile_low(), high = bumpy_high();
   const UdimLayout layout = find_udim_tiles(low);
   ASSERT_EQ(layout.tiles.size(), 3u);
-  BakeOptions automatic = options(64);  // the automatic cage: distances measured per vertex
+  BakeOptions automatic = bake_options(64, 1, 4);  // the automatic cage: distances measured per vertex
   automatic.miss_mask = automatic.suspect_mask = true;
-  BakeOptions closest = options(48);  // fixed distances, 4 samples, both ways
+  BakeOptions closest = bake_options(48, 1, 4);  // fixed distances, 4 samples, both ways
   closest.front = closest.rear = 0.1f;
   closest.samples = 4;
   closest.policy = RayPolicy::closest;
   // A cage file: the automatic cage of the first bake, moved out a little more, with --rear.
   Mesh cage = low;
-  BakeOptions with_cage = options(40);
+  BakeOptions with_cage = bake_options(40, 1, 4);
   with_cage.rear = 0.08f;
   with_cage.threads = 1;
   for (int run = 0; run < 3; ++run) {
@@ -208,7 +203,7 @@ TEST(Udim, ThreeTilesEqualThreeSingleTileBakes) {
 // the bake kept once for all tiles (with the automatic cage) gives the tile's own texels, bit for bit.
 TEST(Udim, RebakedTileTexelsMatchTheTile) {
   const Mesh low = three_tile_low(), high = bumpy_high();
-  BakeOptions o = options(48);
+  BakeOptions o = bake_options(48, 1, 4);
   o.keep_trace = true;
   const UdimBake udim = bake_udim_tiles(low, high, nullptr, o);
   ASSERT_TRUE(udim.trace_inputs);
@@ -231,7 +226,7 @@ TEST(Udim, RebakedTileTexelsMatchTheTile) {
 
 TEST(Udim, OneTileInTheUnitSquareIsThePlainBake) {
   const Mesh low = test::make_height_field(10, 10, dome, dome_normal), high = bumpy_high();
-  const BakeOptions o = options(64);
+  const BakeOptions o = bake_options(64, 1, 4);
   const UdimBake udim = bake_udim_tiles(low, high, nullptr, o);
   ASSERT_EQ(udim.tiles.size(), 1u);
   EXPECT_EQ(udim.tiles[0].tile.number, 1001);
@@ -250,7 +245,7 @@ TEST(Udim, OverlapIsCountedPerTile) {
       return glm::vec2(float((right ? right_tile_u : 0) + 0.1 + 0.8 * (right ? p.x : p.x + 1.0)), float(0.1 + 0.4 * (p.y + 1.0)));
     });
   };
-  BakeOptions o = options(48);
+  BakeOptions o = bake_options(48, 1, 4);
   o.front = o.rear = 0.1f;
   const UdimBake apart = bake_udim_tiles(stacked(1), high, nullptr, o);
   ASSERT_EQ(apart.tiles.size(), 2u);
@@ -294,7 +289,7 @@ TEST(Udim, TrianglesInNoTileAreCountedAndLeftOut) {
   EXPECT_EQ(layout.tiles[1].number, 1002);
   EXPECT_EQ(layout.tiles[0].triangles + layout.tiles[1].triangles + expected_outside, low.triangle_count());
 
-  BakeOptions o = options(48);
+  BakeOptions o = bake_options(48, 1, 4);
   o.front = o.rear = 0.1f;
   const UdimBake udim = bake_udim_tiles(low, high, nullptr, o);
   ASSERT_EQ(udim.tiles.size(), 2u);
@@ -330,7 +325,7 @@ TEST(Udim, LayoutCountsTrianglesAndTexelsPerTile) {
   EXPECT_EQ(layout.texels_beyond_first(), layout.tiles[1].texels + layout.tiles[2].texels);
   // Without a size no texel is counted; with one sample the bake covers the same texels.
   EXPECT_EQ(find_udim_tiles(low).tiles[1].texels, 0u);
-  BakeOptions o = options(64);
+  BakeOptions o = bake_options(64, 1, 4);
   o.front = o.rear = 0.1f;
   const UdimBake udim = bake_udim_tiles(low, high, nullptr, o);
   for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(udim.tiles[i].result.stats.trace.texels_covered, layout.tiles[i].texels);
@@ -359,7 +354,7 @@ TEST(Udim, StraddlingTriangleIsCutAtItsTilesEdge) {
   EXPECT_EQ(layout.tiles[1].straddling, 1u);
   EXPECT_EQ(layout.straddling_triangles, 1u);
 
-  BakeOptions o = options(40);
+  BakeOptions o = bake_options(40, 1, 4);
   o.front = o.rear = 0.1f;
   const UdimBake udim = bake_udim_tiles(low, high, nullptr, o);
   EXPECT_EQ(udim.stats.prepare.uv_outside_triangles, 1u);
@@ -394,7 +389,7 @@ TEST(Udim, MirroredAndZeroAreaUvsInATileStayFinite) {
       default: return t == 4 ? glm::vec2(1.5f, 0.5f) : glm::vec2(float(2.2 + 0.3 * s), 0.5f);  // a point; a line
     }
   });
-  BakeOptions o = options(32);
+  BakeOptions o = bake_options(32, 1, 4);
   o.front = o.rear = 0.1f;
   o.samples = 4;
   const UdimBake udim = bake_udim_tiles(low, high, nullptr, o);
@@ -422,7 +417,7 @@ TEST(Udim, MirroredAndZeroAreaUvsInATileStayFinite) {
 
 TEST(Udim, MemoryCheckCountsEveryTile) {
   const Mesh low = three_tile_low(), high = bumpy_high();
-  BakeOptions o = options(64);
+  BakeOptions o = bake_options(64, 1, 4);
   o.front = o.rear = 0.1f;
   o.memory_limit = 2 * estimate_bake_bytes(o);  // two maps fit, three do not
   try {
@@ -437,7 +432,7 @@ TEST(Udim, MemoryCheckCountsEveryTile) {
 
 TEST(Udim, StagesAnnouncedOnceAndProgressRunsOverAllTiles) {
   const Mesh low = three_tile_low(), high = bumpy_high();
-  BakeOptions o = options(48);
+  BakeOptions o = bake_options(48, 1, 4);
   std::vector<std::string> stages;
   std::vector<double> progress;
   o.on_stage = [&](const char* s) { stages.push_back(s); };
@@ -461,7 +456,7 @@ TEST(Udim, StagesAnnouncedOnceAndProgressRunsOverAllTiles) {
 TEST(Udim, NoTriangleInAnyTileIsAnInputError) {
   Mesh low = three_tile_low();
   for (glm::vec2& uv : low.uvs) uv.x -= 12.0f;
-  EXPECT_THROW(bake_udim_tiles(low, bumpy_high(), nullptr, options(16)), InputError);
+  EXPECT_THROW(bake_udim_tiles(low, bumpy_high(), nullptr, bake_options(16, 1, 4)), InputError);
 }
 
 namespace {

@@ -14,6 +14,7 @@
 #include "cli/outputs.h"
 #include "cli/progress.h"
 #include "cli/shell.h"
+#include "core/stopwatch.h"
 #include "core/errors.h"
 #include "io/text_file.h"
 #include "pipeline/bake.h"
@@ -314,12 +315,12 @@ int run_batch(const BatchArgs& b, const std::function<bool()>& interrupted, cons
                        {"output", a.output},
                        {"exit_code", code},
                        {"error", code ? nlohmann::json(error) : nlohmann::json(nullptr)},
-                       {"seconds", std::chrono::duration<double>(Clock::now() - t0).count()},
+                       {"seconds", seconds_since(t0)},
                        {"report", code ? nlohmann::json(nullptr) : report}});
     if (interrupted()) throw Cancelled();
   }
   progress.finish();
-  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  const double seconds = seconds_since(start);
   std::size_t bvh_reused = 0;
   for (const auto& [key, high] : cache.highs) bvh_reused += high->bvh.reused;
   if (!b.report.empty()) {

@@ -14,6 +14,7 @@
 #include "cli/report.h"
 #include "cli/udim_outputs.h"
 #include "cli/warnings.h"
+#include "core/stopwatch.h"
 #include "core/errors.h"
 #include "core/normals.h"
 #include "core/parallel.h"
@@ -486,7 +487,7 @@ void bake_job(const Args& a, const JobEnv& env) {
   Mesh cage;
   if (!a.cage.empty()) cage = load_as("--cage", a.cage, shared, &run.cage_info);
   const Mesh* cage_mesh = a.cage.empty() ? nullptr : &cage;
-  run.seconds_load = std::chrono::duration<double>(Clock::now() - t0).count();
+  run.seconds_load = seconds_since(t0);
   run.low_objects = object_list(low);
   run.high_objects = object_list(high);
   if (a.match == "names") run.match = match_by_names(run.low_objects, run.high_objects, a.match_suffixes, o);
@@ -552,7 +553,7 @@ void bake_job(const Args& a, const JobEnv& env) {
   env.progress.stage("writing", false);  // not redrawn while the encoders' stderr is redirected
   t0 = Clock::now();
   write_outputs(env, outputs, a, o, r, udim ? &*udim : nullptr, low, bits);
-  run.seconds_write = std::chrono::duration<double>(Clock::now() - t0).count();
+  run.seconds_write = seconds_since(t0);
   *env.doing = "checking the high-poly's topology";
   run.high_topology = topology.get();
   if (env.keep_progress) env.progress.hold();
@@ -562,7 +563,7 @@ void bake_job(const Args& a, const JobEnv& env) {
   warnings.add(map_warnings(udim ? (udim->tiles.empty() ? r : udim->tiles.front().result) : r, bits));
   warnings.check_strict();
   run.warnings = warnings.all();
-  run.seconds_total = std::chrono::duration<double>(Clock::now() - env.start).count();
+  run.seconds_total = seconds_since(env.start);
   run.peak_memory_bytes = peak_memory_bytes();
   run.threads_used = unsigned(worker_threads(a.threads));
   *env.doing = "writing the report";

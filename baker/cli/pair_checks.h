@@ -10,20 +10,15 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
+#include "core/bounds.h"
 #include "core/mesh.h"
 #include "core/uv_overlap.h"
 
 namespace nmbake {
 
-// Axis-aligned box in the files' coordinates (the meshes' origin added back).
-struct Box {
-  glm::dvec3 lo{0.0}, hi{0.0};
-  double diagonal() const { return glm::length(hi - lo); }
-};
-
 // How the low-poly's and the high-poly's boxes compare.
 struct PairBoxes {
-  Box low, high;
+  Box low, high;  // in the files' coordinates (the meshes' origin added back)
   // The larger box diagonal over the smaller (1: the same size).
   double size_ratio = 1.0;
   // Along the axis where the boxes overlap least, the length they share over the smaller of the

@@ -12,6 +12,12 @@
 
 namespace nmbake {
 
+// An axis-aligned box, lo <= hi on each axis for a box that holds anything.
+struct Box {
+  glm::dvec3 lo{0.0}, hi{0.0};
+  double diagonal() const { return glm::length(hi - lo); }
+};
+
 // Grows [lo, hi] by the points `index` refers to (a vertex no face uses, a stray point far away,
 // does not count), in chunks on `threads` threads (0: all cores), each chunk's box joined to the
 // others' after: smallest and largest values, so the same whatever the order. In double.

@@ -12,11 +12,9 @@
 
 #include <glm/glm.hpp>
 
-namespace nmbake {
+#include "core/bounds.h"
 
-struct Box {
-  glm::dvec3 lo{0.0}, hi{0.0};
-};
+namespace nmbake {
 
 // The high-poly triangles (index triples into `positions`) whose bounding box overlaps some box of
 // `regions` grown by `margin` on every side, in increasing order. `candidates`, when not null,

@@ -14,6 +14,7 @@
 #include <thread>
 #include <utility>
 
+#include "core/stopwatch.h"
 #include "core/parallel.h"
 #include "pipeline/bvh.h"
 #include "pipeline/distances.h"
@@ -31,7 +32,6 @@ namespace nmbake {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 }  // namespace
 

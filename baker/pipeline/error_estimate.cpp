@@ -1,5 +1,6 @@
 #include "pipeline/error_estimate.h"
 
+#include "core/stopwatch.h"
 #include "core/codec.h"
 #include "core/parallel.h"
 #include "pipeline/bake_stages.h"
@@ -100,7 +101,7 @@ ErrorEstimate estimate_bake_error(const Mesh& low, const TraceInputs& traced, co
     std::nth_element(err.begin(), err.begin() + std::ptrdiff_t(k), err.end());
     e.p95_deg = err[k];
   }
-  e.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  e.seconds = seconds_since(t0);
   return e;
 }
 

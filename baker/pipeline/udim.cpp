@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/stopwatch.h"
 #include "core/parallel.h"
 #include "core/rasterize.h"
 #include "pipeline/bake_stages.h"
@@ -21,7 +22,6 @@ namespace nmbake {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // The tile holding triangle t's UV centroid as u + 10 v, or -1 when none does (NaN fails every
 // comparison, so a non-finite UV lands in no tile).
