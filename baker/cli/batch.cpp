@@ -192,18 +192,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-std::string read_jobs_file(const std::string& path) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) throw InputError(path + ": cannot read: " + std::strerror(errno));
-  std::string text;
-  char buf[65536];
-  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;) text.append(buf, n);
-  const bool failed = std::ferror(f) != 0;
-  std::fclose(f);
-  if (failed) throw InputError(path + ": cannot read");
-  return text;
-}
-
 // Each job's command line as nmbake parses it; every problem found before the first bake.
 std::vector<Args> check_jobs(const std::string& path, const std::vector<BatchJob>& jobs) {
   std::vector<Args> all(jobs.size());
@@ -258,7 +246,7 @@ nlohmann::json shared_options(const BatchArgs& b) {
 
 int run_batch(const BatchArgs& b, const std::function<bool()>& interrupted, const char** doing, Clock::time_point start) {
   if (!b.merge.empty()) return run_merge_reports(b.merge, b.merged, b.quiet > 0);
-  const std::string text = read_jobs_file(b.file);
+  const std::string text = read_text_file(b.file);
   const std::vector<BatchJob> jobs = parse_batch(b.file, text, shared_options(b));
   const std::vector<Args> args = check_jobs(b.file, jobs);  // every job, also other parts': each part refuses a wrong file
   if (!b.report.empty()) check_output_files({{"--batch", b.file, "the jobs"}}, {{"--report", b.report, "the batch report"}});

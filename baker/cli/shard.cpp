@@ -26,18 +26,6 @@ long long shard_number(const std::string& word) {
   return n;
 }
 
-std::string read_part_report(const std::string& path) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) throw InputError(path + ": cannot read: " + std::strerror(errno));
-  std::string text;
-  char buf[65536];
-  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;) text.append(buf, n);
-  const bool failed = std::ferror(f) != 0;
-  std::fclose(f);
-  if (failed) throw InputError(path + ": cannot read");
-  return text;
-}
-
 // A part's "shard" as its report holds it, checked for what the merge reads.
 struct PartInfo {
   int index = 0, count = 0;
@@ -249,7 +237,7 @@ int run_merge_reports(const std::vector<std::string>& paths, const std::string& 
   check_output_files(inputs, {{"--output", output, "the batch report"}});
   std::vector<nlohmann::json> parts;
   for (const std::string& p : paths) {
-    const std::string text = read_part_report(p);
+    const std::string text = read_text_file(p);
     try {
       parts.push_back(nlohmann::json::parse(text));
     } catch (const nlohmann::json::parse_error& e) {

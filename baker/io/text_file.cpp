@@ -56,4 +56,16 @@ void write_text_atomically(const std::string& path, const std::string& text) {
   }
 }
 
+std::string read_text_file(const std::string& path) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) throw InputError(path + ": cannot read: " + std::strerror(errno));
+  std::string text;
+  char buf[65536];
+  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;) text.append(buf, n);
+  const bool failed = std::ferror(f) != 0;
+  std::fclose(f);
+  if (failed) throw InputError(path + ": cannot read");
+  return text;
+}
+
 }  // namespace nmbake

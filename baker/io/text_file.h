@@ -1,5 +1,5 @@
-// Text outputs (reports, JSON, cages) written like the maps: to a temporary file, renamed into
-// place only when complete, so a failed write never leaves a partial file or loses the old one.
+// Text inputs read whole (jobs files, batch reports), and text outputs (reports, JSON, cages) written like the maps: to a
+// temporary file, renamed into place only when complete, so a failed write never leaves a partial file or loses the old one.
 #pragma once
 
 #include <cstddef>
@@ -18,5 +18,8 @@ void write_bytes_file(const std::string& path, const std::string& temp, const vo
 // write_text_file to a temporary file beside `path`, then renamed over it. Throws OutputError
 // "<path>: cannot write: <reason>" (the temporary removed).
 void write_text_atomically(const std::string& path, const std::string& text);
+
+// The whole file at `path`, as bytes. Throws InputError "<path>: cannot read[: <reason>]".
+std::string read_text_file(const std::string& path);
 
 }  // namespace nmbake
