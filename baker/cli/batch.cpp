@@ -8,9 +8,8 @@
 
 #include <unistd.h>
 
-#include <cerrno>
-
 #include "cli/job.h"
+#include "cli/json_file.h"
 #include "cli/outputs.h"
 #include "cli/progress.h"
 #include "cli/shell.h"
@@ -71,14 +70,7 @@ const nlohmann::json& object_field(const nlohmann::json& parent, const char* key
 }  // namespace
 
 std::vector<BatchJob> parse_batch(const std::string& path, const std::string& text, const nlohmann::json& shared) {
-  nlohmann::json doc;
-  try {
-    doc = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    std::string what = e.what();  // "[json.exception.parse_error.101] parse error at line 3, column 5: ..."
-    const auto at = what.find("parse error");
-    throw InputError(path + ": not valid JSON: " + (at == std::string::npos ? what : what.substr(at)));
-  }
+  const nlohmann::json doc = parse_json_file_text(path, text);
   if (!doc.is_object() || !doc.contains("jobs") || !doc["jobs"].is_array())
     throw InputError(path + ": expected an object with \"jobs\": [...] (and optionally \"defaults\": {...})");
   for (const auto& [key, value] : doc.items())

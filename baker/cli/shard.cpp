@@ -1,16 +1,16 @@
 #include "cli/shard.h"
 
 #include <algorithm>
-#include <cerrno>
 #include <charconv>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <map>
 #include <set>
 #include <system_error>
 
+#include "cli/json_file.h"
 #include "core/errors.h"
+#include "core/fnv.h"
 #include "io/output_files.h"
 #include "io/text_file.h"
 
@@ -151,10 +151,8 @@ std::vector<std::vector<std::size_t>> split_jobs(const std::vector<ShardJob>& jo
 }
 
 std::string jobs_file_fingerprint(const std::string& text) {
-  std::uint64_t h = 0xcbf29ce484222325ull;  // FNV-1a, 64 bits
-  for (unsigned char c : text) h = (h ^ c) * 0x100000001b3ull;
   char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(fnv1a64(text)));
   return std::string("fnv1a64:") + hex;
 }
 
@@ -236,16 +234,7 @@ int run_merge_reports(const std::vector<std::string>& paths, const std::string& 
   for (const std::string& p : paths) inputs.push_back({"--merge-reports", p, "a part's report"});
   check_output_files(inputs, {{"--output", output, "the batch report"}});
   std::vector<nlohmann::json> parts;
-  for (const std::string& p : paths) {
-    const std::string text = read_text_file(p);
-    try {
-      parts.push_back(nlohmann::json::parse(text));
-    } catch (const nlohmann::json::parse_error& e) {
-      const std::string what = e.what();
-      const auto at = what.find("parse error");
-      throw InputError(p + ": not valid JSON: " + (at == std::string::npos ? what : what.substr(at)));
-    }
-  }
+  for (const std::string& p : paths) parts.push_back(parse_json_file_text(p, read_text_file(p)));
   const nlohmann::json merged = merge_batch_reports(paths, parts);
   write_text_atomically(output, merged.dump(2) + "\n");
   int first_failure = 0;

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "core/curvature.h"
+#include "core/fnv.h"
 #include "core/padding.h"
 #include "core/parallel.h"
 
@@ -22,8 +23,7 @@ std::string number(double v) {
 }
 
 std::uint64_t name_hash(const std::string& name) {
-  std::uint64_t h = 0xcbf29ce484222325ull;  // FNV-1a, 64 bits
-  for (unsigned char c : name) h = (h ^ c) * 0x100000001b3ull;
+  std::uint64_t h = fnv1a64(name);
   h ^= h >> 29;  // spread the last characters into the high bits
   h *= 0xbf58476d1ce4e5b9ull;
   return h ^ (h >> 32);
