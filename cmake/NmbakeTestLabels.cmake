@@ -2,7 +2,9 @@
 #   fast        the unit and known-answer tests and the commands' plain cases: what to run while
 #               editing (`ctest -L fast`);
 #   robustness  hostile inputs, faults, limits, signals, closed streams, thread identity, install;
-#   viewer      what runs nmview or the viewer's code (llvmpipe: slow on the CPU).
+#   viewer      what runs nmview or the viewer's code (llvmpipe: slow on the CPU);
+#   integration where others call nmbake: the Python module, the Blender add-on, a Slurm array job
+#               (python.*, blender.*, slurm.*; never under the sanitizers).
 # GoogleTest programs label their tests where they are discovered. nmbake_label_tests(), called at
 # the end of each folder's CMakeLists.txt, labels that folder's other tests by name: one rule here,
 # whichever folder adds a test. The test tests_labelled fails when a test has none.
@@ -15,6 +17,8 @@ function(nmbake_label_tests)
     endif()
     if(name MATCHES "^cli\\.nmview\\.")
       set(labels viewer)
+    elseif(name MATCHES "^(python|blender|slurm)\\.")
+      set(labels integration)
     elseif(name MATCHES "hostile|assimp_malformed|fault_injection|disk_full|under_ulimit|beyond_memory_budget|signals|interrupt|output_contract|^cli\\.nmbake\\.outputs$|gltf_buffer|\\.numbers$|image_module|^install\\.|^threads\\.|^fuzz\\.")
       set(labels robustness)
     else()
