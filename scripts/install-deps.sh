@@ -5,6 +5,9 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 lists=("$root/scripts/packages.txt")
 if [ "${NMBAKE_VIEWER:-ON}" != "OFF" ] && [ -f "$root/viewer/packages.txt" ]; then lists+=("$root/viewer/packages.txt"); fi
+# What only the test command needs (scripts/test.sh sets NMBAKE_TEST_DEPS=1): the peers the
+# integration tests drive (tests/packages.txt).
+if [ "${NMBAKE_TEST_DEPS:-0}" = 1 ] && [ -f "$root/tests/packages.txt" ]; then lists+=("$root/tests/packages.txt"); fi
 missing=()
 for pkg in $(grep -hv '^\s*#' "${lists[@]}" | tr -s ' \t' '\n' | sed '/^$/d' | sort -u); do
   if ! dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q 'install ok installed'; then missing+=("$pkg"); fi

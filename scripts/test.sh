@@ -12,7 +12,7 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${NMBAKE_BUILD_DIR:-$root/build}
 parts=${NMBAKE_TEST_PARTS:-lint unit asan fuzz}
-bash "$root/scripts/install-deps.sh"
+NMBAKE_TEST_DEPS=1 bash "$root/scripts/install-deps.sh"
 summary=()
 for part in $parts; do
   start=$(date +%s)
