@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian packages nmbake needs that are not installed yet (needs root).
-# Lists: scripts/packages.txt (baker, tests) and viewer/packages.txt (unless NMBAKE_VIEWER=OFF).
+# Lists: scripts/packages.txt (baker, tests), viewer/packages.txt (unless NMBAKE_VIEWER=OFF) and
+# tests/packages.txt (with NMBAKE_TEST_DEPS=1: the test command).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 lists=("$root/scripts/packages.txt")
