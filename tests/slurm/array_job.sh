@@ -13,7 +13,7 @@
 set -euo pipefail
 # Absolute: the batch runs in the jobs' folders and reads paths relative to them.
 nmbake=$(realpath "$1") repo=$(realpath "$2") work=$(realpath -m "$3")
-for tool in sbatch squeue sinfo scancel slurmctld slurmd munged mungekey; do
+for tool in sbatch squeue sinfo scancel scontrol slurmctld slurmd munged mungekey; do
   if ! command -v "$tool" >/dev/null; then
     echo "SKIP: $tool is not installed (Debian: slurmctld slurmd slurm-client munge; tests/packages.txt)"
     exit 77
