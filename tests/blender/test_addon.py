@@ -129,6 +129,11 @@ def case_registers():
     check(s.size == 2048 and s.maps == {"normal"} and s.green == "up" and s.cage_mode == "AUTO", "the defaults are nmbake's")
     prefs().executable = ARGS.nmbake
     prefs().keep_exported = True
+    from nmbake_blender import runner
+
+    check(runner.parse_progress("nmbake: tracing  42% [############......] 3.1 s, about 4.2 s left") == ("tracing", 42)
+          and runner.parse_progress("nmbake: building the BVH, 1.2 s") == ("building the BVH", None)
+          and runner.parse_progress("nmbake: wrote a.png (64x64): samples 1") is None, "nmbake's progress line is read")
 
 
 def make_pair():
@@ -234,6 +239,30 @@ def case_cage(low, high):
     bpy.data.objects.remove(cage)
 
 
+def case_texture_set(low, high):
+    """normal, ao, object-id and vertex-color (the high-poly's colour attribute, red) as UDIM
+    images: colour spaces, the tile, the colour."""
+    colors = high.data.color_attributes.new("Col", "FLOAT_COLOR", "POINT")
+    for c in colors.data:
+        c.color = (1.0, 0.0, 0.0, 1.0)
+    high.data.color_attributes.active_color = colors
+    select(low, [high])
+    bake(os.path.join(WORK, "set", "set_<MAP>.<UDIM>.png"), size=32, maps={"normal", "ao", "object-id", "vertex-color"},
+         extra_args="--ao-rays 4")
+    high.data.color_attributes.remove(colors)
+    for name in ("normal", "ao", "object-id", "vertex-color"):
+        check(os.path.isfile(os.path.join(WORK, "set", "set_%s.1001.png" % name)), "the texture set wrote set_%s.1001.png" % name)
+    space = {i.name: (i.source, i.colorspace_settings.name) for i in bpy.data.images if i.name.startswith("set_")}
+    print("  images:", space)
+    check(space.get("set_normal.1001.png") == ("TILED", "Non-Color") and space.get("set_ao.1001.png") == ("TILED", "Non-Color"),
+          "normal and ao are Non-Color UDIM images")
+    check(space.get("set_vertex-color.1001.png") == ("TILED", "sRGB"), "vertex-color is an sRGB UDIM image")
+    image = bpy.data.images.get("set_vertex-color.1001.png")
+    pixels = list(image.pixels) if image is not None else []
+    centre = pixels[4 * (16 * 32 + 16) : 4 * (16 * 32 + 16) + 3]
+    check(len(centre) == 3 and centre[0] > 0.9 and centre[1] < 0.1 and centre[2] < 0.1, "the high-poly's colour is baked (%s)" % centre)
+
+
 def case_uv_orientation():
     """A plane whose UVs fill the lower-left quarter, under a tilted plane: Blender's image
     (pixels from the bottom-left) has the tilted normal there and the flat one far from it."""
@@ -306,6 +335,7 @@ def main():
         reference = case_pair(low, high)
         case_transforms(low, high, reference)
         case_cage(low, high)
+        case_texture_set(low, high)
         case_uv_orientation()
         case_refusals()
     except Exception:
