@@ -83,8 +83,9 @@ def _active_colors(me):
     """(domain, RGBA floats, scene-linear) of the active colour attribute, or (None, None)."""
     attrs = getattr(me, "color_attributes", None)
     layer = attrs.active_color if attrs is not None else None
-    if layer is None and len(me.vertex_colors):  # before 3.2: per-corner byte colours
-        layer = me.vertex_colors.active
+    legacy = getattr(me, "vertex_colors", None)  # per-corner byte colours, gone in Blender 4
+    if layer is None and legacy is not None and legacy.active is not None:
+        layer = legacy.active
         data = _floats(4 * len(me.loops))
         layer.data.foreach_get("color", data)
         return "CORNER", data

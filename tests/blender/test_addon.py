@@ -136,6 +136,42 @@ def case_registers():
           and runner.parse_progress("nmbake: wrote a.png (64x64): samples 1") is None, "nmbake's progress line is read")
 
 
+class _FakeLayout:
+    """Stands in for the panel's UILayout: checks that each prop names a property of its data and
+    each operator exists."""
+
+    def __init__(self, seen):
+        self.seen = seen
+
+    def __getattr__(self, _name):
+        return lambda *args, **kwargs: self
+
+    def prop(self, data, name, **_kwargs):
+        if not hasattr(data, name):
+            raise AttributeError("the panel draws %r, which %s lacks" % (name, data))
+        self.seen.append(name)
+        return self
+
+    def operator(self, idname, **_kwargs):
+        category, name = idname.split(".")
+        if name not in dir(getattr(bpy.ops, category)):
+            raise AttributeError("the panel's operator %s does not exist" % idname)
+        self.seen.append(idname)
+        return self
+
+
+def case_panel_draws():
+    seen = []
+    panel = type("PanelStandIn", (), {"layout": _FakeLayout(seen)})()
+    s = bpy.context.scene.nmbake
+    for mode in ("AUTO", "DISTANCE", "OBJECT"):
+        s.cage_mode = mode
+        bpy.types.RENDER_PT_nmbake.draw(panel, bpy.context)
+    s.cage_mode = "AUTO"
+    wanted = {"size", "samples", "maps", "output", "green", "cage_mode", "front", "rear", "cage_object", "wire_material", "object.nmbake_bake"}
+    check(wanted <= set(seen), "the panel draws the bake's properties and its button (missing: %s)" % sorted(wanted - set(seen)))
+
+
 def make_pair():
     for o in list(bpy.data.objects):
         bpy.data.objects.remove(o)
@@ -332,6 +368,7 @@ def main():
     try:
         case_registers()
         low, high = make_pair()
+        case_panel_draws()
         reference = case_pair(low, high)
         case_transforms(low, high, reference)
         case_cage(low, high)
