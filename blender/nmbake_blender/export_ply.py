@@ -27,7 +27,9 @@ def _floats(n):
 
 
 def _ints(n):
-    return array.array("i", bytes(4 * n))
+    # "I": the type of Blender's index properties, which foreach_get copies at once (with "i" it
+    # goes item by item, 7 to 15 times slower).
+    return array.array("I", bytes(4 * n))
 
 
 class WorldMesh:
@@ -114,10 +116,6 @@ def write_mesh(path, wm, uv_layer=None, colors=False, comment=""):
     nv, nt = len(me.vertices), len(me.loop_triangles)
     co = _floats(3 * nv)
     me.vertices.foreach_get("co", co)
-    tri_loops = _ints(3 * nt)
-    me.loop_triangles.foreach_get("loops", tri_loops)
-    loop_vert = _ints(len(me.loops))
-    me.loops.foreach_get("vertex_index", loop_vert)
     col_domain, col = _active_colors(me) if colors else (None, None)
 
     if uv_layer is None and not _normals_per_corner(me) and col_domain != "CORNER":
@@ -132,6 +130,10 @@ def write_mesh(path, wm, uv_layer=None, colors=False, comment=""):
         _write_ply(path, co, normals, None, rgb, tris, comment)
         return Layout(list(range(nv)), [None] * nv, tris)
 
+    tri_loops = _ints(3 * nt)
+    me.loop_triangles.foreach_get("loops", tri_loops)
+    loop_vert = _ints(len(me.loops))
+    me.loops.foreach_get("vertex_index", loop_vert)
     normals = _corner_normals(me)
     uvs = None
     if uv_layer is not None:
