@@ -6,7 +6,8 @@ so one file unit is one metre with metric units, one Blender unit otherwise; Ble
 kept (no axis conversion: nmbake reads the file's coordinates as they are, so object-space maps
 (object-normal, position) are in Blender's world axes). Normals are the mesh's own (split/corner
 normals where a face is flat, an edge sharp or normals custom), transformed with the positions
-(Mesh.transform); a negative-determinant transform flips the windings back.
+(Mesh.transform); a mirroring (negative-determinant) transform's windings and normals are turned
+back, as Blender draws them.
 
 Vertices: one PLY vertex per distinct (vertex, normal, UV, colour) of the triangles' corners, so
 nmbake's MikkTSpace frames and per-vertex cage see the mesh as Blender does. UVs are written as
@@ -43,8 +44,10 @@ class WorldMesh:
         self.mesh = bpy.data.meshes.new_from_object(obj_eval, preserve_all_data_layers=True, depsgraph=depsgraph)
         matrix = mathutils.Matrix.Scale(scale, 4) @ obj.matrix_world
         self.mesh.transform(matrix)
-        if matrix.is_negative and hasattr(self.mesh, "flip_normals"):
-            self.mesh.flip_normals()
+        # A mirroring transform turns the faces inside out (Mesh.transform keeps the windings and
+        # the normals follow them; Blender draws such an object turned back): the writer reverses
+        # the windings and the normals.
+        self.mirrored = matrix.is_negative
         self.mesh.calc_loop_triangles()
 
     def free(self):
@@ -127,6 +130,8 @@ def write_mesh(path, wm, uv_layer=None, colors=False, comment=""):
         rgb = None
         if col is not None:
             rgb = bytes(_srgb_byte(col[4 * i + k]) for i in range(nv) for k in range(3))
+        if wm.mirrored:
+            _turn_back(normals, tris)
         _write_ply(path, co, normals, None, rgb, tris, comment)
         return Layout(list(range(nv)), [None] * nv, tris)
 
@@ -168,6 +173,8 @@ def write_mesh(path, wm, uv_layer=None, colors=False, comment=""):
         rgb = bytes(
             _srgb_byte(col[4 * (v if col_domain == "POINT" else c) + k]) for v, c in zip(vertex_of, corner_of) for k in range(3)
         )
+    if wm.mirrored:
+        _turn_back(out_n, tris)
     _write_ply(path, out_co, out_n, out_uv, rgb, tris, comment)
     return Layout(vertex_of, corner_of, tris)
 
@@ -188,7 +195,16 @@ def write_cage(path, wm_cage, layout, low_wm, uv_layer, comment=""):
         out_co[3 * k : 3 * k + 3] = co[3 * v : 3 * v + 3]
         out_n[3 * k : 3 * k + 3] = normals[3 * c : 3 * c + 3]
         out_uv[2 * k : 2 * k + 2] = uvs[2 * c : 2 * c + 2]
+    if low_wm.mirrored:  # the layout's triangles are turned back already
+        out_n = array.array("f", (-x for x in out_n))
     _write_ply(path, out_co, out_n, out_uv, None, layout.triangles, comment)
+
+
+def _turn_back(normals, tris):
+    """Reverses each triangle's winding and every normal (a mirrored object's mesh)."""
+    for i in range(len(normals)):
+        normals[i] = -normals[i]
+    tris[1::3], tris[2::3] = tris[2::3], tris[1::3]
 
 
 def _interleave(dest, record, offset, data, size):

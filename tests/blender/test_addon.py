@@ -229,28 +229,36 @@ def case_pair(low, high):
 
 
 def case_transforms(low, high, reference):
-    """Both objects moved, rotated and scaled together, the unit scale changed, and the low-poly's
-    mesh moved, turned and stretched against its object's transform (its world shape unchanged):
-    a map made without the objects' transforms would differ."""
+    """Both objects moved, rotated and scaled together, the unit scale changed, and the low-poly
+    (a copy) given a mirroring, stretching transform with its mesh moved the opposite way (its
+    faces turned to stay outwards: its world shape is the same): a map made without the objects'
+    transforms, or with a mirrored object inside out, would differ."""
+    import bmesh
     import mathutils
 
-    inner = mathutils.Matrix.LocRotScale((0.4, -0.3, 0.2), mathutils.Euler((0.2, 0.9, -0.4)), (1.0, 2.0, 0.5))
-    low.data.transform(inner.inverted())
-    for o in (low, high):
-        o.location = (3.0, -2.0, 1.5)
-        o.rotation_euler = (0.3, -0.5, 0.7)
-        o.scale = (2.5, 2.5, 2.5)
-    bpy.context.view_layer.update()
-    low.matrix_world = low.matrix_world @ inner
+    inner = mathutils.Matrix.LocRotScale((0.4, -0.3, 0.2), mathutils.Euler((0.2, 0.9, -0.4)), (1.0, 2.0, -0.5))
+    moved = low.copy()
+    moved.data = low.data.copy()
+    bpy.context.collection.objects.link(moved)
+    moved.data.transform(inner.inverted())
+    bm = bmesh.new()
+    bm.from_mesh(moved.data)
+    bmesh.ops.reverse_faces(bm, faces=list(bm.faces))
+    bm.to_mesh(moved.data)
+    bm.free()
+    outer = mathutils.Matrix.LocRotScale((3.0, -2.0, 1.5), mathutils.Euler((0.3, -0.5, 0.7)), (2.5, 2.5, 2.5))
+    moved.matrix_world = outer @ inner
+    high.matrix_world = outer
     bpy.context.scene.unit_settings.scale_length = 0.01
+    select(moved, [high])
     bake(os.path.join(WORK, "moved", "moved_<MAP>.png"))
-    for o in (low, high):
-        o.location, o.rotation_euler, o.scale = (0, 0, 0), (0, 0, 0), (1, 1, 1)
-    low.data.transform(inner)
+    bpy.data.objects.remove(moved)
+    high.matrix_world = mathutils.Matrix.Identity(4)
     bpy.context.scene.unit_settings.scale_length = 1.0
+    select(low, [high])
     d = nmdiff(os.path.join(WORK, "moved", "moved_normal.png"), reference, "moved")
     print("  moved vs in place: mean %.5f p99 %.5f max %.5f deg" % (d["mean_deg"], d["p99_deg"], d["max_deg"]))
-    check(d["mean_deg"] <= 0.05 and d["p99_deg"] <= 1.0, "moving, rotating and scaling both objects (and the unit scale) keeps the map")
+    check(d["mean_deg"] <= 0.05 and d["p99_deg"] <= 1.0, "moving, rotating, scaling and mirroring the objects (and the unit scale) keeps the map")
 
 
 def case_cage(low, high):
