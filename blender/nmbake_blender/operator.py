@@ -49,6 +49,7 @@ class _Job:
         self.output = None
         self.wire = False
         self.keep = False
+        self.stopped = False  # Esc
 
 
 def _check(context, s):
@@ -170,10 +171,13 @@ class OBJECT_OT_nmbake_bake(bpy.types.Operator):
             command = _command(executable, s, scale, low_path, high_paths, cage_path, job.maps, job.output, job.report_path)
             print("nmbake-blender: " + " ".join(shlex.quote(c) for c in command))
             job.run = runner.Run(command)
-        except OSError as e:
+        except OSError as e:  # a full disk, a folder not writable, an executable that will not run
             self._cleanup(context, job)
             self.report({"ERROR"}, "nmbake could not start: %s" % e)
             return None
+        except BaseException:
+            self._cleanup(context, job)
+            raise
         return job
 
     def _cleanup(self, context, job):
@@ -183,6 +187,9 @@ class OBJECT_OT_nmbake_bake(bpy.types.Operator):
 
     def _finish(self, context, job):
         try:
+            if job.run.returncode != 0 and job.stopped:
+                self.report({"WARNING"}, "nmbake: stopped (Esc); nothing written")
+                return {"CANCELLED"}
             if job.run.returncode != 0:
                 self.report({"ERROR"}, job.run.error)
                 return {"CANCELLED"}
@@ -232,7 +239,8 @@ class OBJECT_OT_nmbake_bake(bpy.types.Operator):
 
     def modal(self, context, event):
         job = self._job
-        if event.type == "ESC":
+        if event.type == "ESC" and event.value == "PRESS":
+            job.stopped = True
             job.run.cancel()
         if event.type != "TIMER":
             return {"PASS_THROUGH"}

@@ -213,6 +213,7 @@ def case_pair(low, high):
         report = json.load(f)
     check(report["coverage"] > 0.8 and report["misses"] <= report["rays"] * 0.01,
           "the bake hits (coverage %.3f, %d misses of %d rays)" % (report["coverage"], report["misses"], report["rays"]))
+    case_cancel(folder)
     image = bpy.data.images.get("addon_normal.png")
     check(image is not None and image.colorspace_settings.name == "Non-Color" and tuple(image.size) == (SIZE, SIZE),
           "the map is loaded as a Non-Color image")
@@ -226,6 +227,26 @@ def case_pair(low, high):
     texture = nodes.get("nmbake normal")
     check(texture is not None and texture.image == image, "... from the map's Image Texture")
     return addon
+
+
+def case_cancel(folder):
+    """What Esc does in the modal bake: the running nmbake is stopped (SIGTERM) and writes nothing."""
+    import time
+
+    from nmbake_blender import runner
+
+    out = os.path.join(WORK, "cancelled.png")
+    run = runner.Run([ARGS.nmbake, os.path.join(folder, "Low.ply"), os.path.join(folder, "High.ply"), "-o", out, "--size", "4096",
+                      "--samples", "64", "--progress"])
+    deadline = time.time() + 20.0
+    while run.stage == "starting" and not run.done and time.time() < deadline:
+        time.sleep(0.02)
+    stage = run.status_text()
+    run.cancel()
+    run.wait(30.0)
+    print("  cancelled at '%s': exit %s, %s" % (stage, run.returncode, run.error))
+    check(stage.startswith("nmbake: ") and stage != "nmbake: starting", "the progress is read while nmbake runs (%s)" % stage)
+    check(run.returncode == 143 and not os.path.exists(out), "a stopped bake exits 143 and writes nothing")
 
 
 def case_transforms(low, high, reference):
