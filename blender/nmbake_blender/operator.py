@@ -92,7 +92,7 @@ def _check(context, s):
         raise _Refused("no output file: give one in the nmbake panel")
     if s.output.startswith("//") and not bpy.data.filepath:
         raise _Refused("the output '%s' is relative to the .blend file, which is not saved: save it or give an absolute path" % s.output)
-    output = os.path.normpath(bpy.path.abspath(s.output))
+    output = os.path.abspath(bpy.path.abspath(s.output))  # a plain relative path: from Blender's working folder
     return low, highs, cage, uv_map, maps, output
 
 
