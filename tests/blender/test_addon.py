@@ -249,6 +249,82 @@ def case_cancel(folder):
     check(run.returncode == 143 and not os.path.exists(out), "a stopped bake exits 143 and writes nothing")
 
 
+class _FakeWindowManager:
+    def __init__(self, calls):
+        self.calls = calls
+        self.nmbake_last_export = ""
+
+    def event_timer_remove(self, _timer):
+        self.calls.append("timer removed")
+
+    def progress_update(self, value):
+        self.calls.append(("progress", value))
+
+    def progress_end(self):
+        self.calls.append("progress end")
+
+
+class _FakeWorkspace:
+    def __init__(self, calls):
+        self.calls = calls
+
+    def status_text_set(self, text):
+        self.calls.append(("status", text))
+
+
+def case_modal(reference):
+    """The panel's bake (invoke: modal, needs a window) driven by hand: the operator's own _start,
+    modal and _finish with stand-ins for the window manager, the workspace and the timer events.
+    A bake shows nmbake's stage in the status bar and ends with the status cleared and the map
+    loaded; Esc stops nmbake: a warning, nothing written."""
+    import nmbake_blender.operator as op_module
+
+    op_class = op_module.OBJECT_OT_nmbake_bake
+    fake_op_type = type("ModalStandIn", (), {name: getattr(op_class, name) for name in ("_start", "_finish", "_cleanup", "modal")})
+
+    def drive(output, events):
+        calls, reports = [], []
+        op = fake_op_type()
+        op.report = lambda kind, text: reports.append((set(kind), text))
+        context = type("ContextStandIn", (), {})()
+        context.window_manager, context.workspace = _FakeWindowManager(calls), _FakeWorkspace(calls)
+        s = bpy.context.scene.nmbake
+        s.output = output
+        op._job, op._timer = op._start(bpy.context), None
+        result = None
+        for kind in events:
+            event = type("EventStandIn", (), {"type": kind, "value": "PRESS"})()
+            result = op.modal(context, event)
+            if result != {"PASS_THROUGH"}:
+                break
+        for _ in range(3000):
+            if result != {"PASS_THROUGH"}:
+                break
+            op._job.run.wait(0.01)
+            result = op.modal(context, type("EventStandIn", (), {"type": "TIMER", "value": "NOTHING"})())
+        return result, calls, reports
+
+    bake_settings = bpy.context.scene.nmbake
+    bake_settings.size, bake_settings.samples, bake_settings.maps, bake_settings.extra_args = SIZE, 1, {"normal"}, ""
+    result, calls, reports = drive(os.path.join(WORK, "modal", "modal_<MAP>.png"), ["TIMER", "MOUSEMOVE", "TIMER"])
+    statuses = [c[1] for c in calls if isinstance(c, tuple) and c[0] == "status"]
+    print("  modal: %s, statuses %s, reports %s" % (result, statuses[:3] + ["..."] + statuses[-2:], reports))
+    check(result == {"FINISHED"} and any(t and t.startswith("nmbake: ") for t in statuses) and statuses[-1] is None,
+          "the modal bake shows nmbake's stage in the status bar, then clears it")
+    check("progress end" in calls and "timer removed" in calls, "... and ends the progress and its timer")
+    modal_map = os.path.join(WORK, "modal", "modal_normal.png")
+    check(os.path.isfile(modal_map) and same_bytes(modal_map, reference) and bpy.data.images.get("modal_normal.png") is not None,
+          "... and gives the map of the script's bake, loaded")
+    bake_settings.size, bake_settings.samples = 4096, 64
+    result, calls, reports = drive(os.path.join(WORK, "modal", "stopped_<MAP>.png"), ["TIMER", "ESC"])
+    bake_settings.size, bake_settings.samples = SIZE, 1
+    print("  Esc: %s, reports %s" % (result, reports))
+    check(result == {"CANCELLED"} and any("stopped" in text for kind, text in reports if kind == {"WARNING"}),
+          "Esc stops the modal bake with a warning")
+    check(not os.path.exists(os.path.join(WORK, "modal", "stopped_normal.png")) and bpy.data.images.get("stopped_normal.png") is None,
+          "... and nothing is written or loaded")
+
+
 def case_transforms(low, high, reference):
     """Both objects moved, rotated and scaled together, the unit scale changed, and the low-poly
     (a copy) given a mirroring, stretching transform with its mesh moved the opposite way (its
@@ -399,6 +475,7 @@ def main():
         low, high = make_pair()
         case_panel_draws()
         reference = case_pair(low, high)
+        case_modal(reference)
         case_transforms(low, high, reference)
         case_cage(low, high)
         case_texture_set(low, high)
