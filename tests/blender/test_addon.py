@@ -2,13 +2,15 @@
 
 Run by run_addon_test.sh: blender -b --factory-startup --python-exit-code 1 --python test_addon.py --
 --zip ADDON.zip --nmbake NMBAKE --nmdiff NMDIFF --work DIR, with BLENDER_USER_SCRIPTS and TMPDIR in
-DIR. Installs the zip (Preferences > Add-ons > Install), enables it, and checks: it registers; a
-generated pair (a 16x8 UV sphere under a displaced, subdivided icosphere, modifiers unapplied) bakes
-at 128^2 to the same map as the command line on the exported files (nmdiff mean <= 0.01 degrees, and
-the same bytes); moving, rotating and scaling both objects and changing the unit scale leaves the map
-the same; a cage object is passed as --cage and bakes as the command does with it; the map's UVs are
-Blender's (v up); a missing executable, no low-poly, no high-poly, a low-poly without UVs and an
-nmbake error are one-line reports (RuntimeError for a script), naming the object, with nothing written.
+DIR. Installs the zip (Preferences > Add-ons > Install), enables it, and checks: it registers and
+its panel draws; a generated pair (a 16x8 UV sphere under a displaced, subdivided icosphere,
+modifiers unapplied) bakes at 128^2 to the same map as the command line on the exported files
+(nmdiff mean <= 0.01 degrees, and the same bytes), loaded and wired into the material; the modal
+bake (stand-ins for the window) and Esc; moving, rotating, scaling and mirroring the objects and
+changing the unit scale leaves the map the same; a cage object is passed as --cage and bakes as the
+command does with it; a texture set with <UDIM>; the map's UVs are Blender's (v up); a missing
+executable, no low-poly, no high-poly, a low-poly without UVs and an nmbake error are one-line
+reports (RuntimeError for a script), naming the object, with nothing written.
 """
 
 import argparse
