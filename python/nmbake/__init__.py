@@ -64,7 +64,7 @@ Bake.__doc__ = """A bake's result: maps {name: array} ({name: {tile: array}} wit
 # The command's long options, with '_' for '-': name -> (option, takes a value).
 _BAKE_OPTIONS = {name.replace("-", "_"): (name, value) for name, value in _nmbake.option_names().items()}
 # nmdiff's long options (nmdiff --help); --json and --heatmap write files as nmdiff does.
-_DIFF_OPTIONS = {name.replace("-", "_"): (name, value) for name, value in {
+_DIFF_OPTIONS = {name: (name.replace("_", "-"), value) for name, value in {
     "max_mean": True, "max_p99": True, "max_deg": True, "max_abs": True, "max_share": True, "map": True, "mask": True,
     "include_padding": False, "ignore_alpha": False, "green_a": True, "green_b": True, "same_convention": False,
     "resample": True, "heatmap": True, "heatmap_scale": True, "json": True}.items()}

@@ -138,15 +138,20 @@ py::tuple bake(const std::vector<std::string>& words, const std::vector<std::str
   nlohmann::json report;
   int last_percent = -1;
   const char* last_stage = nullptr;
+  auto last_call = std::chrono::steady_clock::now();
   const auto call_back = [&](const char* stage, double share) {
-    // Python is called at each stage and each whole percent, not at every fraction.
+    // Python is called at each stage and, with a callback, at each whole percent; without one (only
+    // to see Ctrl-C) at most ten times a second: the GIL may have to be waited for.
     const int percent = int(share * 100.0);
-    if (stage == last_stage && percent == last_percent) return;
-    last_stage = stage, last_percent = percent;
+    const auto now = std::chrono::steady_clock::now();
+    if (stage == last_stage &&
+        (percent == last_percent || (progress.is_none() && now - last_call < std::chrono::milliseconds(100))))
+      return;
+    last_stage = stage, last_percent = percent, last_call = now;
     py::gil_scoped_acquire gil;
     if (cancel) return;
     try {
-      if (PyErr_CheckSignals() != 0) throw py::error_already_set();  // Ctrl-C on the main thread
+      if (PyErr_CheckSignals() != 0) throw py::error_already_set();  // Ctrl-C, on the main thread
       if (!progress.is_none()) progress(stage, share);
     } catch (py::error_already_set& e) {
       raised.emplace(e);
