@@ -344,3 +344,10 @@ def test_the_gil_is_released_while_baking():
     assert seconds > 0.05
     # Held through the bake, the GIL would let the thread count only outside it (a few ms).
     assert during > 0.2 * rate * seconds, (during, rate, seconds)
+
+
+def test_udim_maps_come_by_tile(tmp_path):
+    result = nmbake.bake(LOW, HIGH, size=32, output=str(tmp_path / "n.<UDIM>.png"), bits=8)
+    assert list(result.maps) == ["normal"] and list(result.maps["normal"]) == [1001]
+    stored = decode_png(tmp_path / "n.1001.png")
+    assert np.array_equal(np.round(result.maps["normal"][1001].astype(np.float64) * 255.0).astype(np.int32), stored)
