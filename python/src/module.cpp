@@ -190,7 +190,8 @@ py::tuple bake(const std::vector<std::string>& words, const std::vector<std::str
   if (failed) raise_failure(*failed);
   py::list out;
   for (DecodedImage& d : images) out.append(py::make_tuple(d.name, d.tile, to_array(d), d.half));
-  return py::make_tuple(out, report.dump());
+  // Invalid UTF-8 in a path given is replaced, where --report's file would fail to be written.
+  return py::make_tuple(out, report.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
 }
 
 // nmdiff's figures (--json's) for its command line (argv[0] "nmdiff").
