@@ -64,10 +64,7 @@ int run(int argc, char** argv) {
     return run_batch(b, interrupted, &g_doing, start);
   }
   Args a;
-  CLI::App app{"nmbake: bake a tangent-space normal map from a high-poly mesh onto a low-poly mesh with UVs.", "nmbake"};
-  add_options(app, a);
-  if (const std::optional<int> status = parse_command_line(app, argc, argv, "nmbake")) return *status;
-  finish_args(a, app);
+  if (const std::optional<int> status = parse_bake_command_line(argc, argv, a)) return *status;
   const auto start = Clock::now();
   install_signal_handlers();
   // One line for the whole command, on a terminal or with --progress; never with --quiet.
@@ -89,6 +86,14 @@ int run_interruptible(int argc, char** argv) {
 }
 
 }  // namespace
+
+std::optional<int> parse_bake_command_line(int argc, char** argv, Args& a) {
+  CLI::App app{"nmbake: bake a tangent-space normal map from a high-poly mesh onto a low-poly mesh with UVs.", "nmbake"};
+  add_options(app, a);
+  if (const std::optional<int> status = parse_command_line(app, argc, argv, "nmbake")) return status;
+  finish_args(a, app);
+  return std::nullopt;
+}
 
 int nmbake_command(int argc, char** argv) {
   g_signal.store(0);

@@ -7,8 +7,18 @@
 // main() protects the streams first (io/output_files.h).
 #pragma once
 
+#include <optional>
+
+#include "cli/args.h"
+
 namespace nmbake {
 
 int nmbake_command(int argc, char** argv);
+
+// A bake's command line (not --batch; argv[0] the program's name) parsed into `a` as the command
+// parses it, every check and message the same (the Python module, python/, turns its keyword
+// arguments into one): throws UsageError on a bad one; returns the status to exit with after
+// --help or --version (printed on stdout), nothing when the bake is to go on.
+std::optional<int> parse_bake_command_line(int argc, char** argv, Args& a);
 
 }  // namespace nmbake

@@ -85,6 +85,7 @@ struct MapFiles {
   const BakeResult* result;
   std::string map, miss_mask, suspect_mask;
   std::vector<std::string> extra;
+  int tile = 0;  // its UDIM tile, 0 without <UDIM>
 };
 
 std::vector<MapFiles> map_files(const Args& a, const BakeOptions& o, const BakeResult& r, const UdimBake* udim) {
@@ -95,7 +96,8 @@ std::vector<MapFiles> map_files(const Args& a, const BakeOptions& o, const BakeR
                o.maps.wants(MapKind::normal) ? path(MapKind::normal) : "",
                tile_path(a.miss_mask, tile),
                tile_path(a.suspect_mask, tile),
-               {}};
+               {},
+               tile};
     if (!tile) f.miss_mask = a.miss_mask, f.suspect_mask = a.suspect_mask;
     for (const BakedMap& m : result.maps) f.extra.push_back(path(m.kind));
     return f;
@@ -205,28 +207,30 @@ void write_outputs(const JobEnv& env, OutputSet& outputs, const Args& a, const B
   const std::vector<MapFiles> files = map_files(a, o, r, udim);
   if (udim) check_tile_files(a, files);
   std::vector<ImageWrite> writes;
+  // Each image to env.on_image, then to its temporary (a map not when !env.write_maps).
+  const auto add = [&](const char* name, int tile, const std::string& path, const Image& image, WriteOptions options, bool map) {
+    if (env.on_image) env.on_image({name, tile, path, &image, &options});
+    if (map && !env.write_maps) return;
+    options.temp_path = outputs.add(path);
+    writes.push_back({path, &image, std::move(options)});
+  };
   for (const MapFiles& f : files) {
-    if (!f.map.empty()) {
-      wo.temp_path = outputs.add(f.map);
-      writes.push_back({f.map, &f.result->map, wo});
-    }
+    if (!f.map.empty()) add(map_name(MapKind::normal), f.tile, f.map, f.result->map, wo, true);
     for (std::size_t i = 0; i < f.extra.size(); ++i) {
       const BakedMap& m = f.result->maps[i];
       if (m.image.pixels.empty()) continue;  // skipped (a warning says why)
       WriteOptions mo = wo;
       mo.metadata = extra_metadata(o, m);
       mo.dither = wo.dither && !map_is_flat(m.kind);  // an ID's colour is exact
-      mo.temp_path = outputs.add(f.extra[i]);
-      writes.push_back({f.extra[i], &m.image, mo});
+      add(map_name(m.kind), f.tile, f.extra[i], m.image, std::move(mo), true);
     }
-    for (const auto& [path, image] :
-         {std::pair{&f.miss_mask, &f.result->miss_mask}, std::pair{&f.suspect_mask, &f.result->suspect_mask}}) {
+    for (const auto& [name, path, image] : {std::tuple{"miss-mask", &f.miss_mask, &f.result->miss_mask},
+                                            std::tuple{"suspect-mask", &f.suspect_mask, &f.result->suspect_mask}}) {
       if (path->empty()) continue;
       WriteOptions mo;
       mo.bits = default_bits_for(*path);
       mo.threads = o.threads;
-      mo.temp_path = outputs.add(*path);
-      writes.push_back({*path, image, mo});
+      add(name, f.tile, *path, *image, std::move(mo), false);
     }
   }
   if (!writes.empty()) write_images(env, writes, o.threads);
@@ -419,9 +423,9 @@ RunInfo run_info(const Args& a, const std::vector<std::string>& command, int bit
 
 // A mesh file loaded in its role (LOW, HIGH, --cage): an error loading it says which it was given as
 // (a sculpt given as LOW fails for want of UVs; the line then says the order of the arguments).
-Mesh load_as(const char* role, const std::string& path, const LoadOptions& options, MeshLoadInfo* info) {
+Mesh load_as(const JobEnv& env, const char* role, const std::string& path, const LoadOptions& options, MeshLoadInfo* info) {
   try {
-    return load_mesh(path, options, info);
+    return env.load_mesh ? env.load_mesh(path, options, info) : load_mesh(path, options, info);
   } catch (const Error& e) {
     const std::string what = e.what();
     const bool low = std::string(role) == "LOW";
@@ -433,7 +437,7 @@ Mesh load_as(const char* role, const std::string& path, const LoadOptions& optio
 }
 
 // The high-poly files merged, from the cache when an earlier job loaded them.
-std::shared_ptr<const LoadedHigh> load_highs(const std::vector<std::string>& paths, const LoadOptions& options,
+std::shared_ptr<const LoadedHigh> load_highs(const JobEnv& env, const std::vector<std::string>& paths, const LoadOptions& options,
                                              MeshCache* cache) {
   std::string key;
   for (const std::string& p : paths) key += p + '\n';
@@ -449,7 +453,7 @@ std::shared_ptr<const LoadedHigh> load_highs(const std::vector<std::string>& pat
   auto loaded = std::make_shared<LoadedHigh>();
   std::vector<Mesh> meshes;
   for (const std::string& path : paths) {
-    meshes.push_back(load_as("HIGH", path, options, &loaded->infos.emplace_back()));
+    meshes.push_back(load_as(env, "HIGH", path, options, &loaded->infos.emplace_back()));
     loaded->triangles.push_back(meshes.back().triangle_count());
   }
   loaded->mesh = merge_meshes(std::move(meshes));
@@ -469,23 +473,30 @@ void bake_job(const Args& a, const JobEnv& env) {
 
   // Load.
   RunInfo run = run_info(a, env.command, bits);
+  // Each stage to the progress line and to env.on_progress, which gets the stage's fractions too.
+  const char* stage_now = "loading";
+  const auto stage = [&](const char* name, bool tick = true) {
+    stage_now = name;
+    env.progress.stage(name, tick);
+    if (env.on_progress) env.on_progress(name, 0.0);
+  };
   *env.doing = "loading the meshes";
-  env.progress.stage("loading");
+  stage("loading");
   auto t0 = Clock::now();
   LoadOptions low_opts;
   low_opts.require_uvs = true;
   low_opts.uv_set = a.uv_set;
-  Mesh low = load_as("LOW", a.low, low_opts, &run.low_info);
+  Mesh low = load_as(env, "LOW", a.low, low_opts, &run.low_info);
   run.origin = {low.origin.x, low.origin.y, low.origin.z};
   LoadOptions shared;  // the high-poly and the cage share the low-poly's origin (re-centred when far)
   shared.origin = low.origin;
-  const std::shared_ptr<const LoadedHigh> loaded = load_highs(a.highs, shared, env.cache);
+  const std::shared_ptr<const LoadedHigh> loaded = load_highs(env, a.highs, shared, env.cache);
   run.high_infos = loaded->infos;
   run.high_triangles = loaded->triangles;
   run.high_info = combined_info(run.high_infos);
   const Mesh& high = loaded->mesh;
   Mesh cage;
-  if (!a.cage.empty()) cage = load_as("--cage", a.cage, shared, &run.cage_info);
+  if (!a.cage.empty()) cage = load_as(env, "--cage", a.cage, shared, &run.cage_info);
   const Mesh* cage_mesh = a.cage.empty() ? nullptr : &cage;
   run.seconds_load = seconds_since(t0);
   run.low_objects = object_list(low);
@@ -517,8 +528,11 @@ void bake_job(const Args& a, const JobEnv& env) {
   if (env.interrupted()) throw Cancelled();
 
   if (env.cache) o.bvh_cache = &loaded->bvh;  // a batch: the next job from this high-poly may trace its BVH
-  o.progress = [&](double f) { return env.progress.fraction(f); };
-  o.on_stage = [&](const char* stage) { env.progress.stage(stage); };
+  o.progress = [&](double f) {
+    if (env.on_progress) env.on_progress(stage_now, f);
+    return env.progress.fraction(f);
+  };
+  o.on_stage = [&](const char* name) { stage(name); };
   o.keep_trace = a.estimate_error;  // the estimate traces the bake's scene again
   *env.doing = "baking";
   BakeResult r;
@@ -538,7 +552,7 @@ void bake_job(const Args& a, const JobEnv& env) {
   ErrorEstimate estimate;
   *env.doing = "estimating the error";
   if (a.estimate_error) {
-    env.progress.stage("estimating the error");
+    stage("estimating the error");
     estimate = estimate_error(low, o, r, udim ? &*udim : nullptr, run, bits, env.progress);
     r.trace_inputs.reset();
     if (udim) udim->trace_inputs.reset();
@@ -550,7 +564,7 @@ void bake_job(const Args& a, const JobEnv& env) {
   // Every output to its temporary file, then all renamed into place together.
   OutputSet outputs;
   *env.doing = "writing the outputs";
-  env.progress.stage("writing", false);  // not redrawn while the encoders' stderr is redirected
+  stage("writing", false);  // not redrawn while the encoders' stderr is redirected
   t0 = Clock::now();
   write_outputs(env, outputs, a, o, r, udim ? &*udim : nullptr, low, bits);
   run.seconds_write = seconds_since(t0);

@@ -13,7 +13,10 @@
 
 #include "cli/args.h"
 #include "cli/progress.h"
+#include "core/image.h"
 #include "core/mesh.h"
+#include "io/image_io.h"
+#include "io/mesh_io.h"
 #include "pipeline/bake.h"
 
 namespace nmbake {
@@ -31,6 +34,17 @@ struct MeshCache {
   std::size_t hits = 0;  // loads saved
 };
 
+// An image a job is about to encode (JobEnv::on_image): the map's name (map_name: "normal", "ao",
+// ...) or "miss-mask" or "suspect-mask"; its UDIM tile (0 without <UDIM>); its file; the float
+// image, valid during the call only; what it is written with (bits: 0 = default_bits_for(path)).
+struct JobImage {
+  std::string name;
+  int tile = 0;
+  std::string path;
+  const Image* image = nullptr;
+  const WriteOptions* options = nullptr;
+};
+
 // What a job shares with the command that runs it.
 struct JobEnv {
   std::vector<std::string> command;  // for the report
@@ -41,6 +55,17 @@ struct JobEnv {
   MeshCache* cache = nullptr;                   // null: load every mesh
   bool keep_progress = false;                   // the line goes on after the job (a batch)
   nlohmann::json* report = nullptr;             // when set, receives the job's report (as --report writes it)
+  // The Python module's hooks (python/); the command and the batch leave them unset.
+  // LOW, HIGH and --cage loaded by this instead of load_mesh (meshes given as arrays).
+  std::function<Mesh(const std::string& path, const LoadOptions&, MeshLoadInfo*)> load_mesh = nullptr;
+  // Each image as it is about to be encoded (the maps, the masks), on the calling thread.
+  std::function<void(const JobImage&)> on_image = nullptr;
+  // false: the maps go to on_image only, no file (the masks, the cage and the report are written
+  // as asked).
+  bool write_maps = true;
+  // Each stage as it begins (share 0) and the share of it done (0-1), on the calling thread; it may
+  // cancel through `interrupted`.
+  std::function<void(const char* stage, double share)> on_progress = nullptr;
 };
 
 // Checks the options and outputs, then bakes; the outputs are in place when it returns. Throws
