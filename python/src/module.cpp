@@ -36,7 +36,7 @@
 #include "io/image_io.h"
 #include "io/image_write.h"
 #include "io/mesh_io.h"
-#include "nmdiff_json.h"
+#include "command.h"
 #include "pipeline/bake.h"
 
 namespace py = pybind11;
@@ -201,7 +201,7 @@ std::string diff(const std::vector<std::string>& words) {
   {
     py::gil_scoped_release release;
     try {
-      json = nmdiff_json(words);
+      json = nmdiff_json_text(words);
     } catch (...) {
       failed = failure_of(std::current_exception());
     }
