@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <map>
 #include <random>
@@ -362,4 +363,34 @@ TEST(Curvature, DefaultSmoothingKeepsTheSphereAndCalmsItsIrregularTriangles) {
     worst = std::max(worst, std::abs(h[i] - expected) / expected);
   }
   EXPECT_LT(worst, 0.02);
+}
+
+// The work is shared out over the vertices and faces (each vertex's sums gathered in face order):
+// the answer and the counts are the same to the bit on 1, 2 and 7 threads, on a jittered sphere
+// (with smoothing) beside an open, repeated and degenerate grid, split at a seam.
+TEST(Curvature, SameBitsOnAnyNumberOfThreads) {
+  Mesh m = split_along_y(jittered_on_sphere(make_icosphere(3, 1.5f), 1.5f, 0.3f, 7));
+  Mesh grid = make_grid(6, 6);
+  const auto base = std::uint32_t(m.positions.size());
+  for (const glm::vec3& p : grid.positions) m.positions.push_back(p + glm::vec3(4.0f, 0.0f, 0.0f));
+  for (std::size_t t = 0; t < grid.triangle_count(); ++t)
+    add_triangle(m, base + grid.position_index[3 * t], base + grid.position_index[3 * t + 1],
+                 base + grid.position_index[3 * t + 2]);
+  add_triangle(m, base, base + 1, base + 7);  // a repeat, if the grid has it
+  add_triangle(m, base, base, base + 2);      // two corners the same vertex
+  m.normal_index.clear();
+  m.uv_index.clear();
+  CurvatureStats one_st, st;
+  const std::vector<float> one = vertex_mean_curvature(m, CurvatureOptions{2, 1}, &one_st);
+  for (int threads : {2, 7}) {
+    const std::vector<float> h = vertex_mean_curvature(m, CurvatureOptions{2, threads}, &st);
+    ASSERT_EQ(h.size(), one.size());
+    EXPECT_EQ(std::memcmp(h.data(), one.data(), h.size() * sizeof(float)), 0) << threads << " threads";
+    EXPECT_EQ(st.border_vertices, one_st.border_vertices);
+    EXPECT_EQ(st.unvalued_vertices, one_st.unvalued_vertices);
+    EXPECT_EQ(st.degenerate_faces, one_st.degenerate_faces);
+    EXPECT_EQ(st.duplicate_faces, one_st.duplicate_faces);
+  }
+  EXPECT_GT(one_st.border_vertices, 0u);
+  EXPECT_GE(one_st.degenerate_faces, 1u);
 }

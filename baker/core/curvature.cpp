@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/mesh_topology.h"
+#include "core/parallel.h"
 
 namespace nmbake {
 
@@ -24,9 +25,12 @@ struct Welded {
   std::vector<std::uint32_t> faces;   // the non-collapsed faces around each vertex, in face order
 };
 
+constexpr std::size_t kFaceChunk = 1 << 14;    // faces a thread takes at once
+constexpr std::size_t kVertexChunk = 1 << 13;  // vertices a thread takes at once
+
 bool finite(const glm::vec3& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z); }
 
-Welded weld_mesh(const Mesh& m) {
+Welded weld_mesh(const Mesh& m, int threads) {
   Welded w;
   w.weld = weld_positions(m.positions, &w.vertices);
   const std::size_t tris = m.triangle_count();
@@ -51,22 +55,25 @@ Welded weld_mesh(const Mesh& m) {
     if (w.state[t] == kCollapsed) continue;
     for (int k = 0; k < 3; ++k) w.faces[fill[w.corner[3 * t + k]]++] = std::uint32_t(t);
   }
-  // A repeated face is found at its lowest vertex, among the earlier faces listed there.
-  for (std::size_t t = 0; t < tris; ++t) {
-    if (w.state[t] == kCollapsed) continue;
-    std::uint32_t s[3] = {w.corner[3 * t], w.corner[3 * t + 1], w.corner[3 * t + 2]};
-    std::sort(s, s + 3);
-    for (std::uint32_t i = w.first[s[0]]; i < w.first[s[0] + 1] && w.faces[i] < t; ++i) {
-      const std::uint32_t u = w.faces[i];
-      if (w.state[u] == kDuplicate) continue;
-      std::uint32_t o[3] = {w.corner[3 * u], w.corner[3 * u + 1], w.corner[3 * u + 2]};
-      std::sort(o, o + 3);
-      if (o[0] == s[0] && o[1] == s[1] && o[2] == s[2]) {
-        w.state[t] = kDuplicate;
-        break;
+  // A repeated face is found at its lowest vertex, among the earlier faces listed there. A face is
+  // a repeat when any earlier face has its three vertices (the first of them is not itself a
+  // repeat, and it is listed there too): each face is decided on its own, on every thread.
+  parallel_chunks(threads, tris, kFaceChunk, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t t = begin; t < end; ++t) {
+      if (w.state[t] == kCollapsed) continue;
+      std::uint32_t s[3] = {w.corner[3 * t], w.corner[3 * t + 1], w.corner[3 * t + 2]};
+      std::sort(s, s + 3);
+      for (std::uint32_t i = w.first[s[0]]; i < w.first[s[0] + 1] && w.faces[i] < t; ++i) {
+        const std::uint32_t u = w.faces[i];
+        std::uint32_t o[3] = {w.corner[3 * u], w.corner[3 * u + 1], w.corner[3 * u + 2]};
+        std::sort(o, o + 3);
+        if (o[0] == s[0] && o[1] == s[1] && o[2] == s[2]) {
+          w.state[t] = kDuplicate;
+          break;
+        }
       }
     }
-  }
+  });
   return w;
 }
 
@@ -97,66 +104,87 @@ struct Sums {
   std::vector<double> area;
 };
 
-Sums accumulate(const Mesh& m, Welded& w) {
+// Face t's twice-area cross product (corner 0's edges).
+glm::dvec3 face_cross(const Mesh& m, std::size_t t) {
+  const glm::dvec3 p0(m.corner_position(t, 0)), p1(m.corner_position(t, 1)), p2(m.corner_position(t, 2));
+  return glm::cross(p1 - p0, -(p0 - p2));
+}
+
+// Face t's terms at its corner k, added to one vertex's sums.
+void add_corner(const Mesh& m, std::size_t t, int k, glm::dvec3& laplace, glm::dvec3& normal, double& area_sum) {
+  const glm::dvec3 p[3] = {glm::dvec3(m.corner_position(t, 0)), glm::dvec3(m.corner_position(t, 1)),
+                           glm::dvec3(m.corner_position(t, 2))};
+  const glm::dvec3 e[3] = {p[2] - p[1], p[0] - p[2], p[1] - p[0]};  // e[k]: the edge opposite corner k
+  const glm::dvec3 cross = glm::cross(e[2], -e[1]);
+  const double len = glm::length(cross);
+  const glm::dvec3 n = cross / len;
+  const double area = 0.5 * len;
+  // Corner k's dot product of its two edges: negative at an obtuse corner; cot = dot / len.
+  const double dot[3] = {-glm::dot(e[2], e[1]), -glm::dot(e[0], e[2]), -glm::dot(e[1], e[0])};
+  const int obtuse = dot[0] < 0.0 ? 0 : dot[1] < 0.0 ? 1 : dot[2] < 0.0 ? 2 : -1;
+  // (cot a + cot b)-weighted edges of this face at corner k, in closed form: n x (opposite edge),
+  // whose length is the opposite edge's however thin the face.
+  laplace += glm::cross(n, e[k]);
+  normal += cross;
+  double mixed;
+  if (obtuse < 0) {
+    // Voronoi area: |edge to corner k+1|^2 cot(corner k+2) + |edge to corner k+2|^2 cot(corner k+1), over 8.
+    const int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+    mixed = (glm::dot(e[k2], e[k2]) * dot[k2] + glm::dot(e[k1], e[k1]) * dot[k1]) / (8.0 * len);
+    mixed = std::clamp(mixed, 0.0, area);
+  } else {
+    mixed = obtuse == k ? 0.5 * area : 0.25 * area;
+  }
+  area_sum += mixed;
+}
+
+// The zero-area faces marked first (a zero-area face has no normal and no area gradient: it
+// contributes nothing), then each vertex's sums gathered over its faces in face order: the order a
+// face-by-face pass would add them in, so the same sums to the bit on any number of threads.
+Sums accumulate(const Mesh& m, Welded& w, int threads) {
+  parallel_chunks(threads, m.triangle_count(), kFaceChunk, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t t = begin; t < end; ++t) {
+      if (w.state[t] != kGood) continue;
+      const double len = glm::length(face_cross(m, t));
+      if (!(len > 0.0) || !std::isfinite(len)) w.state[t] = kZeroArea;
+    }
+  });
   Sums s;
   s.laplace.assign(w.vertices, glm::dvec3(0.0));
   s.normal.assign(w.vertices, glm::dvec3(0.0));
   s.area.assign(w.vertices, 0.0);
-  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
-    if (w.state[t] != kGood) continue;
-    const glm::dvec3 p[3] = {glm::dvec3(m.corner_position(t, 0)), glm::dvec3(m.corner_position(t, 1)),
-                             glm::dvec3(m.corner_position(t, 2))};
-    const glm::dvec3 e[3] = {p[2] - p[1], p[0] - p[2], p[1] - p[0]};  // e[k]: the edge opposite corner k
-    const glm::dvec3 cross = glm::cross(e[2], -e[1]);
-    const double len = glm::length(cross);
-    // A zero-area face has no normal and no area gradient: it contributes nothing.
-    if (!(len > 0.0) || !std::isfinite(len)) {
-      w.state[t] = kZeroArea;
-      continue;
-    }
-    const glm::dvec3 n = cross / len;
-    const double area = 0.5 * len;
-    // Corner k's dot product of its two edges: negative at an obtuse corner; cot = dot / len.
-    const double dot[3] = {-glm::dot(e[2], e[1]), -glm::dot(e[0], e[2]), -glm::dot(e[1], e[0])};
-    const int obtuse = dot[0] < 0.0 ? 0 : dot[1] < 0.0 ? 1 : dot[2] < 0.0 ? 2 : -1;
-    for (int k = 0; k < 3; ++k) {
-      const std::uint32_t v = w.corner[3 * t + std::size_t(k)];
-      // (cot a + cot b)-weighted edges of this face at corner k, in closed form: n x (opposite edge),
-      // whose length is the opposite edge's however thin the face.
-      s.laplace[v] += glm::cross(n, e[k]);
-      s.normal[v] += cross;
-      double mixed;
-      if (obtuse < 0) {
-        // Voronoi area: |edge to corner k+1|^2 cot(corner k+2) + |edge to corner k+2|^2 cot(corner k+1), over 8.
-        const int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
-        mixed = (glm::dot(e[k2], e[k2]) * dot[k2] + glm::dot(e[k1], e[k1]) * dot[k1]) / (8.0 * len);
-        mixed = std::clamp(mixed, 0.0, area);
-      } else {
-        mixed = obtuse == k ? 0.5 * area : 0.25 * area;
+  parallel_chunks(threads, w.vertices, kVertexChunk, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t v = begin; v < end; ++v)
+      for (std::uint32_t i = w.first[v]; i < w.first[v + 1]; ++i) {
+        const std::uint32_t t = w.faces[i];
+        if (w.state[t] != kGood) continue;
+        const int k = w.corner[3 * t] == v ? 0 : w.corner[3 * t + 1] == v ? 1 : 2;
+        add_corner(m, t, k, s.laplace[v], s.normal[v], s.area[v]);
       }
-      s.area[v] += mixed;
-    }
-  }
+  });
   return s;
 }
 
-// The area-weighted mean over each vertex's faces of the faces' mean corner value, `passes` times.
-void smooth(const Mesh& m, const Welded& w, const std::vector<double>& face_area, int passes, std::vector<double>& h) {
-  std::vector<double> sum(w.vertices), weight(w.vertices);
+// The area-weighted mean over each vertex's faces of the faces' mean corner value, `passes` times;
+// each vertex's sums gathered over its faces in face order (the same sums on any number of threads).
+void smooth(const Welded& w, const std::vector<double>& face_area, int passes, int threads, std::vector<double>& h) {
+  std::vector<double> next(w.vertices);
   for (int pass = 0; pass < passes; ++pass) {
-    std::fill(sum.begin(), sum.end(), 0.0);
-    std::fill(weight.begin(), weight.end(), 0.0);
-    for (std::size_t t = 0; t < m.triangle_count(); ++t) {
-      if (w.state[t] != kGood) continue;
-      const std::uint32_t* c = &w.corner[3 * t];
-      const double a = face_area[t], value = a * (h[c[0]] + h[c[1]] + h[c[2]]) / 3.0;
-      for (int k = 0; k < 3; ++k) {
-        sum[c[k]] += value;
-        weight[c[k]] += a;
+    parallel_chunks(threads, w.vertices, kVertexChunk, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t v = begin; v < end; ++v) {
+        double sum = 0.0, weight = 0.0;
+        for (std::uint32_t i = w.first[v]; i < w.first[v + 1]; ++i) {
+          const std::uint32_t t = w.faces[i];
+          if (w.state[t] != kGood) continue;
+          const std::uint32_t* c = &w.corner[3 * t];
+          const double a = face_area[t], value = a * (h[c[0]] + h[c[1]] + h[c[2]]) / 3.0;
+          sum += value;
+          weight += a;
+        }
+        next[v] = weight > 0.0 ? sum / weight : h[v];
       }
-    }
-    for (std::size_t v = 0; v < w.vertices; ++v)
-      if (weight[v] > 0.0) h[v] = sum[v] / weight[v];
+    });
+    h.swap(next);
   }
 }
 
@@ -164,69 +192,74 @@ void smooth(const Mesh& m, const Welded& w, const std::vector<double>& face_area
 
 std::vector<float> vertex_mean_curvature(const Mesh& mesh, const CurvatureOptions& opt, CurvatureStats* stats) {
   CurvatureStats st;
-  Welded w = weld_mesh(mesh);
+  const int threads = opt.threads;
+  Welded w = weld_mesh(mesh, threads);
   st.welded_vertices = w.vertices;
-  const Sums s = accumulate(mesh, w);
+  const Sums s = accumulate(mesh, w, threads);
 
-  // Interior vertices: every edge shared by exactly two kept faces.
+  // Interior vertices: every edge shared by exactly two kept faces. H = K.n / 2 with
+  // K = laplace / (2 area): the normal part of the mean-curvature normal, whose tangential part on
+  // an irregular mesh is discretisation error. 0 where it has no meaning yet.
   std::vector<std::uint8_t> border(w.vertices, 0);
-  std::vector<std::uint32_t> scratch;
-  std::vector<std::pair<std::uint32_t, int>> nb;
-  for (std::uint32_t v = 0; v < w.vertices; ++v) {
-    edge_neighbours(w, v, scratch, nb);
-    for (const auto& e : nb)
-      if (e.second != 2) border[v] = 1;
-    st.border_vertices += border[v];
-  }
-
-  // H = K.n / 2 with K = laplace / (2 area): the normal part of the mean-curvature normal, whose
-  // tangential part on an irregular mesh is discretisation error. 0 where it has no meaning yet.
   std::vector<double> h(w.vertices, 0.0);
   std::vector<std::uint8_t> valued(w.vertices, 0);
-  for (std::size_t v = 0; v < w.vertices; ++v) {
-    const double nlen = glm::length(s.normal[v]);
-    if (border[v] || !(s.area[v] > 0.0) || !(nlen > 0.0) || !std::isfinite(nlen)) continue;
-    const double value = glm::dot(s.laplace[v], s.normal[v] / nlen) / (4.0 * s.area[v]);
-    if (!std::isfinite(value)) continue;
-    h[v] = value;
-    valued[v] = 1;
-  }
+  parallel_chunks(threads, w.vertices, kVertexChunk, [&](std::size_t begin, std::size_t end) {
+    std::vector<std::uint32_t> scratch;
+    std::vector<std::pair<std::uint32_t, int>> nb;
+    for (std::size_t v = begin; v < end; ++v) {
+      edge_neighbours(w, std::uint32_t(v), scratch, nb);
+      for (const auto& e : nb)
+        if (e.second != 2) border[v] = 1;
+      const double nlen = glm::length(s.normal[v]);
+      if (border[v] || !(s.area[v] > 0.0) || !(nlen > 0.0) || !std::isfinite(nlen)) continue;
+      const double value = glm::dot(s.laplace[v], s.normal[v] / nlen) / (4.0 * s.area[v]);
+      if (!std::isfinite(value)) continue;
+      h[v] = value;
+      valued[v] = 1;
+    }
+  });
+  for (std::size_t v = 0; v < w.vertices; ++v) st.border_vertices += border[v];
 
   // The others from their neighbours: first those next to a valued vertex, then those next to one
   // of these (a grid's corner), each the plain mean of the distinct neighbours valued before it.
+  std::vector<double> fill(w.vertices);
+  std::vector<std::uint8_t> filled(w.vertices);
   for (std::uint8_t round = 2; round <= 3; ++round) {
-    std::vector<std::uint32_t> filled;
-    std::vector<double> values;
-    for (std::uint32_t v = 0; v < w.vertices; ++v) {
-      if (valued[v] || w.first[v] == w.first[v + 1]) continue;
-      edge_neighbours(w, v, scratch, nb);
-      double sum = 0.0;
-      int count = 0;
-      for (const auto& e : nb) {
-        if (valued[e.first] == 0 || valued[e.first] >= round) continue;
-        sum += h[e.first];
-        ++count;
+    parallel_chunks(threads, w.vertices, kVertexChunk, [&](std::size_t begin, std::size_t end) {
+      std::vector<std::uint32_t> scratch;
+      std::vector<std::pair<std::uint32_t, int>> nb;
+      for (std::size_t v = begin; v < end; ++v) {
+        filled[v] = 0;
+        if (valued[v] || w.first[v] == w.first[v + 1]) continue;
+        edge_neighbours(w, std::uint32_t(v), scratch, nb);
+        double sum = 0.0;
+        int count = 0;
+        for (const auto& e : nb) {
+          if (valued[e.first] == 0 || valued[e.first] >= round) continue;
+          sum += h[e.first];
+          ++count;
+        }
+        if (count == 0) continue;
+        filled[v] = 1;
+        fill[v] = sum / count;
       }
-      if (count == 0) continue;
-      filled.push_back(v);
-      values.push_back(sum / count);
-    }
-    for (std::size_t i = 0; i < filled.size(); ++i) {
-      h[filled[i]] = values[i];
-      valued[filled[i]] = round;
-    }
+    });
+    for (std::size_t v = 0; v < w.vertices; ++v)
+      if (filled[v]) h[v] = fill[v], valued[v] = round;
   }
   for (std::size_t v = 0; v < w.vertices; ++v) st.unvalued_vertices += valued[v] == 0;
 
   if (opt.smoothing > 0) {
     std::vector<double> face_area(mesh.triangle_count(), 0.0);
-    for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
-      if (w.state[t] != kGood) continue;
-      const glm::dvec3 p0(mesh.corner_position(t, 0));
-      face_area[t] =
-          0.5 * glm::length(glm::cross(glm::dvec3(mesh.corner_position(t, 1)) - p0, glm::dvec3(mesh.corner_position(t, 2)) - p0));
-    }
-    smooth(mesh, w, face_area, opt.smoothing, h);
+    parallel_chunks(threads, mesh.triangle_count(), kFaceChunk, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t t = begin; t < end; ++t) {
+        if (w.state[t] != kGood) continue;
+        const glm::dvec3 p0(mesh.corner_position(t, 0));
+        face_area[t] = 0.5 * glm::length(glm::cross(glm::dvec3(mesh.corner_position(t, 1)) - p0,
+                                                    glm::dvec3(mesh.corner_position(t, 2)) - p0));
+      }
+    });
+    smooth(w, face_area, opt.smoothing, threads, h);
   }
 
   for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
@@ -234,10 +267,12 @@ std::vector<float> vertex_mean_curvature(const Mesh& mesh, const CurvatureOption
     st.duplicate_faces += w.state[t] == kDuplicate;
   }
   std::vector<float> out(mesh.positions.size());
-  for (std::size_t i = 0; i < out.size(); ++i) {
-    const double value = h[w.weld[i]];
-    out[i] = std::isfinite(value) ? float(std::clamp(value, double(-FLT_MAX), double(FLT_MAX))) : 0.0f;
-  }
+  parallel_chunks(threads, out.size(), kVertexChunk, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const double value = h[w.weld[i]];
+      out[i] = std::isfinite(value) ? float(std::clamp(value, double(-FLT_MAX), double(FLT_MAX))) : 0.0f;
+    }
+  });
   if (stats) *stats = st;
   return out;
 }

@@ -321,10 +321,10 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     announce_stage(opt, "padding");
     stage = "padding (" + texels + ")";
     t0 = Clock::now();
-    pad_map(opt, disagree, threads, result);
     if (extra)
       result.maps = finish_maps(opt, in.s, high, map_in, map_ranges(opt, in.s, {&map_out}, {&result.coverage}), map_out,
                                 result.coverage, threads);
+    pad_map(opt, disagree, threads, result);
     st.pad.seconds = seconds_since(t0);
     if (opt.keep_trace) result.trace_inputs = kept;
     return result;

@@ -118,8 +118,9 @@ std::vector<glm::vec3> id_colors(const std::vector<std::string>& names) {
 }
 
 std::vector<float> map_curvature(const BakeOptions& opt, const Mesh& high) {
-  return opt.maps.wants(MapKind::curvature) ? vertex_mean_curvature(high, CurvatureOptions{opt.maps.curvature_smoothing})
-                                            : std::vector<float>();
+  return opt.maps.wants(MapKind::curvature)
+             ? vertex_mean_curvature(high, CurvatureOptions{opt.maps.curvature_smoothing, opt.threads})
+             : std::vector<float>();
 }
 
 MapInputs make_map_inputs(const BakeOptions& opt, const Prepared& s, const HighScene& scene, const HighSelection& selection,
@@ -271,10 +272,6 @@ std::vector<BakedMap> finish_maps(const BakeOptions& opt, const Prepared& s, con
     m.image = std::move(img);
     out.push_back(std::move(m));
   }
-  std::vector<Image*> images;  // padded together: the nearest covered texels found once
-  for (BakedMap& m : out)
-    if (!m.image.pixels.empty()) images.push_back(&m.image);
-  pad_islands(images, coverage, opt.padding, threads);
   return out;
 }
 

@@ -1,5 +1,6 @@
 // The texture set's other maps around the trace: what they read, made before it
-// (make_map_inputs), and from the trace's raw values the encoded, padded maps (finish_maps).
+// (make_map_inputs), and from the trace's raw values the encoded maps (finish_maps; pad_map then
+// pads them with the normal map).
 // Definitions and why: README, "Texture sets".
 #pragma once
 
@@ -30,9 +31,9 @@ struct MapRanges {
 MapRanges map_ranges(const BakeOptions& opt, const Prepared& s, const std::vector<const MapTargets*>& raw,
                      const std::vector<const std::vector<std::uint8_t>*>& coverage);
 
-// The encoded maps of `raw` (MapTargets, trace order of opt.maps), padded over `coverage` as the
-// normal map is: height and curvature by `ranges`, position by the high-poly's bounding box, the
-// IDs by their names' colours.
+// The encoded maps of `raw` (MapTargets, trace order of opt.maps), their covered texels (`coverage`)
+// only: height and curvature by `ranges`, position by the high-poly's bounding box, the IDs by their
+// names' colours. Not padded: pad_map (pad.h) pads them with the normal map, in one pass.
 std::vector<BakedMap> finish_maps(const BakeOptions& opt, const Prepared& s, const Mesh& high, const MapInputs& in,
                                   const MapRanges& ranges, MapTargets& raw, const std::vector<std::uint8_t>& coverage,
                                   int threads);

@@ -83,7 +83,11 @@ void pad_map(const BakeOptions& opt, const std::vector<std::uint8_t>& disagree, 
     for (std::size_t b = begin; b < end; ++b) scan_band(opt, disagree, int(b), result, bands[b]);
   });
   sum_bands(bands, st);
-  st.pad.texels_padded = pad_islands(result.map, result.coverage, opt.padding, threads);
+  // The normal map and the set's other maps padded together: the nearest covered texels found once.
+  std::vector<Image*> images{&result.map};
+  for (BakedMap& m : result.maps)
+    if (!m.image.pixels.empty()) images.push_back(&m.image);
+  st.pad.texels_padded = pad_islands(images, result.coverage, opt.padding, threads);
 }
 
 }  // namespace nmbake

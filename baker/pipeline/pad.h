@@ -1,5 +1,7 @@
 // Stage 7 of the bake, pad: the background (never reached by padding) set to the flat normal, the
-// suspect texels found, and the islands' edges padded (core/padding.h).
+// suspect texels found, and the islands' edges padded (core/padding.h): the normal map's and those
+// of result.maps (finish_maps, map_set.h: called before, so that the texture set is padded in the
+// same pass).
 #pragma once
 
 #include <cstdint>

@@ -256,8 +256,8 @@ UdimBake bake_udim_tiles(const Mesh& low, const Mesh& high, const Mesh* cage, co
       TileBake& tb = out.tiles[i];
       stage = "padding UDIM tile " + std::to_string(tb.tile.number) + " (" + texels + ")";
       const auto t0 = Clock::now();
-      pad_map(opt, disagree[i], threads, tb.result);
       if (extra) tb.result.maps = finish_maps(opt, in.s, high, map_in, ranges, map_out[i], tb.result.coverage, threads);
+      pad_map(opt, disagree[i], threads, tb.result);
       tb.result.stats.pad.seconds = seconds_since(t0);
       std::vector<std::uint8_t>().swap(disagree[i]);
     }
