@@ -49,7 +49,8 @@ struct Options {
   bool no_map = false;
   bool no_ao = false;
   bool compare = false;
-  unsigned uv_set = 0;  // the low-poly's UV set the map was baked into (nmbake --uv-set)
+  double diff_scale = nmview::kDefaultDiffScale;  // degrees at the top of the difference pane's colour scale
+  unsigned uv_set = 0;                            // the low-poly's UV set the map was baked into (nmbake --uv-set)
   nmview::DecodingOverrides decoding;
 };
 
@@ -104,6 +105,9 @@ int run(const Options& o) {
   parse_pair("--light", o.light, io.light.azimuth, io.light.elevation);
   parse_show(o.show, io.toggles);
   io.toggles.map = !o.no_map;
+  if (!(o.diff_scale >= 0.001 && o.diff_scale <= double(nmview::kMaxDiffScale)))  // NaN included
+    throw nmbake::UsageError("--diff-scale: expected degrees above 0 up to 180 (e.g. 30), got " + std::to_string(o.diff_scale));
+  io.toggles.diff_scale = float(o.diff_scale);
   // The texture set's files (a map path with <MAP>); none is read yet.
   const nmview::TextureSetFiles maps = nmview::find_texture_set(o.map);
   if (io.toggles.show_map && !maps.find(io.toggles.shown)) {
@@ -147,7 +151,7 @@ int run(const Options& o) {
       nmview::write_screenshot(o.screenshot, nmview::Renderer::read_framebuffer(target.id(), 3 * pane_width, pane_height), scene);
       std::cerr << "nmview: worst view written to " << o.screenshot << "\n";
     }
-    nmview::print_compare(result, std::cout);
+    nmview::print_compare(result, scene.decoding, std::cout);
     return 0;
   }
 
@@ -197,6 +201,11 @@ int run_command_line(int argc, char** argv) {
                "the object's pixels (one-model pixels against black). Last stdout line: psnr=<dB> rmse=<0..1> "
                "within2=<fraction> silhouette_mismatch=<fraction> union_psnr=<dB> union_rmse=<0..1> "
                "interior_share=<fraction>");
+  app.add_option("--diff-scale", o.diff_scale,
+                 "Difference pane (D, --show diff): the angle in degrees between the low-poly's shading normal and the "
+                 "high-poly's normal at the top of its colour scale (black 0, red, yellow, white at DEG; keys [ and ] "
+                 "step it), above 0 up to 180")
+      ->capture_default_str();
   app.add_option("--space", o.decoding.space,
                  "How the map was baked: tangent or object space (default: the map's nmbake:space metadata, "
                  "else tangent)");
