@@ -140,7 +140,7 @@ TEST(NmviewGolden, SphereWithWaveMap) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("EGL"), std::string::npos) << r.err;
   std::cout << r.err;
-  expect_matches_golden(shot, "golden_sphere.png");
+  expect_matches_golden(shot, "golden_sphere_convention.png");  // with the decoded convention in the left label
 }
 
 TEST(NmviewGolden, SphereWithToggles) {
@@ -150,7 +150,7 @@ TEST(NmviewGolden, SphereWithToggles) {
   Result r = nmview(dir, quote(s.low) + " " + quote(s.map) + " " + quote(s.high) + " --screenshot " + quote(shot) +
                              " --size 720x240 --view -60,35 --light 20,10 --show wire,diff");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  expect_matches_golden(shot, "golden_sphere_wire_diff.png");
+  expect_matches_golden(shot, "golden_sphere_wire_angle.png");  // the angle difference pane
 }
 
 TEST(NmviewGolden, SphereTangentColours) {
