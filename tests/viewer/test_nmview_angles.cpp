@@ -313,7 +313,7 @@ struct VerdictRun {
 
 // nmview --compare's verdict and figures from its last line.
 VerdictRun compare_verdict(const std::string& dir, const std::string& low, const std::string& map, const std::string& high) {
-  const test::ToolRun r = test::nmview(dir, quote(low) + " " + quote(map) + " " + quote(high) + " --compare --size 200x100");
+  const test::ToolRun r = test::nmview(dir, quote(low) + " " + quote(map) + " " + quote(high) + " --compare --size 300x150");
   EXPECT_EQ(r.exit_code, 0) << r.err;
   std::string last = r.out;
   while (!last.empty() && last.back() == '\n') last.pop_back();
