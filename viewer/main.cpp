@@ -146,6 +146,7 @@ int run(const Options& o) {
     if (!o.screenshot.empty()) {
       nmview::Toggles show = measure;
       show.difference = true;
+      show.diff_scale = io.toggles.diff_scale;
       nmview::Framebuffer target(3 * pane_width, pane_height);
       renderer.render(target.id(), 3 * pane_width, pane_height, result.views[result.worst].view, io.light, show);
       nmview::write_screenshot(o.screenshot, nmview::Renderer::read_framebuffer(target.id(), 3 * pane_width, pane_height), scene);
