@@ -9,11 +9,12 @@ bool clearly_better(double variant, double as_decoded) {
 
 }  // namespace
 
-double removed_share(const VariantAngles& a) { return a.no_map > 0.0 ? 1.0 - a.with_map / a.no_map : 0.0; }
+double removed_share(const VariantAngles& a) { return a.no_map >= kMinAngleGain ? 1.0 - a.with_map / a.no_map : 0.0; }
 
 Verdict judge_map(const VariantAngles& a) {
   if (clearly_better(a.green_flipped, a.with_map) && a.green_flipped <= a.swapped) return Verdict::green_flipped;
   if (clearly_better(a.swapped, a.with_map)) return Verdict::swapped_channels;
+  if (a.no_map < kMinAngleGain && a.with_map < kMinAngleGain) return Verdict::good;
   if (removed_share(a) < kMinRemoved) return Verdict::barely_helps;
   return Verdict::good;
 }

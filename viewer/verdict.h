@@ -8,9 +8,11 @@
 //    (its mean angle at most kClearlyBetter times as-decoded's, and at least kMinAngleGain degrees
 //    less) and no worse than the swapped variant;
 // 2. "likely swapped channels": the same for the red/green-swapped variant;
-// 3. "the map barely helps": the map removes less than kMinRemoved of the no-map angle
+// 3. "good" when the low-poly alone is already within kMinAngleGain degrees of the high-poly and
+//    so is it with the map (a low-poly baked from itself: nothing to remove, the map keeps it so);
+// 4. "the map barely helps": the map removes less than kMinRemoved of the no-map angle
 //    (removed = 1 - with_map / no_map; negative when the map makes it worse);
-// 4. "good" otherwise.
+// 5. "good" otherwise.
 #pragma once
 
 #include <string>
@@ -36,7 +38,8 @@ struct VariantAngles {
 };
 
 // 1 - with_map / no_map: the share of the no-map angle the map removes (1 = all, 0 = none,
-// negative = the map adds to it). 0 when no_map is 0 (nothing to remove).
+// negative = the map adds to it). 0 when no_map is below kMinAngleGain (nothing to remove: the
+// share of a near-zero angle would only measure noise).
 double removed_share(const VariantAngles& a);
 
 Verdict judge_map(const VariantAngles& a);

@@ -123,7 +123,13 @@ TEST(Verdict, RulesInOrder) {
   EXPECT_EQ(judge_map({13.0, 14.7, 18.0, 18.0}), Verdict::barely_helps);  // removes 11.6 %
   // Near-zero angles (a map baked from the low-poly itself): no convention flagged on noise.
   EXPECT_EQ(judge_map({0.30, 9.0, 0.20, 0.21}), Verdict::good);
-  EXPECT_EQ(judge_map({0.0, 0.0, 0.0, 0.0}), Verdict::barely_helps);  // nothing to remove, never NaN
+  // A low-poly baked from itself (NmviewSelfCheck): the bare low-poly is exact, the 8-bit map a
+  // third of a degree off: nothing to remove, and the map keeps it so.
+  EXPECT_EQ(judge_map({0.318, 1.5e-7, 0.318, 0.318}), Verdict::good);
+  EXPECT_EQ(removed_share({0.318, 1.5e-7, 0.318, 0.318}), 0.0);  // not -2e6
+  EXPECT_EQ(judge_map({0.0, 0.0, 0.0, 0.0}), Verdict::good);     // never NaN
+  // ...but a map that spoils an exact low-poly does not pass.
+  EXPECT_EQ(judge_map({5.0, 0.1, 5.0, 5.0}), Verdict::barely_helps);
   EXPECT_NEAR(removed_share({9.7, 14.7, 0, 0}), 1.0 - 9.7 / 14.7, 1e-12);
   EXPECT_EQ(removed_share({1.0, 0.0, 0, 0}), 0.0);
   EXPECT_STREQ(verdict_token(Verdict::green_flipped), "green_flipped");
