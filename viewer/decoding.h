@@ -14,11 +14,21 @@
 
 namespace nmview {
 
+// Where a setting came from: the command line, the map's nmbake:* metadata, or the default.
+enum class DecodingSource { default_value, metadata, option };
+
 struct MapDecoding {
   bool object_space = false;  // the map holds object-space normals (n = texel * 2 - 1)
   bool green_down = false;    // DirectX "Y-": the bitangent component is negated (tangent space only)
   nmbake::BitangentMode bitangent = nmbake::BitangentMode::per_pixel;  // as in tangent_frames.h
+  DecodingSource space_source = DecodingSource::default_value;
+  DecodingSource green_source = DecodingSource::default_value;  // default_value for object-space maps
 };
+
+// The convention in a pane label's words (upper case, the viewer's font): "GREEN UP (OPENGL) FROM
+// METADATA", "GREEN DOWN (DIRECTX) FROM --GREEN", "GREEN UP (OPENGL) BY DEFAULT", or for an
+// object-space map "OBJECT SPACE FROM METADATA" / "FROM --SPACE".
+std::string convention_label(const MapDecoding& decoding);
 
 // Command-line overrides: empty = take the map's metadata, else "tangent"/"object", "up"/"down",
 // "pixel"/"vertex".

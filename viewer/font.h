@@ -1,6 +1,6 @@
 // A tiny 5x7 bitmap font of our own for pane labels (triangle counts, mode names, key help).
 //
-// Covers A-Z (lower case is drawn as upper case), 0-9, space and , . + - : = / ( ) % ?; any other
+// Covers A-Z (lower case is drawn as upper case), 0-9, space and , . + - : = / ( ) [ ] % ?; any other
 // character is drawn as '?'. Glyph cells are 6 x 9 font pixels (one column and two rows of gap).
 #pragma once
 

@@ -21,6 +21,7 @@ const std::vector<std::string> kHelp = {
     "N: MAP ON/OFF   W: WIREFRAME   T: TANGENT COLOURS   D: DIFFERENCE",
     "L: ORBITING LIGHT   S: SPECULAR   P: SCREENSHOT   H: HELP   Q: QUIT",
     "A: AO ON/OFF   M: NEXT MAP OF THE SET (LIT, NORMAL, AO, ...)",
+    "[ ]: DIFFERENCE SCALE DOWN/UP (DEGREES AT WHITE)",
 };
 
 struct State {
@@ -63,6 +64,11 @@ void on_key(GLFWwindow* window, int key, int, int action, int) {
       break;
     case GLFW_KEY_M: cycle_display(s.toggles, s.renderer->shown_maps()); break;
     case GLFW_KEY_D: s.toggles.difference = !s.toggles.difference; break;
+    case GLFW_KEY_LEFT_BRACKET:
+    case GLFW_KEY_RIGHT_BRACKET:
+      s.toggles.diff_scale = next_diff_scale(s.toggles.diff_scale, key == GLFW_KEY_RIGHT_BRACKET);
+      std::cerr << "nmview: difference scale 0.." << s.toggles.diff_scale << " degrees\n";
+      break;
     case GLFW_KEY_S: s.toggles.specular = s.toggles.specular > 0.0f ? 0.0f : 0.3f; break;
     case GLFW_KEY_L: s.orbit_light = !s.orbit_light; break;
     case GLFW_KEY_H: s.help = !s.help; break;

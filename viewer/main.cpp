@@ -3,7 +3,7 @@
 //   nmview LOW.obj normal.png HIGH.ply                 window: left low + map, right high
 //   nmview LOW.obj HIGH.ply -m normal.png              the same in nmbake's order (also --map)
 //   nmview LOW.obj normal.png HIGH.ply --screenshot cmp.png --size 1600x800 --view 30,20
-//   nmview LOW.obj normal.png HIGH.ply --compare       appearance difference over fixed views
+//   nmview LOW.obj normal.png HIGH.ply --compare       appearance and normal-angle difference, a verdict
 //   nmview LOW.obj 'crate_<MAP>.png' HIGH.ply          the texture set: AO lit, A and M keys, --show MAP
 //
 // main only parses arguments and wires the stages together; errors print "error: <what>" and
@@ -49,7 +49,8 @@ struct Options {
   bool no_map = false;
   bool no_ao = false;
   bool compare = false;
-  unsigned uv_set = 0;  // the low-poly's UV set the map was baked into (nmbake --uv-set)
+  double diff_scale = nmview::kDefaultDiffScale;  // degrees at the top of the difference pane's colour scale
+  unsigned uv_set = 0;                            // the low-poly's UV set the map was baked into (nmbake --uv-set)
   nmview::DecodingOverrides decoding;
 };
 
@@ -104,6 +105,9 @@ int run(const Options& o) {
   parse_pair("--light", o.light, io.light.azimuth, io.light.elevation);
   parse_show(o.show, io.toggles);
   io.toggles.map = !o.no_map;
+  if (!(o.diff_scale >= 0.001 && o.diff_scale <= double(nmview::kMaxDiffScale)))  // NaN included
+    throw nmbake::UsageError("--diff-scale: expected degrees above 0 up to 180 (e.g. 30), got " + std::to_string(o.diff_scale));
+  io.toggles.diff_scale = float(o.diff_scale);
   // The texture set's files (a map path with <MAP>); none is read yet.
   const nmview::TextureSetFiles maps = nmview::find_texture_set(o.map);
   if (io.toggles.show_map && !maps.find(io.toggles.shown)) {
@@ -142,12 +146,13 @@ int run(const Options& o) {
     if (!o.screenshot.empty()) {
       nmview::Toggles show = measure;
       show.difference = true;
+      show.diff_scale = io.toggles.diff_scale;
       nmview::Framebuffer target(3 * pane_width, pane_height);
       renderer.render(target.id(), 3 * pane_width, pane_height, result.views[result.worst].view, io.light, show);
       nmview::write_screenshot(o.screenshot, nmview::Renderer::read_framebuffer(target.id(), 3 * pane_width, pane_height), scene);
       std::cerr << "nmview: worst view written to " << o.screenshot << "\n";
     }
-    nmview::print_compare(result, std::cout);
+    nmview::print_compare(result, scene.decoding, std::cout);
     return 0;
   }
 
@@ -194,9 +199,19 @@ int run_command_line(int argc, char** argv) {
                "out); rmse of the 8-bit RGB values scaled to 0..1, psnr = 20 log10(1/rmse), within2 = share of "
                "pixels with every channel within 2/255. silhouette_mismatch = share of the object's pixels "
                "(covered by either model) covered by one model only; union_psnr/union_rmse = the same over all "
-               "the object's pixels (one-model pixels against black). Last stdout line: psnr=<dB> rmse=<0..1> "
-               "within2=<fraction> silhouette_mismatch=<fraction> union_psnr=<dB> union_rmse=<0..1> "
-               "interior_share=<fraction>");
+               "the object's pixels (one-model pixels against black). Then the angle in degrees between the "
+               "low-poly's shading normal and the high-poly's over the interior, with the map as decoded, with no map, "
+               "green flipped and red/green swapped (mean, p95), the share of the no-map angle the map removes, and a "
+               "verdict: good, likely green flipped, likely swapped channels, the map barely helps. Last stdout line: "
+               "psnr=<dB> rmse=<0..1> within2=<fraction> silhouette_mismatch=<fraction> union_psnr=<dB> "
+               "union_rmse=<0..1> interior_share=<fraction> angle_mean=<deg> angle_p95=<deg> no_map_angle_mean=<deg> "
+               "no_map_angle_p95=<deg> flipped_angle_mean=<deg> swapped_angle_mean=<deg> map_removes=<share> "
+               "verdict=<good|green_flipped|swapped_channels|barely_helps>");
+  app.add_option("--diff-scale", o.diff_scale,
+                 "Difference pane (D, --show diff): the angle in degrees between the low-poly's shading normal and the "
+                 "high-poly's normal at the top of its colour scale (black 0, red, yellow, white at DEG; keys [ and ] "
+                 "step it), above 0 up to 180")
+      ->capture_default_str();
   app.add_option("--space", o.decoding.space,
                  "How the map was baked: tangent or object space (default: the map's nmbake:space metadata, "
                  "else tangent)");
@@ -213,7 +228,8 @@ int run_command_line(int argc, char** argv) {
       ->check(CLI::Range(0u, nmbake::kMaxUvSets - 1))
       ->capture_default_str();
   app.add_option("--show", o.show,
-                 "Start with toggles on: wire,diff,tangent,specular,nolabels; and what the left pane shows: lit (the "
+                 "Start with toggles on: wire,diff (the normal-angle difference pane),tangent,specular,nolabels; and what "
+                 "the left pane shows: lit (the "
                  "default) or one map of the set unlit in its own colours (normal, ao, curvature, object-id, ...)");
   nmbake::require_numbers(app);
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 
 #include <epoxy/gl.h>
 
@@ -30,10 +31,11 @@ GLuint compile(GLenum type, const std::string& source, const char* name) {
   return shader;
 }
 
-GLuint link(const char* vertex, const char* fragment, const char* name, bool lighting = false) {
+// `prelude`: GLSL functions put before the fragment shader (shaders::kLighting, kAngleColour).
+GLuint link(const char* vertex, const char* fragment, const char* name, const char* prelude = "") {
   const std::string header = "#version 330 core\n";
   GLuint vs = compile(GL_VERTEX_SHADER, header + vertex, name);
-  GLuint fs = compile(GL_FRAGMENT_SHADER, header + (lighting ? shaders::kLighting : "") + fragment, name);
+  GLuint fs = compile(GL_FRAGMENT_SHADER, header + prelude + fragment, name);
   GLuint program = glCreateProgram();
   glAttachShader(program, vs);
   glAttachShader(program, fs);
@@ -150,12 +152,13 @@ std::vector<Rect> pane_layout(int width, int height, bool difference) {
 Renderer::Renderer(const LowVertices& low, const HighVertices& high, const nmbake::Image& map, float radius,
                    const MapDecoding& decoding)
     : radius_(radius), decoding_(decoding) {
-  low_program_ = link(shaders::kLowVertex, shaders::kLowFragment, "low", true);
-  high_program_ = link(shaders::kHighVertex, shaders::kHighFragment, "high", true);
+  low_program_ = link(shaders::kLowVertex, shaders::kLowFragment, "low", shaders::kLighting);
+  high_program_ = link(shaders::kHighVertex, shaders::kHighFragment, "high", shaders::kLighting);
   wire_program_ = link(shaders::kWireVertex, shaders::kFlatFragment, "wire");
   background_program_ = link(shaders::kFullscreenVertex, shaders::kBackgroundFragment, "background");
   pane_program_ = link(shaders::kFullscreenVertex, shaders::kPaneFragment, "pane");
-  difference_program_ = link(shaders::kFullscreenVertex, shaders::kDifferenceFragment, "difference");
+  difference_program_ = link(shaders::kFullscreenVertex, shaders::kDifferenceFragment, "difference", shaders::kAngleColour);
+  legend_program_ = link(shaders::kFullscreenVertex, shaders::kLegendFragment, "legend", shaders::kAngleColour);
   text_program_ = link(shaders::kTextVertex, shaders::kFlatFragment, "text");
 
   upload(low, {{0, 3}, {1, 3}, {2, 4}, {3, 2}, {4, 3}}, low_.vao, low_.vbo, low_.ebo);
@@ -212,6 +215,9 @@ Renderer::~Renderer() {
     glDeleteRenderbuffers(1, &p.msaa_depth);
     glDeleteFramebuffers(1, &p.fbo);
     glDeleteTextures(1, &p.texture);
+    glDeleteFramebuffers(1, &p.normal_fbo);
+    glDeleteTextures(1, &p.normal_texture);
+    glDeleteRenderbuffers(1, &p.normal_depth);
   }
   for (Model* m : {&low_, &high_}) {
     glDeleteVertexArrays(1, &m->vao);
@@ -223,8 +229,8 @@ Renderer::~Renderer() {
   glDeleteVertexArrays(1, &empty_vao_);
   glDeleteVertexArrays(1, &text_vao_);
   glDeleteBuffers(1, &text_vbo_);
-  for (GLuint p :
-       {low_program_, high_program_, wire_program_, background_program_, pane_program_, difference_program_, text_program_})
+  for (GLuint p : {low_program_, high_program_, wire_program_, background_program_, pane_program_, difference_program_,
+                   text_program_, legend_program_})
     glDeleteProgram(p);
 }
 
@@ -241,6 +247,9 @@ void Renderer::ensure_pane_size(int width, int height) {
       glGenRenderbuffers(1, &p.msaa_depth);
       glGenFramebuffers(1, &p.fbo);
       glGenTextures(1, &p.texture);
+      glGenFramebuffers(1, &p.normal_fbo);
+      glGenTextures(1, &p.normal_texture);
+      glGenRenderbuffers(1, &p.normal_depth);
     }
     glBindRenderbuffer(GL_RENDERBUFFER, p.msaa_color);
     glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples_, GL_RGBA8, width, height);
@@ -261,16 +270,31 @@ void Renderer::ensure_pane_size(int width, int height) {
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, p.texture, 0);
     if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
       throw nmbake::OutputError("cannot create a " + std::to_string(width) + "x" + std::to_string(height) + " framebuffer");
+
+    // Normals are not multisampled: a resolve would average two surfaces' normals at an edge.
+    glBindTexture(GL_TEXTURE_2D, p.normal_texture);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, nullptr);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glBindRenderbuffer(GL_RENDERBUFFER, p.normal_depth);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
+    glBindFramebuffer(GL_FRAMEBUFFER, p.normal_fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, p.normal_texture, 0);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, p.normal_depth);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+      throw nmbake::OutputError("cannot create a " + std::to_string(width) + "x" + std::to_string(height) +
+                                " float framebuffer for the normals");
   }
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
-void Renderer::draw_model(int which, const CameraMatrices& camera, const Toggles& toggles) {
+void Renderer::draw_model(int which, const CameraMatrices& camera, const Toggles& toggles, MapVariant variant, bool normals) {
   const Model& model = which == 0 ? low_ : high_;
   GLuint program = which == 0 ? low_program_ : high_program_;
   glUseProgram(program);
   set_camera(program, camera);
   glUniform1f(uniform(program, "u_specular"), toggles.specular);
+  glUniform1i(uniform(program, "u_output"), normals ? 1 : 0);
   // A map shown texel-exact is drawn without multisampling: every sample of a pixel then takes
   // the fragment's one colour, so the resolve cannot blend two IDs.
   bool single_sample = false;
@@ -290,14 +314,19 @@ void Renderer::draw_model(int which, const CameraMatrices& camera, const Toggles
     glBindTexture(GL_TEXTURE_2D, shown);
     glUniform1i(uniform(program, "u_shown"), 2);
     glActiveTexture(GL_TEXTURE0);
-    glUniform1i(uniform(program, "u_mode"), show ? 3 : toggles.tangent_colours ? 2 : toggles.map ? 0 : 1);
+    const int lit_mode = toggles.map && variant != MapVariant::no_map ? 0 : 1;
+    glUniform1i(uniform(program, "u_mode"), normals ? lit_mode : show ? 3 : toggles.tangent_colours ? 2 : lit_mode);
     glUniform1i(uniform(program, "u_object"), decoding_.object_space ? 1 : 0);
-    glUniform1f(uniform(program, "u_green"), decoding_.green_down ? -1.0f : 1.0f);
+    const float green = decoding_.green_down ? -1.0f : 1.0f;
+    glUniform1f(uniform(program, "u_green"), variant == MapVariant::green_flipped ? -green : green);
+    glUniform1i(uniform(program, "u_swap"), variant == MapVariant::swapped ? 1 : 0);
     glUniform1i(uniform(program, "u_bitangent"), decoding_.bitangent == nmbake::BitangentMode::per_vertex ? 1 : 0);
   }
   glBindVertexArray(model.vao);
-  // The filled pass is pushed back a little so the wireframe lines win the depth test.
-  if (toggles.wireframe) {
+  // The filled pass is pushed back a little so the wireframe lines win the depth test. The normal
+  // pass never has the wireframe: lines are not a difference between the models.
+  const bool wireframe = toggles.wireframe && !normals;
+  if (wireframe) {
     glEnable(GL_POLYGON_OFFSET_FILL);
     glPolygonOffset(1.0f, 1.0f);
   }
@@ -305,7 +334,7 @@ void Renderer::draw_model(int which, const CameraMatrices& camera, const Toggles
   glDrawElements(GL_TRIANGLES, GLsizei(model.index_count), GL_UNSIGNED_INT, nullptr);
   glEnable(GL_MULTISAMPLE);
   glDisable(GL_POLYGON_OFFSET_FILL);
-  if (toggles.wireframe) {
+  if (wireframe) {
     glUseProgram(wire_program_);
     set_camera(wire_program_, camera);
     // Half-transparent lines so a dense mesh stays readable; destination alpha (coverage) is kept.
@@ -346,6 +375,39 @@ void Renderer::render_panes(int width, int height, const OrbitView& view, const 
 
 Rgba8Image Renderer::read_pane(int which) const { return read_framebuffer(panes_[which].fbo, pane_width_, pane_height_); }
 
+void Renderer::render_normals(int width, int height, const OrbitView& view, MapVariant variant, int which_models) {
+  ensure_pane_size(width, height);
+  const CameraMatrices camera = camera_matrices(view, Light{}, radius_, float(pane_width_) / float(pane_height_));
+  glDisable(GL_BLEND);
+  glDisable(GL_CULL_FACE);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  Toggles plain;  // lit with the map, no wireframe, no AO: only the normal matters
+  for (int which = 0; which < 2; ++which) {
+    if (!(which_models & (1 << which))) continue;
+    glBindFramebuffer(GL_FRAMEBUFFER, panes_[which].normal_fbo);
+    glViewport(0, 0, pane_width_, pane_height_);
+    glClearColor(0, 0, 0, 0);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    draw_model(which, camera, plain, variant, true);
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glDisable(GL_DEPTH_TEST);
+}
+
+NormalImage Renderer::read_normals(int which) const {
+  NormalImage image{pane_width_, pane_height_, std::vector<glm::vec4>(std::size_t(pane_width_) * std::size_t(pane_height_))};
+  std::vector<glm::vec4> rows(image.pixels.size());
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, panes_[which].normal_fbo);
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glReadPixels(0, 0, pane_width_, pane_height_, GL_RGBA, GL_FLOAT, rows.data());
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+  const std::size_t stride = std::size_t(pane_width_);
+  for (int y = 0; y < pane_height_; ++y)
+    std::copy_n(&rows[std::size_t(pane_height_ - 1 - y) * stride], stride, &image.pixels[std::size_t(y) * stride]);
+  return image;
+}
+
 Rgba8Image Renderer::read_framebuffer(unsigned target, int width, int height) {
   Rgba8Image image{width, height, std::vector<std::uint8_t>(std::size_t(width) * std::size_t(height) * 4)};
   std::vector<std::uint8_t> rows(image.pixels.size());
@@ -378,10 +440,46 @@ void Renderer::draw_text(const std::string& text, float x, float y, float scale,
   glBindVertexArray(0);
 }
 
+namespace {
+
+// "30", "2.5": a scale value in the labels' words.
+std::string degrees_label(float degrees) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g", double(degrees));
+  return text;
+}
+
+}  // namespace
+
+// The difference pane's colour scale: a bar of the scale from 0 to `diff_scale` degrees with its
+// top `top` window pixels (y down) below the target's top, 0, the middle and the maximum written under it.
+void Renderer::draw_legend(const Rect& pane, float scale, float margin, float top, float diff_scale, int target_width,
+                           int target_height) {
+  const float bar_height = kCellHeight * scale;
+  const int bar_width = int(std::min(float(pane.width) - 2.0f * margin, 150.0f * scale));
+  if (bar_width < 8) return;
+  const int x = pane.x + int(margin), y = int(float(target_height) - top - bar_height);
+  glViewport(x, y, bar_width, int(bar_height));
+  glUseProgram(legend_program_);
+  glUniform2i(uniform(legend_program_, "u_origin"), x, y);
+  glUniform1f(uniform(legend_program_, "u_width"), float(bar_width));
+  glBindVertexArray(empty_vao_);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glViewport(0, 0, target_width, target_height);
+  const float text_y = top + bar_height + 2.0f * scale;
+  const std::string low = "0", middle = degrees_label(0.5f * diff_scale), high = degrees_label(diff_scale) + " DEG";
+  draw_text(low, float(x), text_y, scale, target_width, target_height);
+  draw_text(middle, float(x) + 0.5f * float(bar_width) - 0.5f * text_width(middle, scale), text_y, scale, target_width,
+            target_height);
+  draw_text(high, float(x + bar_width) - text_width(high, scale), text_y, scale, target_width, target_height);
+}
+
 void Renderer::render(unsigned target, int width, int height, const OrbitView& view, const Light& light, const Toggles& toggles,
                       const std::vector<std::string>& help) {
   const std::vector<Rect> layout = pane_layout(width, height, toggles.difference);
   render_panes(layout[0].width, layout[0].height, view, light, toggles);
+  if (toggles.difference)
+    render_normals(layout[0].width, layout[0].height, view, toggles.map ? MapVariant::as_decoded : MapVariant::no_map);
 
   glBindFramebuffer(GL_FRAMEBUFFER, target);
   glViewport(0, 0, width, height);
@@ -406,12 +504,12 @@ void Renderer::render(unsigned target, int width, int height, const OrbitView& v
       glBindTexture(GL_TEXTURE_2D, panes_[i].texture);
       glUniform1i(uniform(program, "u_pane"), 0);
     } else {
-      glBindTexture(GL_TEXTURE_2D, panes_[0].texture);
+      glBindTexture(GL_TEXTURE_2D, panes_[0].normal_texture);
       glActiveTexture(GL_TEXTURE1);
-      glBindTexture(GL_TEXTURE_2D, panes_[1].texture);
-      glUniform1i(uniform(program, "u_left"), 0);
-      glUniform1i(uniform(program, "u_right"), 1);
-      glUniform1f(uniform(program, "u_gain"), kDifferenceGain);
+      glBindTexture(GL_TEXTURE_2D, panes_[1].normal_texture);
+      glUniform1i(uniform(program, "u_low_normals"), 0);
+      glUniform1i(uniform(program, "u_high_normals"), 1);
+      glUniform1f(uniform(program, "u_scale"), std::max(toggles.diff_scale, 1e-3f));
     }
     glBindVertexArray(empty_vao_);
     glDrawArrays(GL_TRIANGLES, 0, 3);
@@ -423,24 +521,29 @@ void Renderer::render(unsigned target, int width, int height, const OrbitView& v
   const float scale = std::max(1.0f, std::floor(float(height) / 400.0f));
   const float margin = 4.0f * scale;
   if (toggles.labels) {
-    // Two lines per pane, clipped to the pane: what it is with its triangle count, then its mode.
+    // Up to three lines per pane, clipped to the pane: what it is with its triangle count, its mode,
+    // and the convention the map is decoded with wherever it is (decoding.h, with where it came from).
     const bool ao = toggles.ao && set_textures_[int(nmbake::MapKind::ao)] != 0;
     const std::string mode = toggles.show_map && has_map(toggles.shown)
                                  ? std::string(nmbake::map_name(toggles.shown)) + " MAP, UNLIT"
                              : toggles.tangent_colours ? "MAP IN TANGENT-SPACE COLOURS"
                              : toggles.map             ? std::string(ao ? "WITH NORMAL MAP X AO" : "WITH NORMAL MAP")
                                                        : std::string(ao ? "NO MAP (BARE SHADING) X AO" : "NO MAP (BARE SHADING)");
-    const std::vector<std::pair<std::string, std::string>> titles = {
-        {"LOW  " + with_thousands(low_triangles()) + " TRIS", mode},
-        {"HIGH  " + with_thousands(high_triangles()) + " TRIS", "OWN NORMALS"},
-        {"DIFFERENCE X" + std::to_string(int(kDifferenceGain)), "BLUE: ONE MODEL ONLY"}};
+    const bool lit_with_map = toggles.map && !(toggles.show_map && has_map(toggles.shown)) && !toggles.tangent_colours;
+    const std::string convention = convention_label(decoding_);
+    const std::vector<std::vector<std::string>> titles = {
+        {"LOW  " + with_thousands(low_triangles()) + " TRIS", mode, lit_with_map ? convention : ""},
+        {"HIGH  " + with_thousands(high_triangles()) + " TRIS", "OWN NORMALS, NO MAP"},
+        {"ANGLE LOW TO HIGH NORMAL", "BLUE: ONE MODEL ONLY", toggles.map ? "LOW: " + convention : "LOW: NO MAP"}};
     glEnable(GL_SCISSOR_TEST);
     for (std::size_t i = 0; i < layout.size(); ++i) {
       const Rect& r = layout[i];
       glScissor(r.x, r.y, r.width, r.height);
-      draw_text(titles[i].first, float(r.x) + margin, margin, scale, width, height);
-      draw_text(titles[i].second, float(r.x) + margin, margin + kCellHeight * scale, scale, width, height);
+      for (std::size_t line = 0; line < titles[i].size(); ++line)
+        draw_text(titles[i][line], float(r.x) + margin, margin + float(line) * kCellHeight * scale, scale, width, height);
     }
+    if (toggles.difference)
+      draw_legend(layout[2], scale, margin, margin + 3.5f * kCellHeight * scale, toggles.diff_scale, width, height);
     glDisable(GL_SCISSOR_TEST);
   }
   for (std::size_t i = 0; i < help.size(); ++i) {

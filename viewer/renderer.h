@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "angle_metrics.h"
 #include "decoding.h"
 #include "core/image.h"
 #include "core/maps.h"
@@ -22,19 +23,23 @@
 namespace nmview {
 
 struct Toggles {
-  bool map = true;               // left pane decodes the normal map; off: the low-poly's bare shading
-  bool ao = false;               // lit left pane (ambient + diffuse, not specular) times the ao map, if added
-  bool show_map = false;         // left pane shows `shown` unlit in its own colours, if added (wins over the rest)
-  bool wireframe = false;        // triangle edges over both models
-  bool tangent_colours = false;  // left pane shows the map's RGB (tangent-space colours) unlit
-  bool difference = false;       // a third pane: |left - right| x kDifferenceGain as a heat colour
-  bool labels = true;            // pane titles with triangle counts
-  float specular = 0.0f;         // Blinn specular weight, 0 = off
+  bool map = true;                       // left pane decodes the normal map; off: the low-poly's bare shading
+  bool ao = false;                       // lit left pane (ambient + diffuse, not specular) times the ao map, if added
+  bool show_map = false;                 // left pane shows `shown` unlit in its own colours, if added (wins over the rest)
+  bool wireframe = false;                // triangle edges over both models
+  bool tangent_colours = false;          // left pane shows the map's RGB (tangent-space colours) unlit
+  bool difference = false;               // a third pane: the angle between the models' normals (angle_metrics.h)
+  bool labels = true;                    // pane titles with triangle counts
+  float specular = 0.0f;                 // Blinn specular weight, 0 = off
+  float diff_scale = kDefaultDiffScale;  // degrees at the top of the difference pane's colour scale, > 0
   // With show_map: normal, or a map given to Renderer::add_set_map.
   nmbake::MapKind shown = nmbake::MapKind::normal;
 };
 
-constexpr float kDifferenceGain = 8.0f;
+// How the low-poly's normal pass decodes the map: as decoded (the lit pane's normal with the map),
+// the bare interpolated normal, or --compare's wrong-convention variants: green negated after the
+// decoding, red and green exchanged before it.
+enum class MapVariant { as_decoded, no_map, green_flipped, swapped };
 
 // Pixel rectangle, origin at the lower left (GL convention).
 struct Rect {
@@ -74,6 +79,13 @@ class Renderer {
   void render_panes(int width, int height, const OrbitView& view, const Light& light, const Toggles& toggles);
   Rgba8Image read_pane(int which) const;
 
+  // Each model's shading normal (angle_metrics.h: unit, scene space, w = coverage) into a
+  // single-sample float target of `width` x `height`, no wireframe, the low-poly's decoded as
+  // `variant`; then read_normals(0 = low, 1 = high). `which_models`: 1 = low only, 2 = high only,
+  // 3 = both (the high-poly's does not depend on the variant).
+  void render_normals(int width, int height, const OrbitView& view, MapVariant variant, int which_models = 3);
+  NormalImage read_normals(int which) const;
+
   // Reads framebuffer `target` (row 0 at the top).
   static Rgba8Image read_framebuffer(unsigned target, int width, int height);
 
@@ -87,18 +99,21 @@ class Renderer {
   };
   struct Pane {
     unsigned msaa_fbo = 0, msaa_color = 0, msaa_depth = 0;
-    unsigned fbo = 0, texture = 0;  // resolved RGBA8
+    unsigned fbo = 0, texture = 0;                                  // resolved RGBA8
+    unsigned normal_fbo = 0, normal_texture = 0, normal_depth = 0;  // single-sample RGBA32F normals
   };
 
   void ensure_pane_size(int width, int height);
-  void draw_model(int which, const CameraMatrices& camera, const Toggles& toggles);
+  void draw_model(int which, const CameraMatrices& camera, const Toggles& toggles, MapVariant variant = MapVariant::as_decoded,
+                  bool normals = false);
+  void draw_legend(const Rect& pane, float scale, float margin, float top, float diff_scale, int target_width, int target_height);
   void draw_text(const std::string& text, float x, float y, float scale, int target_width, int target_height);
 
   Model low_, high_;
   unsigned map_texture_ = 0;
   unsigned set_textures_[nmbake::kMapKinds] = {};  // by MapKind; 0 = not loaded (normal uses map_texture_)
   unsigned low_program_ = 0, high_program_ = 0, wire_program_ = 0;
-  unsigned background_program_ = 0, pane_program_ = 0, difference_program_ = 0, text_program_ = 0;
+  unsigned background_program_ = 0, pane_program_ = 0, difference_program_ = 0, text_program_ = 0, legend_program_ = 0;
   unsigned empty_vao_ = 0, text_vao_ = 0, text_vbo_ = 0;
   Pane panes_[2];
   int pane_width_ = 0, pane_height_ = 0, samples_ = 1;

@@ -60,6 +60,10 @@ void main() {
 // are (v = 1 is the image's top row); so are the texture set's other maps (texture_set.h).
 // Mode 3 shows one of them (u_shown) unlit, as its texels are; u_ao multiplies the lit modes by the
 // ao map's value.
+// u_output 1 writes the shading normal itself (xyz, alpha 1 = covered) instead of the shaded colour,
+// for the angle difference (angle_metrics.h); u_swap exchanges the texel's red and green before the
+// decoding, and --compare's green-flipped variant passes the opposite u_green. A zero-length
+// perturbed normal (a grey 0.5 texel) falls back to the interpolated normal, so no NaN is shaded.
 inline const char* kLowFragment = R"(
 in vec3 v_position;
 in vec3 v_normal;
@@ -75,7 +79,13 @@ uniform int u_ao;         // 1 = the lit modes times u_ao_map's red (grey) value
 uniform int u_object;     // 1 = object-space map
 uniform float u_green;    // +1 green up (OpenGL), -1 green down (DirectX)
 uniform int u_bitangent;  // 0 = per pixel, 1 = per vertex
+uniform int u_output;     // 0 = colour, 1 = the shading normal (modes 0 and 1)
+uniform int u_swap;       // 1 = the texel's red and green exchanged before decoding
 out vec4 frag_color;
+vec3 unit_or(vec3 v, vec3 fallback) {
+  float l = length(v);
+  return l > 1e-12 ? v / l : fallback;
+}
 void main() {
   vec3 N = v_normal;
   vec3 T = v_tangent.xyz;
@@ -88,16 +98,23 @@ void main() {
     frag_color = vec4(texel, 1.0);
     return;
   }
+  vec3 bare = unit_or(N, vec3(0.0, 0.0, 1.0));
   vec3 n;
+  vec3 t = texel * 2.0 - 1.0;
+  if (u_swap == 1) t.xy = t.yx;
   if (u_mode == 0 && u_object == 1) {
-    n = normalize(texel * 2.0 - 1.0);
+    t.y *= u_green;
+    n = unit_or(t, bare);
   } else if (u_mode == 0) {
     vec3 B = u_bitangent == 1 ? v_bitangent : v_tangent.w * cross(N, T);
-    vec3 t = texel * 2.0 - 1.0;
     t.y *= u_green;
-    n = normalize(t.x * T + t.y * B + t.z * N);
+    n = unit_or(t.x * T + t.y * B + t.z * N, bare);
   } else {
-    n = normalize(N);
+    n = bare;
+  }
+  if (u_output == 1) {
+    frag_color = vec4(n, 1.0);
+    return;
   }
   float occlusion = u_ao == 1 ? texture(u_ao_map, v_uv).r : 1.0;
   frag_color = vec4(shade(n, v_position, occlusion), 1.0);
@@ -120,8 +137,13 @@ void main() {
 inline const char* kHighFragment = R"(
 in vec3 v_position;
 in vec3 v_normal;
+uniform int u_output;  // 0 = colour, 1 = the unit normal (alpha 1 = covered)
 out vec4 frag_color;
-void main() { frag_color = vec4(shade(normalize(v_normal), v_position, 1.0), 1.0); }
+void main() {
+  float l = length(v_normal);
+  vec3 n = l > 1e-12 ? v_normal / l : vec3(0.0, 0.0, 1.0);
+  frag_color = u_output == 1 ? vec4(n, 1.0) : vec4(shade(n, v_position, 1.0), 1.0);
+}
 )";
 
 // Wireframe overlay: the triangles again as lines, in one flat colour.
@@ -162,28 +184,47 @@ out vec4 frag_color;
 void main() { frag_color = texelFetch(u_pane, ivec2(gl_FragCoord.xy) - u_origin, 0); }
 )";
 
-// |left - right| where both panes cover the pixel, largest channel times u_gain, as a heat colour:
-// black, red, yellow, white. Pixels only one model covers (the silhouette mismatch, which no map
-// can fix) are blue, so they are not read as shading error.
+// The angle colour scale of angle_metrics.h (angle_colour): v = angle / scale clamped to 0..1,
+// black -> red -> yellow -> white, r + g + b = 3v.
+inline const char* kAngleColour = R"(
+vec3 angle_colour(float v) {
+  v = clamp(v, 0.0, 1.0);
+  return clamp(vec3(3.0 * v, 3.0 * v - 1.0, 3.0 * v - 2.0), 0.0, 1.0);
+}
+)";
+
+// The difference pane: per pixel the angle between the two models' normals (Renderer's normal
+// targets, single-sample float, alpha = coverage) on the angle colour scale up to u_scale degrees.
+// Pixels only one model covers (the silhouette mismatch, which no map can fix) are kOneModelColour
+// (angle_metrics.h), so they are not read as shading error. atan2(|a x b|, a.b) as
+// angle_between_degrees, well conditioned near 0.
 inline const char* kDifferenceFragment = R"(
-uniform sampler2D u_left;
-uniform sampler2D u_right;
+uniform sampler2D u_low_normals;
+uniform sampler2D u_high_normals;
 uniform ivec2 u_origin;
-uniform float u_gain;
+uniform float u_scale;  // degrees at the top of the scale
 out vec4 frag_color;
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy) - u_origin;
-  vec4 a = texelFetch(u_left, p, 0);
-  vec4 b = texelFetch(u_right, p, 0);
-  if (a.a == 0.0 && b.a == 0.0) discard;
-  if (a.a == 0.0 || b.a == 0.0) {
+  vec4 a = texelFetch(u_low_normals, p, 0);
+  vec4 b = texelFetch(u_high_normals, p, 0);
+  bool in_a = a.a > 0.5, in_b = b.a > 0.5;
+  if (!in_a && !in_b) discard;
+  if (!in_a || !in_b) {
     frag_color = vec4(0.15, 0.35, 0.85, 1.0);
     return;
   }
-  vec3 d = abs(a.rgb - b.rgb);
-  float v = clamp(max(d.r, max(d.g, d.b)) * u_gain, 0.0, 1.0);
-  frag_color = vec4(clamp(3.0 * v, 0.0, 1.0), clamp(3.0 * v - 1.0, 0.0, 1.0), clamp(3.0 * v - 2.0, 0.0, 1.0), 1.0);
+  float angle = degrees(atan(length(cross(a.xyz, b.xyz)), dot(a.xyz, b.xyz)));
+  frag_color = vec4(angle_colour(angle / max(u_scale, 1e-6)), 1.0);
 }
+)";
+
+// The colour scale's legend: a bar from 0 on the left to u_scale at the right of the viewport.
+inline const char* kLegendFragment = R"(
+uniform ivec2 u_origin;
+uniform float u_width;  // pixels
+out vec4 frag_color;
+void main() { frag_color = vec4(angle_colour((gl_FragCoord.x - float(u_origin.x)) / max(u_width - 1.0, 1.0)), 1.0); }
 )";
 
 // Text squares in window pixels, y down.

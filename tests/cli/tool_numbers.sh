@@ -10,7 +10,7 @@ map=$repo/data/golden/torus_256.png
 low=$repo/data/sample/torus_low.obj high=$repo/data/sample/torus_high.ply
 case "$tool" in
   nmdiff) code=2 options=(--max-mean --max-p99 --max-deg --heatmap-scale --max-abs --max-share) args=("$map" "$map" --json out.json) out=out.json ;;
-  nmview) code=1 options=(--uv-set) args=("$low" "$map" "$high" --screenshot out.png --size 64x32) out=out.png ;;
+  nmview) code=1 options=(--uv-set --diff-scale) args=("$low" "$map" "$high" --screenshot out.png --size 64x32) out=out.png ;;
   *) echo "usage: tool_numbers.sh nmdiff|nmview EXE REPO WORK"; exit 1 ;;
 esac
 fail=0
