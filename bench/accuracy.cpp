@@ -145,9 +145,13 @@ double appearance_rmse(const std::string& nmview, const std::string& low, const 
   const std::string out = command_output(shell_quote(nmview) + " " + shell_quote(fs::absolute(low).string()) + " " +
                                          shell_quote(fs::absolute(map).string()) + " " +
                                          shell_quote(fs::absolute(high).string()) + " --compare --size 800x400 2>/dev/null");
-  const auto pos = out.rfind("rmse=");
-  if (pos == std::string::npos || out.rfind("psnr=") == std::string::npos) return -1.0;
-  return std::atof(out.c_str() + pos + 5);
+  // The last line starting "psnr=": its first rmse= (the interior's; union_rmse= comes later).
+  const std::size_t nl = out.rfind("\npsnr=");
+  const std::size_t line = nl != std::string::npos ? nl + 1 : out.rfind("psnr=", 0) == 0 ? 0 : std::string::npos;
+  if (line == std::string::npos) return -1.0;
+  const std::size_t pos = out.find(" rmse=", line);
+  if (pos == std::string::npos) return -1.0;
+  return std::atof(out.c_str() + pos + 6);
 }
 
 // The scene called `name`, or nothing (with a line on stderr) when it is unknown or its data is missing.
