@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <optional>
 
 #include <epoxy/gl.h>
 #include <GLFW/glfw3.h>
@@ -17,15 +18,19 @@ constexpr float kDegreesPerPixel = 0.4f;
 constexpr float kLightOrbitDegreesPerSecond = 45.0f;
 
 const std::vector<std::string> kHelp = {
-    "LEFT DRAG: ORBIT   RIGHT DRAG OR ARROWS: LIGHT   WHEEL: ZOOM   R: RESET",
+    "LEFT DRAG: ORBIT   MIDDLE OR SHIFT+LEFT DRAG: PAN   WHEEL: ZOOM AT THE CURSOR",
+    "F: FRAME BOTH MODELS   R: RESET   V: PRINT THE VIEW AS --VIEW   RIGHT DRAG OR ARROWS: LIGHT",
     "N: MAP ON/OFF   W: WIREFRAME   T: TANGENT COLOURS   D: DIFFERENCE",
     "L: ORBITING LIGHT   S: SPECULAR   P: SCREENSHOT   H: HELP   Q: QUIT",
     "A: AO ON/OFF   M: NEXT MAP OF THE SET (LIT, NORMAL, AO, ...)",
     "[ ]: DIFFERENCE SCALE DOWN/UP (DEGREES AT WHITE)",
 };
 
+enum class Drag { none, orbit, pan, light };
+
 struct State {
   const Renderer* renderer = nullptr;
+  const Scene* scene = nullptr;
   InteractiveOptions initial;
   OrbitView view;
   Light light;
@@ -35,10 +40,67 @@ struct State {
   bool dirty = true;
   bool screenshot = false;
   int dragging = -1;  // GLFW mouse button held, or -1
+  Drag drag = Drag::none;
   double last_x = 0, last_y = 0;
+  double pending_scroll = 0;          // wheel steps not applied yet (one pick per frame, however many events)
+  double scroll_x = 0, scroll_y = 0;  // the cursor at the last wheel event, window coordinates
 };
 
 State& state_of(GLFWwindow* window) { return *static_cast<State*>(glfwGetWindowUserPointer(window)); }
+
+// Where a window point (screen coordinates, y down) falls: its pane of the layout the renderer
+// draws (0 low, 1 high, 2 difference), the point in that pane's normalized device coordinates, the
+// pane's aspect, and the size of one window unit in NDC.
+struct PanePoint {
+  int pane = -1;  // -1: between panes (the leftover columns)
+  glm::vec2 ndc{0.0f}, ndc_per_unit{0.0f};
+  float aspect = 1.0f;
+};
+
+PanePoint pane_point(GLFWwindow* window, const Toggles& toggles, double x, double y) {
+  int ww = 0, wh = 0, fw = 0, fh = 0;
+  glfwGetWindowSize(window, &ww, &wh);
+  glfwGetFramebufferSize(window, &fw, &fh);
+  PanePoint p;
+  if (ww <= 0 || wh <= 0 || fw <= 0 || fh <= 0) return p;
+  // Framebuffer pixels (larger than window units on a high-DPI screen), origin at the lower left.
+  const float px = float(x) * float(fw) / float(ww), py = float(fh) - float(y) * float(fh) / float(wh);
+  const std::vector<Rect> layout = pane_layout(fw, fh, toggles.difference);
+  const Rect& first = layout.front();
+  p.aspect = float(first.width) / float(first.height);
+  p.ndc_per_unit = {2.0f * float(fw) / float(ww) / float(first.width), 2.0f * float(fh) / float(wh) / float(first.height)};
+  for (std::size_t i = 0; i < layout.size(); ++i) {
+    const Rect& r = layout[i];
+    if (px < float(r.x) || px >= float(r.x + r.width)) continue;
+    p.pane = int(i);
+    p.ndc = {2.0f * (px - float(r.x)) / float(r.width) - 1.0f, 2.0f * (py - float(r.y)) / float(r.height) - 1.0f};
+  }
+  return p;
+}
+
+// The wheel's steps since the last frame, towards the model under the cursor (the pane's mesh; in
+// the difference pane the nearer of both), else towards the cursor's point at the target's depth.
+void apply_scroll(GLFWwindow* window, State& s) {
+  const float factor = std::pow(0.9f, float(s.pending_scroll));
+  s.pending_scroll = 0;
+  const PanePoint p = pane_point(window, s.toggles, s.scroll_x, s.scroll_y);
+  glm::vec3 pivot = s.view.target;  // between panes: straight ahead
+  if (p.pane >= 0) {
+    const Ray ray = cursor_ray(s.view, s.scene->radius, p.aspect, p.ndc);
+    std::optional<float> t;
+    if (p.pane != 1) t = nearest_hit(ray, s.scene->low);
+    if (p.pane != 0) {
+      const std::optional<float> high = nearest_hit(ray, s.scene->high);
+      if (high && (!t || *high < *t)) t = high;
+    }
+    pivot = t ? ray.origin + *t * ray.direction : point_at_target_depth(s.view, s.scene->radius, p.aspect, ray);
+  }
+  s.view = zoom_towards(s.view, pivot, factor);
+}
+
+void print_view(const State& s) {
+  std::cerr << "nmview: --view " << format_view_option(s.view, s.scene->bounds.centre()) << "\n";
+}
 
 void clamp_light(Light& light) {
   light.azimuth = std::remainder(light.azimuth, 360.0f);
@@ -55,6 +117,8 @@ void on_key(GLFWwindow* window, int key, int, int action, int) {
       s.view = s.initial.view;
       s.light = s.initial.light;
       break;
+    case GLFW_KEY_F: s.view = frame_view(s.view); break;
+    case GLFW_KEY_V: print_view(s); return;
     case GLFW_KEY_N: s.toggles.map = !s.toggles.map; break;
     case GLFW_KEY_W: s.toggles.wireframe = !s.toggles.wireframe; break;
     case GLFW_KEY_T: s.toggles.tangent_colours = !s.toggles.tangent_colours; break;
@@ -83,23 +147,34 @@ void on_key(GLFWwindow* window, int key, int, int action, int) {
   s.dirty = true;
 }
 
-void on_mouse_button(GLFWwindow* window, int button, int action, int) {
+void on_mouse_button(GLFWwindow* window, int button, int action, int mods) {
   State& s = state_of(window);
   if (action == GLFW_PRESS && s.dragging < 0) {
     s.dragging = button;
+    s.drag = button == GLFW_MOUSE_BUTTON_MIDDLE                                 ? Drag::pan
+             : button == GLFW_MOUSE_BUTTON_LEFT && (mods & GLFW_MOD_SHIFT) != 0 ? Drag::pan
+             : button == GLFW_MOUSE_BUTTON_LEFT                                 ? Drag::orbit
+                                                                                : Drag::light;
     glfwGetCursorPos(window, &s.last_x, &s.last_y);
   } else if (action == GLFW_RELEASE && button == s.dragging) {
     s.dragging = -1;
+    s.drag = Drag::none;
   }
 }
 
 void on_cursor(GLFWwindow* window, double x, double y) {
   State& s = state_of(window);
-  if (s.dragging < 0) return;
-  const float dx = float(x - s.last_x) * kDegreesPerPixel, dy = float(y - s.last_y) * kDegreesPerPixel;
+  if (s.drag == Drag::none) return;
+  const double move_x = x - s.last_x, move_y = y - s.last_y;
+  const float dx = float(move_x) * kDegreesPerPixel, dy = float(move_y) * kDegreesPerPixel;
   s.last_x = x;
   s.last_y = y;
-  if (s.dragging == GLFW_MOUSE_BUTTON_LEFT) {
+  if (s.drag == Drag::pan) {
+    // The point under the cursor at the target's depth follows it (window y is down, NDC y up).
+    const PanePoint p = pane_point(window, s.toggles, x, y);
+    const glm::vec2 delta{float(move_x) * p.ndc_per_unit.x, -float(move_y) * p.ndc_per_unit.y};
+    s.view = pan_view(s.view, s.scene->radius, p.aspect, delta);
+  } else if (s.drag == Drag::orbit) {
     // Dragging right turns the object right, i.e. the camera left.
     s.view.azimuth = std::remainder(s.view.azimuth - dx, 360.0f);
     s.view.elevation = std::clamp(s.view.elevation + dy, -90.0f, 90.0f);
@@ -113,7 +188,8 @@ void on_cursor(GLFWwindow* window, double x, double y) {
 
 void on_scroll(GLFWwindow* window, double, double y) {
   State& s = state_of(window);
-  s.view.zoom = std::clamp(s.view.zoom * std::pow(0.9f, float(y)), 0.05f, 20.0f);
+  s.pending_scroll += y;
+  glfwGetCursorPos(window, &s.scroll_x, &s.scroll_y);
   s.dirty = true;
 }
 
@@ -145,6 +221,7 @@ void run_interactive(const Scene& scene, const InteractiveOptions& options) {
 
   State s;
   s.renderer = &renderer;
+  s.scene = &scene;
   s.initial = options;
   s.view = options.view;
   s.light = options.light;
@@ -173,6 +250,7 @@ void run_interactive(const Scene& scene, const InteractiveOptions& options) {
     last_time = now;
     if (!s.dirty) continue;
     s.dirty = false;
+    if (s.pending_scroll != 0) apply_scroll(w, s);
 
     int width = 0, height = 0;
     glfwGetFramebufferSize(w, &width, &height);
@@ -183,7 +261,7 @@ void run_interactive(const Scene& scene, const InteractiveOptions& options) {
       std::string path = "nmview-" + std::to_string(++screenshots) + ".png";
       try {
         write_screenshot(path, Renderer::read_framebuffer(0, width, height), scene);
-        std::cerr << "nmview: wrote " << path << "\n";
+        std::cerr << "nmview: wrote " << path << " (--view " << format_view_option(s.view, scene.bounds.centre()) << ")\n";
       } catch (const nmbake::Error& e) {
         std::cerr << "nmview: " << e.what() << "\n";
       }

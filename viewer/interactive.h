@@ -1,4 +1,6 @@
-// The interactive window: one orbit camera and one light drive both panes.
+// The interactive window: one orbit camera and one light drive both panes. Left drag orbits the
+// target, middle or shift+left drag pans it, the wheel zooms towards the model under the cursor
+// (view.h: zoom_towards, a ray picked against the pane's mesh), F frames both models, R resets.
 #pragma once
 
 #include <vector>
@@ -11,7 +13,7 @@ namespace nmview {
 
 struct InteractiveOptions {
   int width = 1600, height = 800;  // window size in screen units
-  OrbitView view;                  // initial camera, restored by R
+  OrbitView view;                  // initial camera (target re-centred: resolve_view), restored by R
   Light light;                     // initial light, restored by R
   Toggles toggles;
 };
