@@ -39,7 +39,10 @@ float framing_distance(float radius, float aspect) {
   aspect = std::max(aspect, 1e-3f);
   const float fovy = glm::radians(kFovyDegrees);
   const float fovx = 2.0f * std::atan(std::tan(0.5f * fovy) * aspect);
-  return kMargin * radius / std::sin(0.5f * std::min(fovy, fovx));
+  // In this order (the fit, then the margin) for the same rounding as before the target existed:
+  // the golden images' wireframes sit on depth ties.
+  const float fit = radius / std::sin(0.5f * std::min(fovy, fovx));
+  return kMargin * fit;
 }
 
 CameraFrame camera_frame(const OrbitView& view, float radius, float aspect) {
@@ -50,7 +53,7 @@ CameraFrame camera_frame(const OrbitView& view, float radius, float aspect) {
   f.up = glm::vec3(orbit[1]);
   f.forward = -glm::vec3(orbit[2]);
   f.distance = framing_distance(radius, aspect) * clamped_zoom(view.zoom);
-  f.eye = view.target - f.distance * f.forward;
+  f.eye = view.target + glm::vec3(orbit * glm::vec4(0.0f, 0.0f, f.distance, 0.0f));
   f.tan_half_fovy = std::tan(0.5f * glm::radians(kFovyDegrees));
   f.tan_half_fovx = f.tan_half_fovy * aspect;
   return f;
@@ -70,9 +73,11 @@ CameraMatrices camera_matrices(const OrbitView& view, const Light& light, float 
 
   // Near and far hug the bounding sphere around the scene centre at its depth; a camera inside the
   // sphere keeps a small positive near, below the target's distance so the target is never clipped.
-  const float centre_depth = glm::dot(-f.eye, f.forward);
+  // (Written so that a target at the centre gives exactly the distance: golden images keep their depths.)
+  const float centre_depth = f.distance - glm::dot(view.target, f.forward);
   const float near_plane = std::max(centre_depth - kMargin * radius, std::min(1e-3f * radius, 0.05f * f.distance));
-  const float far_plane = std::max(centre_depth + kMargin * radius, 2.0f * near_plane);
+  // (A sphere wholly behind the near plane draws nothing; far only has to stay beyond near.)
+  const float far_plane = std::max(centre_depth + kMargin * radius, near_plane + kMargin * radius);
   m.projection = glm::perspective(glm::radians(kFovyDegrees), aspect, near_plane, far_plane);
   return m;
 }

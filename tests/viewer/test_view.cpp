@@ -153,6 +153,24 @@ TEST(ViewNavigation, AnOffCentreTargetIsThePaneCentreAndTheSceneStaysInDepth) {
   EXPECT_LT(nav_project({0.0f, 0.0f, 1.0f, glm::vec3(0.5f, 0.0f, 0.0f)}, 1.0f, 1.0f, glm::vec3(0.0f)).x, -0.1f);
 }
 
+TEST(ViewNavigation, NearAndFarHugTheBoundingSphere) {
+  // At the centre or away from it, zoomed in or out: the depth range is the sphere's (with the 5 %
+  // margin) wherever the sphere is in front of the camera.
+  const float radius = 2.0f;
+  for (const OrbitView& view : nav_views()) {
+    const nmview::CameraFrame f = nmview::camera_frame(view, radius, 1.0f);
+    const float centre_depth = glm::dot(-f.eye, f.forward);
+    if (centre_depth - 1.05f * radius <= 0.0f) continue;
+    const glm::vec3 nearest = f.eye + f.forward * (centre_depth - 1.05f * radius);
+    const glm::vec3 farthest = f.eye + f.forward * (centre_depth + 1.05f * radius);
+    EXPECT_NEAR(nav_project(view, radius, 1.0f, nearest).z, -1.0f, 1e-4f);
+    EXPECT_NEAR(nav_project(view, radius, 1.0f, farthest).z, 1.0f, 1e-4f);
+  }
+  // Inside the sphere, the target is still in the depth range.
+  const OrbitView inside{0.0f, 0.0f, 0.01f, glm::vec3(0.5f, 0.5f, 0.5f)};
+  EXPECT_LT(std::abs(nav_project(inside, radius, 1.0f, inside.target).z), 1.0f);
+}
+
 TEST(ViewNavigation, NearestHitIsTheFirstTriangleAlongTheRay) {
   nmview::HighVertices mesh;
   // Two unit squares facing +Z, at z = 0 and z = -1, and a degenerate triangle at z = 1.
