@@ -3,7 +3,7 @@
 //   nmview LOW.obj normal.png HIGH.ply                 window: left low + map, right high
 //   nmview LOW.obj HIGH.ply -m normal.png              the same in nmbake's order (also --map)
 //   nmview LOW.obj normal.png HIGH.ply --screenshot cmp.png --size 1600x800 --view 30,20
-//   nmview LOW.obj normal.png HIGH.ply --screenshot ear.png --view 30,20,0.2,0.4,1.1,0   zoomed on a point
+//   nmview LOW.obj normal.png HIGH.ply --screenshot ear.png --view 30,20,0.25,0.6,1.2,0.1   zoomed on a point
 //   nmview LOW.obj normal.png HIGH.ply --compare       appearance and normal-angle difference, a verdict
 //   nmview LOW.obj 'crate_<MAP>.png' HIGH.ply          the texture set: AO lit, A and M keys, --show MAP
 //
