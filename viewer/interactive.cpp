@@ -48,54 +48,15 @@ struct State {
 
 State& state_of(GLFWwindow* window) { return *static_cast<State*>(glfwGetWindowUserPointer(window)); }
 
-// Where a window point (screen coordinates, y down) falls: its pane of the layout the renderer
-// draws (0 low, 1 high, 2 difference), the point in that pane's normalized device coordinates, the
-// pane's aspect, and the size of one window unit in NDC.
-struct PanePoint {
-  int pane = -1;  // -1: between panes (the leftover columns)
-  glm::vec2 ndc{0.0f}, ndc_per_unit{0.0f};
-  float aspect = 1.0f;
-};
-
-PanePoint pane_point(GLFWwindow* window, const Toggles& toggles, double x, double y) {
-  int ww = 0, wh = 0, fw = 0, fh = 0;
-  glfwGetWindowSize(window, &ww, &wh);
-  glfwGetFramebufferSize(window, &fw, &fh);
-  PanePoint p;
-  if (ww <= 0 || wh <= 0 || fw <= 0 || fh <= 0) return p;
-  // Framebuffer pixels (larger than window units on a high-DPI screen), origin at the lower left.
-  const float px = float(x) * float(fw) / float(ww), py = float(fh) - float(y) * float(fh) / float(wh);
-  const std::vector<Rect> layout = pane_layout(fw, fh, toggles.difference);
-  const Rect& first = layout.front();
-  p.aspect = float(first.width) / float(first.height);
-  p.ndc_per_unit = {2.0f * float(fw) / float(ww) / float(first.width), 2.0f * float(fh) / float(wh) / float(first.height)};
-  for (std::size_t i = 0; i < layout.size(); ++i) {
-    const Rect& r = layout[i];
-    if (px < float(r.x) || px >= float(r.x + r.width)) continue;
-    p.pane = int(i);
-    p.ndc = {2.0f * (px - float(r.x)) / float(r.width) - 1.0f, 2.0f * (py - float(r.y)) / float(r.height) - 1.0f};
-  }
-  return p;
-}
-
-// The wheel's steps since the last frame, towards the model under the cursor (the pane's mesh; in
-// the difference pane the nearer of both), else towards the cursor's point at the target's depth.
+// The wheel's steps since the last frame, applied once (one pick per frame, however many events).
 void apply_scroll(GLFWwindow* window, State& s) {
   const float factor = std::pow(0.9f, float(s.pending_scroll));
   s.pending_scroll = 0;
-  const PanePoint p = pane_point(window, s.toggles, s.scroll_x, s.scroll_y);
-  glm::vec3 pivot = s.view.target;  // between panes: straight ahead
-  if (p.pane >= 0) {
-    const Ray ray = cursor_ray(s.view, s.scene->radius, p.aspect, p.ndc);
-    std::optional<float> t;
-    if (p.pane != 1) t = nearest_hit(ray, s.scene->low);
-    if (p.pane != 0) {
-      const std::optional<float> high = nearest_hit(ray, s.scene->high);
-      if (high && (!t || *high < *t)) t = high;
-    }
-    pivot = t ? ray.origin + *t * ray.direction : point_at_target_depth(s.view, s.scene->radius, p.aspect, ray);
-  }
-  s.view = zoom_towards(s.view, pivot, factor);
+  int ww = 0, wh = 0, fw = 0, fh = 0;
+  glfwGetWindowSize(window, &ww, &wh);
+  glfwGetFramebufferSize(window, &fw, &fh);
+  const PanePoint p = pane_at(ww, wh, fw, fh, s.toggles.difference, s.scroll_x, s.scroll_y);
+  s.view = zoom_towards(s.view, zoom_pivot(s.view, s.scene->low, s.scene->high, s.scene->radius, p), factor);
 }
 
 void print_view(const State& s) {
@@ -171,7 +132,10 @@ void on_cursor(GLFWwindow* window, double x, double y) {
   s.last_y = y;
   if (s.drag == Drag::pan) {
     // The point under the cursor at the target's depth follows it (window y is down, NDC y up).
-    const PanePoint p = pane_point(window, s.toggles, x, y);
+    int ww = 0, wh = 0, fw = 0, fh = 0;
+    glfwGetWindowSize(window, &ww, &wh);
+    glfwGetFramebufferSize(window, &fw, &fh);
+    const PanePoint p = pane_at(ww, wh, fw, fh, s.toggles.difference, x, y);
     const glm::vec2 delta{float(move_x) * p.ndc_per_unit.x, -float(move_y) * p.ndc_per_unit.y};
     s.view = pan_view(s.view, s.scene->radius, p.aspect, delta);
   } else if (s.drag == Drag::orbit) {
@@ -201,6 +165,38 @@ std::string title(const Scene& scene) {
 }
 
 }  // namespace
+
+PanePoint pane_at(int window_width, int window_height, int framebuffer_width, int framebuffer_height, bool difference, double x,
+                  double y) {
+  PanePoint p;
+  if (window_width <= 0 || window_height <= 0 || framebuffer_width <= 0 || framebuffer_height <= 0) return p;
+  // Framebuffer pixels (more than window units on a high-DPI screen), origin at the lower left.
+  const float sx = float(framebuffer_width) / float(window_width), sy = float(framebuffer_height) / float(window_height);
+  const float px = float(x) * sx, py = float(framebuffer_height) - float(y) * sy;
+  const std::vector<Rect> layout = pane_layout(framebuffer_width, framebuffer_height, difference);
+  const Rect& first = layout.front();
+  p.aspect = float(first.width) / float(first.height);
+  p.ndc_per_unit = {2.0f * sx / float(first.width), 2.0f * sy / float(first.height)};
+  for (std::size_t i = 0; i < layout.size(); ++i) {
+    const Rect& r = layout[i];
+    if (px < float(r.x) || px >= float(r.x + r.width)) continue;
+    p.pane = int(i);
+    p.ndc = {2.0f * (px - float(r.x)) / float(r.width) - 1.0f, 2.0f * (py - float(r.y)) / float(r.height) - 1.0f};
+  }
+  return p;
+}
+
+glm::vec3 zoom_pivot(const OrbitView& view, const LowVertices& low, const HighVertices& high, float radius, const PanePoint& at) {
+  if (at.pane < 0) return view.target;
+  const Ray ray = cursor_ray(view, radius, at.aspect, at.ndc);
+  std::optional<float> t;
+  if (at.pane != 1) t = nearest_hit(ray, low);
+  if (at.pane != 0) {
+    const std::optional<float> t_high = nearest_hit(ray, high);
+    if (t_high && (!t || *t_high < *t)) t = t_high;
+  }
+  return t ? ray.origin + *t * ray.direction : point_at_target_depth(view, radius, at.aspect, ray);
+}
 
 void cycle_display(Toggles& toggles, const std::vector<nmbake::MapKind>& maps) {
   if (!toggles.show_map) {

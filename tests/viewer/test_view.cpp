@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "core/errors.h"
+#include "interactive.h"
 #include "vertex_data.h"
 #include "view.h"
 
@@ -245,4 +246,70 @@ TEST(ViewOption, OtherFormsAreClearErrors) {
     EXPECT_NE(message.find("--view: DIST"), std::string::npos) << bad << ": " << message;
     EXPECT_NE(message.find("0.001..1000"), std::string::npos) << bad << ": " << message;
   }
+}
+
+namespace {
+
+// A 2 x 2 square facing +Z at height z, as a mesh of either kind (only positions matter here).
+template <class V>
+nmview::IndexedVertices<V> nav_square(float z) {
+  nmview::IndexedVertices<V> mesh;
+  for (glm::vec2 xy : {glm::vec2(-1, -1), glm::vec2(1, -1), glm::vec2(1, 1), glm::vec2(-1, 1)}) {
+    V v{};
+    v.position = glm::vec3(xy, z);
+    mesh.vertices.push_back(v);
+  }
+  mesh.indices = {0, 1, 2, 0, 2, 3};
+  return mesh;
+}
+
+}  // namespace
+
+TEST(WindowNavigation, CursorFallsInItsPaneOnAHighDpiScreen) {
+  // A window of 800 x 400 units drawn into 1600 x 800 pixels: two panes of 800 x 800 pixels.
+  const nmview::PanePoint left = nmview::pane_at(800, 400, 1600, 800, false, 100.0, 150.0);
+  EXPECT_EQ(left.pane, 0);
+  EXPECT_NEAR(left.ndc.x, -0.5f, 1e-6f);  // pixel 200 of 800
+  EXPECT_NEAR(left.ndc.y, 0.25f, 1e-6f);  // pixel row 500 of 800 from the bottom
+  EXPECT_FLOAT_EQ(left.aspect, 1.0f);
+  EXPECT_NEAR(left.ndc_per_unit.x, 2.0f * 2.0f / 800.0f, 1e-7f);
+  EXPECT_EQ(nmview::pane_at(800, 400, 1600, 800, false, 500.0, 150.0).pane, 1);
+  // With the difference pane: three panes of 533 pixels and one leftover column on each side.
+  EXPECT_EQ(nmview::pane_at(1601, 800, 1601, 800, true, 0.0, 10.0).pane, -1);
+  EXPECT_EQ(nmview::pane_at(1601, 800, 1601, 800, true, 1.0, 10.0).pane, 0);
+  EXPECT_EQ(nmview::pane_at(1601, 800, 1601, 800, true, 1200.0, 10.0).pane, 2);
+  EXPECT_EQ(nmview::pane_at(0, 0, 0, 0, false, 1.0, 1.0).pane, -1);  // minimized
+}
+
+TEST(WindowNavigation, WheelZoomsTowardsTheModelUnderTheCursor) {
+  // Looking down -Z at the low-poly square at z = 0 and the high-poly one at z = 0.5.
+  const nmview::LowVertices low = nav_square<nmview::LowVertex>(0.0f);
+  const nmview::HighVertices high = nav_square<nmview::HighVertex>(0.5f);
+  const float radius = std::sqrt(2.0f);
+  const OrbitView view{0.0f, 0.0f, 1.0f, glm::vec3(0.0f)};
+  struct Case {
+    bool difference;
+    double x;
+    float z;  // the pivot's height: the pane's model, the nearer in the difference pane
+  };
+  for (const Case& c : {Case{false, 150.0, 0.0f}, Case{false, 550.0, 0.5f}, Case{true, 650.0, 0.5f}}) {
+    const nmview::PanePoint at = nmview::pane_at(800, 400, 800, 400, c.difference, c.x, 180.0);
+    const glm::vec3 pivot = nmview::zoom_pivot(view, low, high, radius, at);
+    EXPECT_NEAR(pivot.z, c.z, 1e-5f) << c.x;
+    const glm::vec3 before = nav_project(view, radius, at.aspect, pivot);
+    EXPECT_NEAR(before.x, at.ndc.x, 1e-4f);
+    EXPECT_NEAR(before.y, at.ndc.y, 1e-4f);
+    // Three wheel steps in: the point under the cursor stays under it.
+    const OrbitView zoomed = nmview::zoom_towards(view, pivot, std::pow(0.9f, 3.0f));
+    const glm::vec3 after = nav_project(zoomed, radius, at.aspect, pivot);
+    EXPECT_NEAR(after.x, at.ndc.x, 1e-4f);
+    EXPECT_NEAR(after.y, at.ndc.y, 1e-4f);
+  }
+  // Over the background: the cursor's point at the target's depth (z = 0 here, the target's plane).
+  const nmview::PanePoint corner = nmview::pane_at(800, 400, 800, 400, false, 2.0, 2.0);
+  const glm::vec3 beside = nmview::zoom_pivot(view, low, high, radius, corner);
+  EXPECT_NEAR(beside.z, 0.0f, 1e-4f);
+  EXPECT_GT(std::abs(beside.x), 1.0f);  // off the square
+  // Between panes: the target.
+  EXPECT_EQ(nmview::zoom_pivot(view, low, high, radius, nmview::PanePoint{}), view.target);
 }
