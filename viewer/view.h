@@ -106,7 +106,8 @@ OrbitView frame_view(const OrbitView& view);
 std::optional<float> intersect_triangle(const Ray& ray, glm::vec3 a, glm::vec3 b, glm::vec3 c);
 
 // Distance along `ray` to the nearest triangle of `mesh` it crosses, if any. Brute force over every
-// triangle (measured: about 55 ms per million on one core of the 2-core build machine): for one pick per frame, not per pixel.
+// triangle (measured: about 55 ms per million on one core of the build machine): for one pick per
+// frame, not per pixel.
 template <class V>
 std::optional<float> nearest_hit(const Ray& ray, const IndexedVertices<V>& mesh) {
   std::optional<float> nearest;
