@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <optional>
 
 #include <epoxy/gl.h>
 #include <GLFW/glfw3.h>
@@ -17,15 +18,19 @@ constexpr float kDegreesPerPixel = 0.4f;
 constexpr float kLightOrbitDegreesPerSecond = 45.0f;
 
 const std::vector<std::string> kHelp = {
-    "LEFT DRAG: ORBIT   RIGHT DRAG OR ARROWS: LIGHT   WHEEL: ZOOM   R: RESET",
+    "LEFT DRAG: ORBIT   MIDDLE OR SHIFT+LEFT DRAG: PAN   WHEEL: ZOOM AT THE CURSOR",
+    "F: FRAME BOTH MODELS   R: RESET   V: PRINT THE VIEW AS --VIEW   RIGHT DRAG OR ARROWS: LIGHT",
     "N: MAP ON/OFF   W: WIREFRAME   T: TANGENT COLOURS   D: DIFFERENCE",
     "L: ORBITING LIGHT   S: SPECULAR   P: SCREENSHOT   H: HELP   Q: QUIT",
     "A: AO ON/OFF   M: NEXT MAP OF THE SET (LIT, NORMAL, AO, ...)",
     "[ ]: DIFFERENCE SCALE DOWN/UP (DEGREES AT WHITE)",
 };
 
+enum class Drag { none, orbit, pan, light };
+
 struct State {
   const Renderer* renderer = nullptr;
+  const Scene* scene = nullptr;
   InteractiveOptions initial;
   OrbitView view;
   Light light;
@@ -35,10 +40,28 @@ struct State {
   bool dirty = true;
   bool screenshot = false;
   int dragging = -1;  // GLFW mouse button held, or -1
+  Drag drag = Drag::none;
   double last_x = 0, last_y = 0;
+  double pending_scroll = 0;          // wheel steps not applied yet (one pick per frame, however many events)
+  double scroll_x = 0, scroll_y = 0;  // the cursor at the last wheel event, window coordinates
 };
 
 State& state_of(GLFWwindow* window) { return *static_cast<State*>(glfwGetWindowUserPointer(window)); }
+
+// The wheel's steps since the last frame, applied once (one pick per frame, however many events).
+void apply_scroll(GLFWwindow* window, State& s) {
+  const float factor = std::pow(0.9f, float(s.pending_scroll));
+  s.pending_scroll = 0;
+  int ww = 0, wh = 0, fw = 0, fh = 0;
+  glfwGetWindowSize(window, &ww, &wh);
+  glfwGetFramebufferSize(window, &fw, &fh);
+  const PanePoint p = pane_at(ww, wh, fw, fh, s.toggles.difference, s.scroll_x, s.scroll_y);
+  s.view = zoom_towards(s.view, zoom_pivot(s.view, s.scene->low, s.scene->high, s.scene->radius, p), factor);
+}
+
+void print_view(const State& s) {
+  std::cerr << "nmview: --view " << format_view_option(s.view, s.scene->bounds.centre()) << "\n";
+}
 
 void clamp_light(Light& light) {
   light.azimuth = std::remainder(light.azimuth, 360.0f);
@@ -55,6 +78,8 @@ void on_key(GLFWwindow* window, int key, int, int action, int) {
       s.view = s.initial.view;
       s.light = s.initial.light;
       break;
+    case GLFW_KEY_F: s.view = frame_view(s.view); break;
+    case GLFW_KEY_V: print_view(s); return;
     case GLFW_KEY_N: s.toggles.map = !s.toggles.map; break;
     case GLFW_KEY_W: s.toggles.wireframe = !s.toggles.wireframe; break;
     case GLFW_KEY_T: s.toggles.tangent_colours = !s.toggles.tangent_colours; break;
@@ -83,23 +108,37 @@ void on_key(GLFWwindow* window, int key, int, int action, int) {
   s.dirty = true;
 }
 
-void on_mouse_button(GLFWwindow* window, int button, int action, int) {
+void on_mouse_button(GLFWwindow* window, int button, int action, int mods) {
   State& s = state_of(window);
   if (action == GLFW_PRESS && s.dragging < 0) {
     s.dragging = button;
+    s.drag = button == GLFW_MOUSE_BUTTON_MIDDLE                                 ? Drag::pan
+             : button == GLFW_MOUSE_BUTTON_LEFT && (mods & GLFW_MOD_SHIFT) != 0 ? Drag::pan
+             : button == GLFW_MOUSE_BUTTON_LEFT                                 ? Drag::orbit
+                                                                                : Drag::light;
     glfwGetCursorPos(window, &s.last_x, &s.last_y);
   } else if (action == GLFW_RELEASE && button == s.dragging) {
     s.dragging = -1;
+    s.drag = Drag::none;
   }
 }
 
 void on_cursor(GLFWwindow* window, double x, double y) {
   State& s = state_of(window);
-  if (s.dragging < 0) return;
-  const float dx = float(x - s.last_x) * kDegreesPerPixel, dy = float(y - s.last_y) * kDegreesPerPixel;
+  if (s.drag == Drag::none) return;
+  const double move_x = x - s.last_x, move_y = y - s.last_y;
+  const float dx = float(move_x) * kDegreesPerPixel, dy = float(move_y) * kDegreesPerPixel;
   s.last_x = x;
   s.last_y = y;
-  if (s.dragging == GLFW_MOUSE_BUTTON_LEFT) {
+  if (s.drag == Drag::pan) {
+    // The point under the cursor at the target's depth follows it (window y is down, NDC y up).
+    int ww = 0, wh = 0, fw = 0, fh = 0;
+    glfwGetWindowSize(window, &ww, &wh);
+    glfwGetFramebufferSize(window, &fw, &fh);
+    const PanePoint p = pane_at(ww, wh, fw, fh, s.toggles.difference, x, y);
+    const glm::vec2 delta{float(move_x) * p.ndc_per_unit.x, -float(move_y) * p.ndc_per_unit.y};
+    s.view = pan_view(s.view, s.scene->radius, p.aspect, delta);
+  } else if (s.drag == Drag::orbit) {
     // Dragging right turns the object right, i.e. the camera left.
     s.view.azimuth = std::remainder(s.view.azimuth - dx, 360.0f);
     s.view.elevation = std::clamp(s.view.elevation + dy, -90.0f, 90.0f);
@@ -113,7 +152,8 @@ void on_cursor(GLFWwindow* window, double x, double y) {
 
 void on_scroll(GLFWwindow* window, double, double y) {
   State& s = state_of(window);
-  s.view.zoom = std::clamp(s.view.zoom * std::pow(0.9f, float(y)), 0.05f, 20.0f);
+  s.pending_scroll += y;
+  glfwGetCursorPos(window, &s.scroll_x, &s.scroll_y);
   s.dirty = true;
 }
 
@@ -125,6 +165,38 @@ std::string title(const Scene& scene) {
 }
 
 }  // namespace
+
+PanePoint pane_at(int window_width, int window_height, int framebuffer_width, int framebuffer_height, bool difference, double x,
+                  double y) {
+  PanePoint p;
+  if (window_width <= 0 || window_height <= 0 || framebuffer_width <= 0 || framebuffer_height <= 0) return p;
+  // Framebuffer pixels (more than window units on a high-DPI screen), origin at the lower left.
+  const float sx = float(framebuffer_width) / float(window_width), sy = float(framebuffer_height) / float(window_height);
+  const float px = float(x) * sx, py = float(framebuffer_height) - float(y) * sy;
+  const std::vector<Rect> layout = pane_layout(framebuffer_width, framebuffer_height, difference);
+  const Rect& first = layout.front();
+  p.aspect = float(first.width) / float(first.height);
+  p.ndc_per_unit = {2.0f * sx / float(first.width), 2.0f * sy / float(first.height)};
+  for (std::size_t i = 0; i < layout.size(); ++i) {
+    const Rect& r = layout[i];
+    if (px < float(r.x) || px >= float(r.x + r.width)) continue;
+    p.pane = int(i);
+    p.ndc = {2.0f * (px - float(r.x)) / float(r.width) - 1.0f, 2.0f * (py - float(r.y)) / float(r.height) - 1.0f};
+  }
+  return p;
+}
+
+glm::vec3 zoom_pivot(const OrbitView& view, const LowVertices& low, const HighVertices& high, float radius, const PanePoint& at) {
+  if (at.pane < 0) return view.target;
+  const Ray ray = cursor_ray(view, radius, at.aspect, at.ndc);
+  std::optional<float> t;
+  if (at.pane != 1) t = nearest_hit(ray, low);
+  if (at.pane != 0) {
+    const std::optional<float> t_high = nearest_hit(ray, high);
+    if (t_high && (!t || *t_high < *t)) t = t_high;
+  }
+  return t ? ray.origin + *t * ray.direction : point_at_target_depth(view, radius, at.aspect, ray);
+}
 
 void cycle_display(Toggles& toggles, const std::vector<nmbake::MapKind>& maps) {
   if (!toggles.show_map) {
@@ -145,6 +217,7 @@ void run_interactive(const Scene& scene, const InteractiveOptions& options) {
 
   State s;
   s.renderer = &renderer;
+  s.scene = &scene;
   s.initial = options;
   s.view = options.view;
   s.light = options.light;
@@ -173,6 +246,7 @@ void run_interactive(const Scene& scene, const InteractiveOptions& options) {
     last_time = now;
     if (!s.dirty) continue;
     s.dirty = false;
+    if (s.pending_scroll != 0) apply_scroll(w, s);
 
     int width = 0, height = 0;
     glfwGetFramebufferSize(w, &width, &height);
@@ -183,7 +257,7 @@ void run_interactive(const Scene& scene, const InteractiveOptions& options) {
       std::string path = "nmview-" + std::to_string(++screenshots) + ".png";
       try {
         write_screenshot(path, Renderer::read_framebuffer(0, width, height), scene);
-        std::cerr << "nmview: wrote " << path << "\n";
+        std::cerr << "nmview: wrote " << path << " (--view " << format_view_option(s.view, scene.bounds.centre()) << ")\n";
       } catch (const nmbake::Error& e) {
         std::cerr << "nmview: " << e.what() << "\n";
       }

@@ -3,6 +3,7 @@
 //   nmview LOW.obj normal.png HIGH.ply                 window: left low + map, right high
 //   nmview LOW.obj HIGH.ply -m normal.png              the same in nmbake's order (also --map)
 //   nmview LOW.obj normal.png HIGH.ply --screenshot cmp.png --size 1600x800 --view 30,20
+//   nmview LOW.obj normal.png HIGH.ply --screenshot ear.png --view 30,20,0.25,0.6,1.2,0.1   zoomed on a point
 //   nmview LOW.obj normal.png HIGH.ply --compare       appearance and normal-angle difference, a verdict
 //   nmview LOW.obj 'crate_<MAP>.png' HIGH.ply          the texture set: AO lit, A and M keys, --show MAP
 //
@@ -54,7 +55,7 @@ struct Options {
   nmview::DecodingOverrides decoding;
 };
 
-// "A,B" of two finite numbers.
+// "A,B" of two finite numbers (--light).
 void parse_pair(const std::string& flag, const std::string& text, float& a, float& b) {
   std::istringstream in(text);
   char comma = 0;
@@ -101,7 +102,7 @@ void parse_show(const std::string& text, nmview::Toggles& toggles) {
 int run(const Options& o) {
   nmview::InteractiveOptions io;
   parse_size(o.size, io.width, io.height);
-  parse_pair("--view", o.view, io.view.azimuth, io.view.elevation);
+  const nmview::ViewOption view = nmview::parse_view_option(o.view);
   parse_pair("--light", o.light, io.light.azimuth, io.light.elevation);
   parse_show(o.show, io.toggles);
   io.toggles.map = !o.no_map;
@@ -122,6 +123,8 @@ int run(const Options& o) {
   nmview::check_screenshot(o.screenshot, o.low, maps, o.high);
 
   const nmview::Scene scene = nmview::load_scene(o.low, maps, o.high, std::cerr, o.decoding, o.uv_set);
+  // The target is given in the meshes' object space; the renderer's scene is re-centred.
+  io.view = nmview::resolve_view(view, scene.bounds.centre());
 
   if (!o.compare && o.screenshot.empty()) {
     nmview::run_interactive(scene, io);
@@ -187,7 +190,13 @@ int run_command_line(int argc, char** argv) {
                  "Render without a display to FILE and exit (with --compare: write the worst view's difference "
                  "image to FILE; without it --compare writes no image)");
   app.add_option("--size", o.size, "Window or image size WxH in pixels (both panes together)")->capture_default_str();
-  app.add_option("--view", o.view, "Camera azimuth,elevation in degrees (Y up; 0,0 looks from +Z)")->capture_default_str();
+  app.add_option("--view", o.view,
+                 "Camera AZ,EL[,DIST[,TX,TY,TZ]]: azimuth and elevation in degrees (Y up; 0,0 looks from +Z); DIST "
+                 "the distance from the target as a factor of the distance that frames both models (1, the default, "
+                 "frames them; 0.5 is twice as close; 0.001..1000); TX,TY,TZ the point looked at and orbited, in the "
+                 "meshes' own coordinates (default: the centre of both models' bounding box). --compare keeps its "
+                 "fixed views. The window's V key prints its current view in this form")
+      ->capture_default_str();
   app.add_option("--light", o.light, "Light azimuth,elevation in degrees relative to the view direction (0,0 = from the eye)")
       ->capture_default_str();
   app.add_flag("--no-map", o.no_map, "Left pane without the normal map (the low-poly's bare shading)");
