@@ -1,14 +1,18 @@
 // nmview --compare on the thin-parts family (tests/procedural/thin_parts.h, issue 34 item 1): the
 // map of the automatic cage renders no worse than the map of the best fixed ray distance of a
-// sweep, by at most kMarginDb of the interior PSNR. Headless (llvmpipe), like test_nmview.cpp.
+// sweep, by at most kMarginDb of the interior PSNR. Headless (llvmpipe), in this process.
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
 
+#include "compare.h"
+#include "gl_context.h"
 #include "io/mesh_io.h"
+#include "scene.h"
 #include "test_support.h"
 #include "thin_parts.h"
 
@@ -22,22 +26,25 @@ constexpr double kSweep[] = {0.01, 0.015, 0.02, 0.03, 0.05};
 // others the automatic cage renders 0.01-0.13 dB better.
 constexpr double kMarginDb = 0.2;
 
-// The interior PSNR of `map` (nmview's last stdout line, "psnr=<dB> ..."), or -1 on a failure.
+// The interior PSNR of `map` as `nmview LOW MAP HIGH --compare --size 300x300` measures it (its
+// last line's psnr=), run in this process: the scene loaded and compared by the viewer's own code
+// (scene.h, compare.h) in the test's one headless context, without a process start per map.
 double compare_psnr(const std::string& dir, const std::string& name, const std::string& map) {
-  unsetenv("DISPLAY");
-  unsetenv("WAYLAND_DISPLAY");
-  setenv("LIBGL_ALWAYS_SOFTWARE", "1", 1);
-  const std::string cmd = "cd '" + dir + "' && '" + NMVIEW_EXE + "' " + name + "_low.obj " + map + " " + name +
-                          "_high.obj --compare --size 300x300 2>/dev/null | tail -n 1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return -1.0;
-  double psnr = -1.0;
-  if (std::fscanf(pipe, "psnr=%lf", &psnr) != 1) psnr = -1.0;
-  pclose(pipe);
-  return psnr;
+  std::ostringstream log;
+  const nmview::Scene scene = nmview::load_scene(dir + "/" + name + "_low.obj", nmview::find_texture_set(dir + "/" + map),
+                                                 dir + "/" + name + "_high.obj", log);
+  nmview::Renderer renderer(scene.low, scene.high, scene.map, scene.radius, scene.decoding);
+  nmview::Toggles measure;
+  measure.map = true;
+  const nmview::CompareResult result = nmview::run_compare(renderer, 150, 300, nmview::Light{}, measure);
+  return result.total.interior.psnr();
 }
 
 TEST(ThinPartsView, AutomaticCageRendersNoWorseThanTheBestFixedDistance) {
+  unsetenv("DISPLAY");
+  unsetenv("WAYLAND_DISPLAY");
+  setenv("LIBGL_ALWAYS_SOFTWARE", "1", 1);
+  const nmview::HeadlessContext context;
   const std::string dir = nmbake::test::scratch_dir();
   for (const nmbake::procedural::ThinPartsSpec& spec : nmbake::procedural::thin_parts_family()) {
     const nmbake::procedural::ThinParts p = nmbake::procedural::make_thin_parts(spec);
