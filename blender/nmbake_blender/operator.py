@@ -257,13 +257,4 @@ class OBJECT_OT_nmbake_bake(bpy.types.Operator):
 
 
 classes = (OBJECT_OT_nmbake_bake,)
-
-
-def register():
-    for cls in classes:
-        bpy.utils.register_class(cls)
-
-
-def unregister():
-    for cls in reversed(classes):
-        bpy.utils.unregister_class(cls)
+register, unregister = bpy.utils.register_classes_factory(classes)

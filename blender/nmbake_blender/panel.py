@@ -47,13 +47,4 @@ class RENDER_PT_nmbake(bpy.types.Panel):
 
 
 classes = (RENDER_PT_nmbake,)
-
-
-def register():
-    for cls in classes:
-        bpy.utils.register_class(cls)
-
-
-def unregister():
-    for cls in reversed(classes):
-        bpy.utils.unregister_class(cls)
+register, unregister = bpy.utils.register_classes_factory(classes)
