@@ -172,12 +172,19 @@ TEST(Adaptive, TheCommandTakesSamplesAutoAndReportsTheHistogram) {
   // Refined texels cast their first 4 rays too, and the deepest their 16.
   EXPECT_EQ(r["rays"].get<std::uint64_t>(), 4 * base + 20 * refined + 84 * deep);
   EXPECT_TRUE(r.contains("error_estimate"));
+  // Below 2048^2 the report says that auto does not pay, and why; from 2048 (either side) that it does.
+  EXPECT_EQ(r["samples_auto"]["pays_at_this_size"], false);
+  EXPECT_TRUE(test::contains(r["samples_auto"]["why"].get<std::string>(), "below 2048^2"));
+  const test::CliRun wide = test::run_nmbake(pair + " -o w.png --size 2048x8 --samples auto --report r.json");
+  ASSERT_EQ(wide.code, 0) << wide.err;
+  EXPECT_EQ(wide.report["samples_auto"]["pays_at_this_size"], true);
   // A fixed count: one row, every covered texel.
   const test::CliRun fixed = test::run_nmbake(pair + " -o m.png --size 64 --samples 4 --report r.json");
   ASSERT_EQ(fixed.code, 0) << fixed.err;
   ASSERT_EQ(fixed.report["samples_histogram"].size(), 1u);
   EXPECT_EQ(fixed.report["samples_histogram"][0]["texels"], fixed.report["texels"]["covered"]);
   EXPECT_EQ(fixed.report["options"]["samples"], 4);
+  EXPECT_FALSE(fixed.report.contains("samples_auto"));
 }
 
 TEST(Adaptive, TheCommandRefusesBadSamplingOptions) {
