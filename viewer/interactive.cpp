@@ -24,7 +24,7 @@ const std::vector<std::string> kHelp = {
     "L: ORBITING LIGHT   S: SPECULAR   P: SCREENSHOT   H: HELP   Q: QUIT",
     "A: AO ON/OFF   M: NEXT MAP OF THE SET (LIT, NORMAL, AO, ...)",
     "[ ]: DIFFERENCE SCALE DOWN/UP (DEGREES AT WHITE)",
-    "K: MISS AND SUSPECT MASKS   C: CAGE",
+    "K: MISS AND SUSPECT MASKS   C: CAGE   U: UV LAYOUT OVER THE MAP",
 };
 
 enum class Drag { none, orbit, pan, light };
@@ -97,6 +97,7 @@ void on_key(GLFWwindow* window, int key, int, int action, int) {
       s.toggles.cage = !s.toggles.cage;
       if (!s.renderer->has_cage()) std::cerr << "nmview: C: no cage given (--cage, or --report of a bake with --cage)\n";
       break;
+    case GLFW_KEY_U: s.toggles.uv_layout = !s.toggles.uv_layout; break;
     case GLFW_KEY_D: s.toggles.difference = !s.toggles.difference; break;
     case GLFW_KEY_LEFT_BRACKET:
     case GLFW_KEY_RIGHT_BRACKET:

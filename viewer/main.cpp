@@ -98,10 +98,11 @@ void parse_show(const std::string& text, nmview::Toggles& toggles) {
     else if (item == "nolabels") toggles.labels = false;
     else if (item == "masks") toggles.masks = true;
     else if (item == "cage") toggles.cage = true;
+    else if (item == "uv") toggles.uv_layout = true;
     else if (!item.empty())
       throw nmbake::UsageError(
           "--show: unknown item '" + nmbake::printable(item) +
-          "' (wire, diff, tangent, specular, nolabels, masks, cage; lit or one map: " + nmbake::map_name_list() + ")");
+          "' (wire, diff, tangent, specular, nolabels, masks, cage, uv; lit or one map: " + nmbake::map_name_list() + ")");
   }
 }
 
@@ -280,7 +281,7 @@ int run_command_line(int argc, char** argv) {
                  "folder, else the report's) are loaded where --miss-mask, --suspect-mask, --cage are not given");
   app.add_option("--show", o.show,
                  "Start with toggles on: wire,diff (the normal-angle difference pane),tangent,specular,nolabels,masks (K),cage "
-                 "(C); and what "
+                 "(C),uv (U: the left pane shows the map flat with the UV edges); and what "
                  "the left pane shows: lit (the "
                  "default) or one map of the set unlit in its own colours (normal, ao, curvature, object-id, ...)");
   nmbake::require_numbers(app);

@@ -32,21 +32,62 @@ void main() {
 }
 )";
 
-const char* kMaskFragment = R"(
-in vec2 v_uv;
+// The masks' paint at `uv`: rgb the colour, a how much of it covers what is under it.
+const char* kMaskPaint = R"(
 uniform sampler2D u_miss;
 uniform sampler2D u_suspect;
 uniform vec3 u_miss_colour;
 uniform vec3 u_suspect_colour;
 uniform float u_strength;
+vec4 mask_paint(vec2 uv) {
+  float m = u_strength * clamp(texture(u_miss, uv).r, 0.0, 1.0);
+  float s = u_strength * clamp(texture(u_suspect, uv).r, 0.0, 1.0);
+  float a = m + s * (1.0 - m);
+  return a > 0.0 ? vec4((u_miss_colour * m + u_suspect_colour * s * (1.0 - m)) / a, a) : vec4(0.0);
+}
+)";
+
+const char* kMaskFragment = R"(
+in vec2 v_uv;
 out vec4 frag_color;
 void main() {
-  float m = u_strength * clamp(texture(u_miss, v_uv).r, 0.0, 1.0);
-  float s = u_strength * clamp(texture(u_suspect, v_uv).r, 0.0, 1.0);
-  float a = m + s * (1.0 - m);
-  if (a < 0.5 / 255.0) discard;
-  frag_color = vec4((u_miss_colour * m + u_suspect_colour * s * (1.0 - m)) / a, a);
+  vec4 paint = mask_paint(v_uv);
+  if (paint.a < 0.5 / 255.0) discard;
+  frag_color = paint;
 }
+)";
+
+// The UV view: the map over the UV square [0,1]^2 drawn at u_rect (pane pixels: x, y of the lower
+// left corner, side), v up, with the masks' paint over it when u_masks is 1.
+const char* kUvFullscreenVertex = R"(
+void main() {
+  vec2 p = vec2(float((gl_VertexID & 1) << 2) - 1.0, float((gl_VertexID & 2) << 1) - 1.0);
+  gl_Position = vec4(p, 0.0, 1.0);
+}
+)";
+
+const char* kUvMapFragment = R"(
+uniform sampler2D u_map;
+uniform vec3 u_rect;
+uniform int u_masks;
+out vec4 frag_color;
+void main() {
+  vec2 uv = (gl_FragCoord.xy - u_rect.xy) / u_rect.z;
+  if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) discard;
+  vec3 c = texture(u_map, uv).rgb;
+  if (u_masks == 1) {
+    vec4 paint = mask_paint(uv);
+    c = mix(c, paint.rgb, paint.a);
+  }
+  frag_color = vec4(c, 1.0);
+}
+)";
+
+// The low-poly's triangles at their UVs: clip = uv * scale + offset.
+const char* kUvEdgeVertex = R"(
+layout(location = 3) in vec2 a_uv;
+uniform vec4 u_uv_to_clip;  // scale xy, offset zw
+void main() { gl_Position = vec4(a_uv * u_uv_to_clip.xy + u_uv_to_clip.zw, 0.0, 1.0); }
 )";
 
 const char* kCageVertex = R"(
@@ -78,9 +119,10 @@ GLuint compile_overlay_shader(GLenum type, const char* source, const char* name)
   return shader;
 }
 
-GLuint link_overlay_program(const char* vertex, const char* fragment, const char* name) {
+// `prelude`: GLSL functions put before the fragment shader (kMaskPaint).
+GLuint link_overlay_program(const char* vertex, const char* fragment, const char* name, const char* prelude = "") {
   GLuint vs = compile_overlay_shader(GL_VERTEX_SHADER, vertex, name);
-  GLuint fs = compile_overlay_shader(GL_FRAGMENT_SHADER, fragment, name);
+  GLuint fs = compile_overlay_shader(GL_FRAGMENT_SHADER, (std::string(prelude) + fragment).c_str(), name);
   GLuint program = glCreateProgram();
   glAttachShader(program, vs);
   glAttachShader(program, fs);
@@ -238,8 +280,10 @@ std::string overlay_legend(bool masks, bool cage, const OverlayData& data) {
 }
 
 OverlayRenderer::OverlayRenderer(const OverlayData& data) {
-  mask_program_ = link_overlay_program(kMaskVertex, kMaskFragment, "masks");
+  mask_program_ = link_overlay_program(kMaskVertex, kMaskFragment, "masks", kMaskPaint);
   cage_program_ = link_overlay_program(kCageVertex, kCageFragment, "cage");
+  uv_map_program_ = link_overlay_program(kUvFullscreenVertex, kUvMapFragment, "uv map", kMaskPaint);
+  uv_edge_program_ = link_overlay_program(kUvEdgeVertex, kCageFragment, "uv edges");
   if (data.has_miss()) miss_ = upload_mask(data.miss_mask, "miss mask");
   if (data.has_suspect()) suspect_ = upload_mask(data.suspect_mask, "suspect mask");
   const float black[3] = {0.0f, 0.0f, 0.0f};
@@ -274,26 +318,32 @@ OverlayRenderer::OverlayRenderer(const OverlayData& data) {
 OverlayRenderer::~OverlayRenderer() {
   glDeleteProgram(mask_program_);
   glDeleteProgram(cage_program_);
+  glDeleteProgram(uv_map_program_);
+  glDeleteProgram(uv_edge_program_);
   for (GLuint* t : {&miss_, &suspect_, &fallback_}) glDeleteTextures(1, t);
   glDeleteVertexArrays(1, &cage_vao_);
   glDeleteBuffers(1, &cage_vbo_);
   glDeleteBuffers(1, &cage_ebo_);
 }
 
+void OverlayRenderer::bind_masks(unsigned program) const {
+  glActiveTexture(GL_TEXTURE1);
+  glBindTexture(GL_TEXTURE_2D, miss_ ? miss_ : fallback_);
+  glActiveTexture(GL_TEXTURE2);
+  glBindTexture(GL_TEXTURE_2D, suspect_ ? suspect_ : fallback_);
+  glActiveTexture(GL_TEXTURE0);
+  glUniform1i(glGetUniformLocation(program, "u_miss"), 1);
+  glUniform1i(glGetUniformLocation(program, "u_suspect"), 2);
+  glUniform3fv(glGetUniformLocation(program, "u_miss_colour"), 1, &kMissColour[0]);
+  glUniform3fv(glGetUniformLocation(program, "u_suspect_colour"), 1, &kSuspectColour[0]);
+  glUniform1f(glGetUniformLocation(program, "u_strength"), kMaskStrength);
+}
+
 void OverlayRenderer::draw_masks(const CameraMatrices& camera, unsigned low_vao, std::size_t index_count) const {
   if (!has_masks()) return;
   glUseProgram(mask_program_);
   set_view_projection(mask_program_, camera);
-  glActiveTexture(GL_TEXTURE0);
-  glBindTexture(GL_TEXTURE_2D, miss_ ? miss_ : fallback_);
-  glActiveTexture(GL_TEXTURE1);
-  glBindTexture(GL_TEXTURE_2D, suspect_ ? suspect_ : fallback_);
-  glActiveTexture(GL_TEXTURE0);
-  glUniform1i(glGetUniformLocation(mask_program_, "u_miss"), 0);
-  glUniform1i(glGetUniformLocation(mask_program_, "u_suspect"), 1);
-  glUniform3fv(glGetUniformLocation(mask_program_, "u_miss_colour"), 1, &kMissColour[0]);
-  glUniform3fv(glGetUniformLocation(mask_program_, "u_suspect_colour"), 1, &kSuspectColour[0]);
-  glUniform1f(glGetUniformLocation(mask_program_, "u_strength"), kMaskStrength);
+  bind_masks(mask_program_);
   // The same triangles as the fill: pulled forward so they pass LEQUAL whatever the fill's offset,
   // depth not written so the wireframe after them is tested against the fill as before.
   glEnable(GL_POLYGON_OFFSET_FILL);
@@ -324,6 +374,41 @@ void OverlayRenderer::draw_cage(const CameraMatrices& camera) const {
   glBindVertexArray(0);
   glDepthFunc(GL_LESS);
   glDisable(GL_BLEND);
+}
+
+void OverlayRenderer::draw_uv_layout(int width, int height, unsigned map_texture, unsigned low_vao, std::size_t index_count,
+                                     bool masks) const {
+  const UvSquare square = uv_square(width, height);
+  glDisable(GL_DEPTH_TEST);
+  glBindVertexArray(low_vao);  // the fullscreen triangle reads no attribute; any vertex array does
+  glUseProgram(uv_map_program_);
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_2D, map_texture);
+  glUniform1i(glGetUniformLocation(uv_map_program_, "u_map"), 0);
+  glUniform3f(glGetUniformLocation(uv_map_program_, "u_rect"), float(square.x), float(square.y), float(square.side));
+  glUniform1i(glGetUniformLocation(uv_map_program_, "u_masks"), masks && has_masks() ? 1 : 0);
+  bind_masks(uv_map_program_);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+
+  // The UV edges, premultiplied over (coverage grows where a UV lies outside the square).
+  glUseProgram(uv_edge_program_);
+  const float sx = 2.0f * float(square.side) / float(width), sy = 2.0f * float(square.side) / float(height);
+  glUniform4f(glGetUniformLocation(uv_edge_program_, "u_uv_to_clip"), sx, sy, 2.0f * float(square.x) / float(width) - 1.0f,
+              2.0f * float(square.y) / float(height) - 1.0f);
+  glUniform4fv(glGetUniformLocation(uv_edge_program_, "u_color"), 1, &kUvEdgeColour[0]);
+  glEnable(GL_BLEND);
+  glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
+  glDrawElements(GL_TRIANGLES, GLsizei(index_count), GL_UNSIGNED_INT, nullptr);
+  glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+  glDisable(GL_BLEND);
+  glBindVertexArray(0);
+  glEnable(GL_DEPTH_TEST);
+}
+
+UvSquare uv_square(int width, int height) {
+  const int side = std::max(std::min(width, height), 1);
+  return {(width - side) / 2, (height - side) / 2, side};
 }
 
 }  // namespace nmview

@@ -1,5 +1,6 @@
 // What nmview draws over the low-poly pane to show where a bake went wrong (issue 36, item 2):
-// nmbake's miss and suspect masks painted on the model, and the cage as a wireframe.
+// nmbake's miss and suspect masks painted on the model, the cage as a wireframe, and the UV view
+// (the map flat over the UV square with the low-poly's UV edges, the masks on it too).
 //
 // The masks are the images nmbake writes with --miss-mask (the share of a texel's rays that found
 // nothing, 0..1) and --suspect-mask (1 for a suspect texel), in the map's UV layout; they are
@@ -31,7 +32,15 @@ struct Scene;
 constexpr glm::vec3 kMissColour{1.0f, 0.0f, 1.0f};      // magenta
 constexpr glm::vec3 kSuspectColour{1.0f, 0.55f, 0.0f};  // orange
 constexpr float kMaskStrength = 0.85f;
-constexpr glm::vec4 kCageColour{0.15f, 1.0f, 0.15f, 0.9f};  // green lines, alpha
+constexpr glm::vec4 kCageColour{0.15f, 1.0f, 0.15f, 0.9f};   // green lines, alpha
+constexpr glm::vec4 kUvEdgeColour{1.0f, 1.0f, 1.0f, 0.85f};  // the UV view's edges, alpha
+
+// The UV view's square in a pane of `width` x `height` pixels: the UV square [0,1]^2 as large as
+// fits, centred; x, y its lower-left corner in pane pixels (GL convention, y up), v up.
+struct UvSquare {
+  int x = 0, y = 0, side = 1;
+};
+UvSquare uv_square(int width, int height);
 
 // The overlay files; an empty path is none.
 struct OverlayFiles {
@@ -95,9 +104,16 @@ class OverlayRenderer {
   // The cage's edges, depth tested against the model, blended premultiplied (coverage grows
   // where a line passes outside the model).
   void draw_cage(const CameraMatrices& camera) const;
+  // The UV view into the bound framebuffer of `width` x `height` pixels (a pane): the texture
+  // `map_texture` over the UV square (uv_square; outside it nothing is drawn), the masks painted on
+  // it when `masks`, and the low-poly's triangles (`low_vao`, `index_count` indices) as lines at
+  // their UVs.
+  void draw_uv_layout(int width, int height, unsigned map_texture, unsigned low_vao, std::size_t index_count, bool masks) const;
 
  private:
-  unsigned mask_program_ = 0, cage_program_ = 0;
+  void bind_masks(unsigned program) const;  // the mask textures on units 1 and 2, kMaskPaint's uniforms
+
+  unsigned mask_program_ = 0, cage_program_ = 0, uv_map_program_ = 0, uv_edge_program_ = 0;
   unsigned miss_ = 0, suspect_ = 0, fallback_ = 0;  // textures; fallback_ is 1x1 black
   unsigned cage_vao_ = 0, cage_vbo_ = 0, cage_ebo_ = 0;
   std::size_t cage_edge_count_ = 0;

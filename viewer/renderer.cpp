@@ -375,7 +375,13 @@ void Renderer::render_panes(int width, int height, const OrbitView& view, const 
     glViewport(0, 0, pane_width_, pane_height_);
     glClearColor(0, 0, 0, 0);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-    draw_model(which, camera, toggles);
+    if (which == 0 && toggles.uv_layout && overlays_) {
+      const bool set_map = toggles.show_map && toggles.shown != nmbake::MapKind::normal && has_map(toggles.shown);
+      overlays_->draw_uv_layout(pane_width_, pane_height_, set_map ? set_textures_[int(toggles.shown)] : map_texture_, low_.vao,
+                                low_.index_count, toggles.masks);
+    } else {
+      draw_model(which, camera, toggles);
+    }
     glBindFramebuffer(GL_READ_FRAMEBUFFER, p.msaa_fbo);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, p.fbo);
     glBlitFramebuffer(0, 0, pane_width_, pane_height_, 0, 0, pane_width_, pane_height_, GL_COLOR_BUFFER_BIT, GL_NEAREST);
@@ -535,16 +541,19 @@ void Renderer::render(unsigned target, int width, int height, const OrbitView& v
     // Up to three lines per pane, clipped to the pane: what it is with its triangle count, its mode,
     // and the convention the map is decoded with wherever it is (decoding.h, with where it came from).
     const bool ao = toggles.ao && set_textures_[int(nmbake::MapKind::ao)] != 0;
-    const std::string mode = toggles.show_map && has_map(toggles.shown)
+    const bool uv = toggles.uv_layout && overlays_;
+    const std::string shown_name = toggles.show_map && has_map(toggles.shown) ? nmbake::map_name(toggles.shown) : "normal";
+    const std::string mode = uv ? "UV LAYOUT OVER THE " + shown_name + " MAP"
+                             : toggles.show_map && has_map(toggles.shown)
                                  ? std::string(nmbake::map_name(toggles.shown)) + " MAP, UNLIT"
                              : toggles.tangent_colours ? "MAP IN TANGENT-SPACE COLOURS"
                              : toggles.map             ? std::string(ao ? "WITH NORMAL MAP X AO" : "WITH NORMAL MAP")
                                                        : std::string(ao ? "NO MAP (BARE SHADING) X AO" : "NO MAP (BARE SHADING)");
-    const bool lit_with_map = toggles.map && !(toggles.show_map && has_map(toggles.shown)) && !toggles.tangent_colours;
+    const bool lit_with_map = toggles.map && !(toggles.show_map && has_map(toggles.shown)) && !toggles.tangent_colours && !uv;
     const std::string convention = convention_label(decoding_);
     const std::vector<std::vector<std::string>> titles = {
         {"LOW  " + with_thousands(low_triangles()) + " TRIS", mode, lit_with_map ? convention : "",
-         overlay_legends_[(toggles.masks ? 1 : 0) + (toggles.cage ? 2 : 0)]},
+         overlay_legends_[(toggles.masks ? 1 : 0) + (toggles.cage && !uv ? 2 : 0)]},
         {"HIGH  " + with_thousands(high_triangles()) + " TRIS", "OWN NORMALS, NO MAP"},
         {"ANGLE LOW TO HIGH NORMAL", "BLUE: ONE MODEL ONLY", toggles.map ? "LOW: " + convention : "LOW: NO MAP"}};
     glEnable(GL_SCISSOR_TEST);

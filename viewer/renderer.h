@@ -33,6 +33,7 @@ struct Toggles {
   bool labels = true;                    // pane titles with triangle counts
   bool masks = false;                    // the miss and suspect masks painted on the low-poly, if set (overlays.h)
   bool cage = false;                     // the cage's edges over the low-poly pane, if set (overlays.h)
+  bool uv_layout = false;                // left pane: the shown map flat over the UV square with the UV edges (overlays.h)
   float specular = 0.0f;                 // Blinn specular weight, 0 = off
   float diff_scale = kDefaultDiffScale;  // degrees at the top of the difference pane's colour scale, > 0
   // With show_map: normal, or a map given to Renderer::add_set_map.

@@ -1,10 +1,11 @@
 // nmview's overlays (issue 36, item 2): nmbake's miss and suspect masks painted on the low-poly,
-// and the cage drawn as a wireframe. A generated pair with a known wrong region: the low-poly is
-// the 2 x 2 plane at z = 0 facing +Z (UV = (x + 1) / 2, (y + 1) / 2), the high-poly covers only its
-// left half (x <= 0, at z = 0.01), so every ray of the right half (u > 0.5) misses; the cage is
-// the plane grown to 2.4 x 2.4 at z = 0.1. nmbake bakes it with --cage, --miss-mask,
+// the cage drawn as a wireframe, and the UV view (the map flat under the UV edges). A generated pair with a known wrong region:
+// the low-poly is the 2 x 2 plane at z = 0 facing +Z (UV = (x + 1) / 2, (y + 1) / 2), the high-poly covers only its left half (x
+// <= 0, at z = 0.01), so every ray of the right half (u > 0.5) misses; the cage is the plane grown to 2.4 x 2.4 at z = 0.1.
+// nmbake bakes it with --cage, --miss-mask,
 // --suspect-mask and --report, and nmview (headless, llvmpipe, as test_nmview.cpp) renders it
 // from the front with the light from the eye, so every pixel has a known answer.
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -218,6 +219,50 @@ TEST(NmviewOverlays, CageEdgesDrawnAroundTheModel) {
   EXPECT_TRUE(corner);
 }
 
+// The UV view's pixel of (u, v) in the left pane (column, row from the top): the UV square fills
+// the square pane, v up.
+std::pair<int, int> overlay_uv_view_pixel(double u, double v) {
+  const nmview::UvSquare square = nmview::uv_square(kOverlayPane, kOverlayPane);
+  return {square.x + int(std::floor(u * square.side)), kOverlayPane - 1 - (square.y + int(std::floor(v * square.side)))};
+}
+
+TEST(NmviewOverlays, UvViewShowsTheMapUnderItsEdgesAndMasks) {
+  const OverlayScene& s = overlay_scene();
+  const OverlayShot shot = overlay_render("uv", "--report " + quote(s.report) + " --show nolabels,uv,masks");
+  ASSERT_FALSE(shot.pixels.empty());
+  // The map's texel at (u, v) in 8-bit steps (image row 0 is v = 1).
+  const nmbake::Image map = nmbake::read_image(s.map);
+  auto texel = [&](double u, double v) {
+    const float* p = map.at(int(u * map.width), int((1.0 - v) * map.height));
+    return glm::vec3(p[0], p[1], p[2]);
+  };
+  auto over = [](glm::vec3 under, glm::vec3 paint, double a) {
+    auto channel = [&](float b, float c) { return int(std::lround(255.0 * (double(b) * (1.0 - a) + double(c) * a))); };
+    return OverlayColour{channel(under.r, paint.r), channel(under.g, paint.g), channel(under.b, paint.b)};
+  };
+  // Off the two triangles' edges (the square's sides and its diagonal u = v): the map's texel, the
+  // missed right half painted.
+  for (double u : kSamples)
+    for (double v : kSamples) {
+      if (std::abs(u - v) < 0.15) continue;
+      const auto [x, y] = overlay_uv_view_pixel(u, v);
+      const OverlayColour want =
+          u > 0.5 ? over(texel(u, v), nmview::kMissColour, nmview::kMaskStrength) : over(texel(u, v), {}, 0.0);
+      expect_colour(shot.at(x, y), want, "uv " + std::to_string(u) + "," + std::to_string(v));
+    }
+  // On the diagonal, within a pixel: the edge's white over the map, at least half of it (a 1-pixel
+  // line's multisampled coverage of a pixel varies); only the left half, whose map is unpainted.
+  for (double t : {0.1, 0.2, 0.3, 0.4}) {
+    const auto [x, y] = overlay_uv_view_pixel(t, t);
+    const OverlayColour map_colour = over(texel(t + 0.05, t - 0.05), {}, 0.0);
+    const OverlayColour full = over(texel(t + 0.05, t - 0.05), glm::vec3(nmview::kUvEdgeColour), double(nmview::kUvEdgeColour.a));
+    int brightest = 0;
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) brightest = std::max(brightest, shot.at(x + dx, y + dy).r);
+    EXPECT_GE(brightest - map_colour.r, (full.r - map_colour.r) / 2) << "near uv " << t << "," << t;
+  }
+}
+
 TEST(NmviewOverlays, OptionErrorsSayWhatIsMissing) {
   const OverlayScene& s = overlay_scene();
   const std::string files = quote(s.low) + " " + quote(s.map) + " " + quote(s.high);
@@ -256,7 +301,7 @@ TEST(NmviewOverlays, OptionErrorsSayWhatIsMissing) {
 
   r = run("--show masks,bogus");
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_TRUE(contains(r.err, "masks, cage")) << r.err;
+  EXPECT_TRUE(contains(r.err, "masks, cage, uv")) << r.err;
 }
 
 TEST(OverlayUnits, UniqueEdgesOfTwoTriangles) {
