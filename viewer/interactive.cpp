@@ -24,6 +24,7 @@ const std::vector<std::string> kHelp = {
     "L: ORBITING LIGHT   S: SPECULAR   P: SCREENSHOT   H: HELP   Q: QUIT",
     "A: AO ON/OFF   M: NEXT MAP OF THE SET (LIT, NORMAL, AO, ...)",
     "[ ]: DIFFERENCE SCALE DOWN/UP (DEGREES AT WHITE)",
+    "K: MISS AND SUSPECT MASKS   C: CAGE   U: UV LAYOUT OVER THE MAP",
 };
 
 enum class Drag { none, orbit, pan, light };
@@ -88,6 +89,15 @@ void on_key(GLFWwindow* window, int key, int, int action, int) {
       if (!s.renderer->has_map(nmbake::MapKind::ao)) std::cerr << "nmview: A: the set has no ao map\n";
       break;
     case GLFW_KEY_M: cycle_display(s.toggles, s.renderer->shown_maps()); break;
+    case GLFW_KEY_K:
+      s.toggles.masks = !s.toggles.masks;
+      if (!s.renderer->has_masks()) std::cerr << "nmview: K: no mask given (--miss-mask, --suspect-mask, or --report)\n";
+      break;
+    case GLFW_KEY_C:
+      s.toggles.cage = !s.toggles.cage;
+      if (!s.renderer->has_cage()) std::cerr << "nmview: C: no cage given (--cage, or --report of a bake with --cage)\n";
+      break;
+    case GLFW_KEY_U: s.toggles.uv_layout = !s.toggles.uv_layout; break;
     case GLFW_KEY_D: s.toggles.difference = !s.toggles.difference; break;
     case GLFW_KEY_LEFT_BRACKET:
     case GLFW_KEY_RIGHT_BRACKET:
@@ -209,11 +219,12 @@ void cycle_display(Toggles& toggles, const std::vector<nmbake::MapKind>& maps) {
   else toggles.shown = *(at + 1);
 }
 
-void run_interactive(const Scene& scene, const InteractiveOptions& options) {
+void run_interactive(const Scene& scene, const InteractiveOptions& options, const OverlayData& overlays) {
   Window window(options.width, options.height, title(scene));
   std::cerr << "nmview: " << current_renderer() << "\n";
   Renderer renderer(scene.low, scene.high, scene.map, scene.radius, scene.decoding);
   for (const SetMap& m : scene.set_maps) renderer.add_set_map(m.kind, m.image);
+  renderer.set_overlays(overlays);
 
   State s;
   s.renderer = &renderer;

@@ -5,6 +5,7 @@
 
 #include <vector>
 
+#include "overlays.h"
 #include "scene.h"
 #include "renderer.h"
 #include "view.h"
@@ -39,7 +40,8 @@ glm::vec3 zoom_pivot(const OrbitView& view, const LowVertices& low, const HighVe
 void cycle_display(Toggles& toggles, const std::vector<nmbake::MapKind>& maps);
 
 // Opens the window and runs until it is closed (Esc or Q). Throws nmbake::Error
-// (ExitCode::output) when no window can be opened (no display).
-void run_interactive(const Scene& scene, const InteractiveOptions& options);
+// (ExitCode::output) when no window can be opened (no display). `overlays` are what the K (masks)
+// and C (cage) keys show.
+void run_interactive(const Scene& scene, const InteractiveOptions& options, const OverlayData& overlays = {});
 
 }  // namespace nmview

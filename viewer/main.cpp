@@ -6,6 +6,7 @@
 //   nmview LOW.obj normal.png HIGH.ply --screenshot ear.png --view 30,20,0.25,0.6,1.2,0.1   zoomed on a point
 //   nmview LOW.obj normal.png HIGH.ply --compare       appearance and normal-angle difference, a verdict
 //   nmview LOW.obj 'crate_<MAP>.png' HIGH.ply          the texture set: AO lit, A and M keys, --show MAP
+//   nmview LOW.obj normal.png HIGH.ply --report r.json --show masks,cage   nmbake's masks and cage (K, C keys)
 //
 // main only parses arguments and wires the stages together; errors print "error: <what>" and
 // exit with the baker's codes (errors.h).
@@ -33,6 +34,7 @@
 #include "gl_context.h"
 #include "inputs.h"
 #include "interactive.h"
+#include "overlays.h"
 #include "renderer.h"
 #include "scene.h"
 
@@ -47,6 +49,7 @@ struct Options {
   std::string view = "30,20";
   std::string light = "-30,30";
   std::string show;
+  nmview::OverlayFiles overlays;  // --miss-mask, --suspect-mask, --cage, --report
   bool no_map = false;
   bool no_ao = false;
   bool compare = false;
@@ -93,10 +96,35 @@ void parse_show(const std::string& text, nmview::Toggles& toggles) {
     else if (item == "tangent") toggles.tangent_colours = true;
     else if (item == "specular") toggles.specular = 0.3f;
     else if (item == "nolabels") toggles.labels = false;
+    else if (item == "masks") toggles.masks = true;
+    else if (item == "cage") toggles.cage = true;
+    else if (item == "uv") toggles.uv_layout = true;
     else if (!item.empty())
-      throw nmbake::UsageError("--show: unknown item '" + nmbake::printable(item) +
-                               "' (wire, diff, tangent, specular, nolabels; lit or one map: " + nmbake::map_name_list() + ")");
+      throw nmbake::UsageError(
+          "--show: unknown item '" + nmbake::printable(item) +
+          "' (wire, diff, tangent, specular, nolabels, masks, cage, uv; lit or one map: " + nmbake::map_name_list() + ")");
   }
+}
+
+// The overlay files of the options and the report, checked against --show's masks and cage.
+nmview::OverlayFiles resolve_overlays(const Options& o, const nmview::Toggles& toggles) {
+  nmview::OverlayFiles report;
+  if (!o.overlays.report.empty()) report = nmview::read_report_overlays(o.overlays.report);
+  const nmview::OverlayFiles files = nmview::merge_overlay_files(o.overlays, report);
+  const std::string in_report = o.overlays.report.empty() ? "" : " (" + o.overlays.report + " names none)";
+  if (toggles.masks && !files.any_mask())
+    throw nmbake::UsageError("--show masks: no mask given" + in_report +
+                             "; give --miss-mask FILE or --suspect-mask FILE (written by nmbake --miss-mask, "
+                             "--suspect-mask), or --report FILE of a bake that wrote them");
+  if (toggles.cage && files.cage.empty())
+    throw nmbake::UsageError("--show cage: no cage given" +
+                             (o.overlays.report.empty() ? std::string()
+                                                        : " (" + o.overlays.report +
+                                                              " names none: that bake made its own cage; nmbake --save-cage "
+                                                              "FILE writes it)") +
+                             "; give --cage FILE (a cage nmbake took with --cage or wrote with --save-cage), or --report "
+                             "FILE of a bake with --cage");
+  return files;
 }
 
 int run(const Options& o) {
@@ -120,14 +148,17 @@ int run(const Options& o) {
   io.toggles.ao = !o.no_ao && maps.find(nmbake::MapKind::ao);
   // The screenshot may not be an input (exit 1) nor a file that cannot be written (exit 3): checked
   // before anything is loaded or rendered.
+  const nmview::OverlayFiles overlay_files = resolve_overlays(o, io.toggles);
   nmview::check_screenshot(o.screenshot, o.low, maps, o.high);
+  nmbake::check_output_files(nmview::overlay_inputs(overlay_files), {{"--screenshot", o.screenshot, "the screenshot"}});
 
   const nmview::Scene scene = nmview::load_scene(o.low, maps, o.high, std::cerr, o.decoding, o.uv_set);
   // The target is given in the meshes' object space; the renderer's scene is re-centred.
   io.view = nmview::resolve_view(view, scene.bounds.centre());
+  const nmview::OverlayData overlays = nmview::load_overlays(overlay_files, scene, std::cerr);
 
   if (!o.compare && o.screenshot.empty()) {
-    nmview::run_interactive(scene, io);
+    nmview::run_interactive(scene, io, overlays);
     return 0;
   }
 
@@ -135,6 +166,7 @@ int run(const Options& o) {
   std::cerr << "nmview: " << context.description() << "\n";
   nmview::Renderer renderer(scene.low, scene.high, scene.map, scene.radius, scene.decoding);
   for (const nmview::SetMap& m : scene.set_maps) renderer.add_set_map(m.kind, m.image);
+  renderer.set_overlays(overlays);
 
   if (o.compare) {
     // Each view is measured at the size of one pane of the --size window, lit and without AO: the
@@ -236,8 +268,20 @@ int run_command_line(int argc, char** argv) {
                  "may have several)")
       ->check(CLI::Range(0u, nmbake::kMaxUvSets - 1))
       ->capture_default_str();
+  app.add_option("--miss-mask", o.overlays.miss_mask,
+                 "nmbake --miss-mask's image (the share of each texel's rays that missed): painted magenta on the low-poly "
+                 "with --show masks or the K key");
+  app.add_option("--suspect-mask", o.overlays.suspect_mask,
+                 "nmbake --suspect-mask's image: suspect texels painted orange on the low-poly with --show masks or K");
+  app.add_option("--cage", o.overlays.cage,
+                 "A cage with the low-poly's topology (as given to nmbake --cage, or written by --save-cage): its edges drawn "
+                 "green over the low-poly with --show cage or the C key");
+  app.add_option("--report", o.overlays.report,
+                 "nmbake --report's JSON: the miss mask, suspect mask and cage it names (relative paths from the current "
+                 "folder, else the report's) are loaded where --miss-mask, --suspect-mask, --cage are not given");
   app.add_option("--show", o.show,
-                 "Start with toggles on: wire,diff (the normal-angle difference pane),tangent,specular,nolabels; and what "
+                 "Start with toggles on: wire,diff (the normal-angle difference pane),tangent,specular,nolabels,masks (K),cage "
+                 "(C),uv (U: the left pane shows the map flat with the UV edges); and what "
                  "the left pane shows: lit (the "
                  "default) or one map of the set unlit in its own colours (normal, ao, curvature, object-id, ...)");
   nmbake::require_numbers(app);

@@ -9,6 +9,7 @@
 
 #include "core/errors.h"
 #include "font.h"
+#include "overlays.h"
 #include "shaders.h"
 #include "texture_set.h"
 
@@ -199,6 +200,14 @@ void Renderer::add_set_map(nmbake::MapKind kind, const nmbake::Image& image) {
                               " map");
 }
 
+void Renderer::set_overlays(const OverlayData& data) {
+  overlays_ = std::make_unique<OverlayRenderer>(data);
+  for (int i = 0; i < 4; ++i) overlay_legends_[i] = overlay_legend(i & 1, i & 2, data);
+}
+
+bool Renderer::has_masks() const { return overlays_ && overlays_->has_masks(); }
+bool Renderer::has_cage() const { return overlays_ && overlays_->has_cage(); }
+
 bool Renderer::has_map(nmbake::MapKind kind) const { return kind == nmbake::MapKind::normal || set_textures_[int(kind)] != 0; }
 
 std::vector<nmbake::MapKind> Renderer::shown_maps() const {
@@ -334,6 +343,7 @@ void Renderer::draw_model(int which, const CameraMatrices& camera, const Toggles
   glDrawElements(GL_TRIANGLES, GLsizei(model.index_count), GL_UNSIGNED_INT, nullptr);
   glEnable(GL_MULTISAMPLE);
   glDisable(GL_POLYGON_OFFSET_FILL);
+  if (which == 0 && !normals && toggles.masks && overlays_) overlays_->draw_masks(camera, model.vao, model.index_count);
   if (wireframe) {
     glUseProgram(wire_program_);
     set_camera(wire_program_, camera);
@@ -348,6 +358,7 @@ void Renderer::draw_model(int which, const CameraMatrices& camera, const Toggles
     glDepthFunc(GL_LESS);
     glDisable(GL_BLEND);
   }
+  if (which == 0 && !normals && toggles.cage && overlays_) overlays_->draw_cage(camera);
   glBindVertexArray(0);
 }
 
@@ -364,7 +375,13 @@ void Renderer::render_panes(int width, int height, const OrbitView& view, const 
     glViewport(0, 0, pane_width_, pane_height_);
     glClearColor(0, 0, 0, 0);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-    draw_model(which, camera, toggles);
+    if (which == 0 && toggles.uv_layout && overlays_) {
+      const bool set_map = toggles.show_map && toggles.shown != nmbake::MapKind::normal && has_map(toggles.shown);
+      overlays_->draw_uv_layout(pane_width_, pane_height_, set_map ? set_textures_[int(toggles.shown)] : map_texture_, low_.vao,
+                                low_.index_count, toggles.masks);
+    } else {
+      draw_model(which, camera, toggles);
+    }
     glBindFramebuffer(GL_READ_FRAMEBUFFER, p.msaa_fbo);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, p.fbo);
     glBlitFramebuffer(0, 0, pane_width_, pane_height_, 0, 0, pane_width_, pane_height_, GL_COLOR_BUFFER_BIT, GL_NEAREST);
@@ -524,15 +541,19 @@ void Renderer::render(unsigned target, int width, int height, const OrbitView& v
     // Up to three lines per pane, clipped to the pane: what it is with its triangle count, its mode,
     // and the convention the map is decoded with wherever it is (decoding.h, with where it came from).
     const bool ao = toggles.ao && set_textures_[int(nmbake::MapKind::ao)] != 0;
-    const std::string mode = toggles.show_map && has_map(toggles.shown)
+    const bool uv = toggles.uv_layout && overlays_;
+    const std::string shown_name = toggles.show_map && has_map(toggles.shown) ? nmbake::map_name(toggles.shown) : "normal";
+    const std::string mode = uv ? "UV LAYOUT OVER THE " + shown_name + " MAP"
+                             : toggles.show_map && has_map(toggles.shown)
                                  ? std::string(nmbake::map_name(toggles.shown)) + " MAP, UNLIT"
                              : toggles.tangent_colours ? "MAP IN TANGENT-SPACE COLOURS"
                              : toggles.map             ? std::string(ao ? "WITH NORMAL MAP X AO" : "WITH NORMAL MAP")
                                                        : std::string(ao ? "NO MAP (BARE SHADING) X AO" : "NO MAP (BARE SHADING)");
-    const bool lit_with_map = toggles.map && !(toggles.show_map && has_map(toggles.shown)) && !toggles.tangent_colours;
+    const bool lit_with_map = toggles.map && !(toggles.show_map && has_map(toggles.shown)) && !toggles.tangent_colours && !uv;
     const std::string convention = convention_label(decoding_);
     const std::vector<std::vector<std::string>> titles = {
-        {"LOW  " + with_thousands(low_triangles()) + " TRIS", mode, lit_with_map ? convention : ""},
+        {"LOW  " + with_thousands(low_triangles()) + " TRIS", mode, lit_with_map ? convention : "",
+         overlay_legends_[(toggles.masks ? 1 : 0) + (toggles.cage && !uv ? 2 : 0)]},
         {"HIGH  " + with_thousands(high_triangles()) + " TRIS", "OWN NORMALS, NO MAP"},
         {"ANGLE LOW TO HIGH NORMAL", "BLUE: ONE MODEL ONLY", toggles.map ? "LOW: " + convention : "LOW: NO MAP"}};
     glEnable(GL_SCISSOR_TEST);

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,9 @@ struct Toggles {
   bool tangent_colours = false;          // left pane shows the map's RGB (tangent-space colours) unlit
   bool difference = false;               // a third pane: the angle between the models' normals (angle_metrics.h)
   bool labels = true;                    // pane titles with triangle counts
+  bool masks = false;                    // the miss and suspect masks painted on the low-poly, if set (overlays.h)
+  bool cage = false;                     // the cage's edges over the low-poly pane, if set (overlays.h)
+  bool uv_layout = false;                // left pane: the shown map flat over the UV square with the UV edges (overlays.h)
   float specular = 0.0f;                 // Blinn specular weight, 0 = off
   float diff_scale = kDefaultDiffScale;  // degrees at the top of the difference pane's colour scale, > 0
   // With show_map: normal, or a map given to Renderer::add_set_map.
@@ -40,6 +44,9 @@ struct Toggles {
 // the bare interpolated normal, or --compare's wrong-convention variants: green negated after the
 // decoding, red and green exchanged before it.
 enum class MapVariant { as_decoded, no_map, green_flipped, swapped };
+
+class OverlayRenderer;
+struct OverlayData;
 
 // Pixel rectangle, origin at the lower left (GL convention).
 struct Rect {
@@ -69,6 +76,12 @@ class Renderer {
   bool has_map(nmbake::MapKind kind) const;
   // normal, then every added map, in MapKind order (the order the display cycles through).
   std::vector<nmbake::MapKind> shown_maps() const;
+
+  // Uploads the overlays (overlays.h) that Toggles::masks and Toggles::cage draw, replacing any
+  // earlier ones. Throws like the constructor.
+  void set_overlays(const OverlayData& data);
+  bool has_masks() const;
+  bool has_cage() const;
 
   // A whole frame into framebuffer `target` (0 = the window) of `width` x `height` pixels.
   // `help` lines are printed at the bottom left.
@@ -119,6 +132,8 @@ class Renderer {
   int pane_width_ = 0, pane_height_ = 0, samples_ = 1;
   float radius_ = 1.0f;
   MapDecoding decoding_;
+  std::unique_ptr<OverlayRenderer> overlays_;
+  std::string overlay_legends_[4];  // overlay_legend() by toggles: [masks + 2 * cage]
 };
 
 // An offscreen RGBA8 framebuffer for headless frames.

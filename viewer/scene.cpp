@@ -59,6 +59,7 @@ Scene load_scene(const std::string& low_path, const TextureSetFiles& maps, const
   if (nmbake::ensure_normals(high))
     log << "nmview: " << high_path << " has no normals; using the bake's angle-weighted normals\n";
 
+  scene.origin = low.origin;
   scene.bounds = mesh_bounds(low);
   scene.bounds.extend(mesh_bounds(high));
   const glm::vec3 centre = scene.bounds.centre();

@@ -30,6 +30,8 @@ struct Scene {
   // other than the normal map as read, in MapKind order.
   TextureSetFiles map_files;
   std::vector<SetMap> set_maps;
+  // The low-poly's Mesh::origin (load_mesh), shared by the high-poly and an overlay's cage.
+  glm::dvec3 origin{0.0};
 };
 
 // Throws nmbake::InputError (from the loaders, or "<map>: has N channel(s); a normal map needs
