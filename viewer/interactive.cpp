@@ -10,6 +10,7 @@
 
 #include "core/errors.h"
 #include "gl_context.h"
+#include "udim_textures.h"
 
 namespace nmview {
 namespace {
@@ -214,6 +215,7 @@ void run_interactive(const Scene& scene, const InteractiveOptions& options) {
   std::cerr << "nmview: " << current_renderer() << "\n";
   Renderer renderer(scene.low, scene.high, scene.map, scene.radius, scene.decoding);
   for (const SetMap& m : scene.set_maps) renderer.add_set_map(m.kind, m.image);
+  upload_udim_tiles(renderer, scene);
 
   State s;
   s.renderer = &renderer;

@@ -35,6 +35,7 @@
 #include "interactive.h"
 #include "renderer.h"
 #include "scene.h"
+#include "udim_textures.h"
 
 namespace {
 
@@ -135,6 +136,7 @@ int run(const Options& o) {
   std::cerr << "nmview: " << context.description() << "\n";
   nmview::Renderer renderer(scene.low, scene.high, scene.map, scene.radius, scene.decoding);
   for (const nmview::SetMap& m : scene.set_maps) renderer.add_set_map(m.kind, m.image);
+  nmview::upload_udim_tiles(renderer, scene);
 
   if (o.compare) {
     // Each view is measured at the size of one pane of the --size window, lit and without AO: the
