@@ -6,6 +6,7 @@
 //   nmview LOW.obj normal.png HIGH.ply --screenshot ear.png --view 30,20,0.25,0.6,1.2,0.1   zoomed on a point
 //   nmview LOW.obj normal.png HIGH.ply --compare       appearance and normal-angle difference, a verdict
 //   nmview LOW.obj 'crate_<MAP>.png' HIGH.ply          the texture set: AO lit, A and M keys, --show MAP
+//   nmview LOW.obj 'suz.<UDIM>.png' HIGH.ply           UDIM tiles (udim_tiles.h): each face samples its tile
 //
 // main only parses arguments and wires the stages together; errors print "error: <what>" and
 // exit with the baker's codes (errors.h).
@@ -182,7 +183,10 @@ int run_command_line(int argc, char** argv) {
                  "meshes and images are told apart by their content. LOW: the low-poly mesh with UVs (OBJ, PLY, OFF, STL, "
                  "glTF, FBX, DAE...), as given to nmbake. MAP: the normal map baked for it (any size; its nmbake:* "
                  "metadata says how it was baked), or the texture set as nmbake -o wrote it, with <MAP> for each map's "
-                 "name (crate_<MAP>.png: every map found is loaded, the normal map is required). HIGH: the high-poly "
+                 "name (crate_<MAP>.png: every map found is loaded, the normal map is required), and/or <UDIM> for each UDIM "
+                 "tile's number (suz.<UDIM>.png: every tile 1001-2000 found is loaded, each face samples the tile of its "
+                 "UV centroid; a face whose tile has no file is drawn magenta and one warning lists those tiles). HIGH: the "
+                 "high-poly "
                  "mesh (its normals, else computed ones)")
       ->expected(2, 3)
       ->required()
