@@ -10,6 +10,7 @@
 
 #include "core/errors.h"
 #include "gl_context.h"
+#include "udim_textures.h"
 
 namespace nmview {
 namespace {
@@ -225,6 +226,7 @@ void run_interactive(const Scene& scene, const InteractiveOptions& options, cons
   Renderer renderer(scene.low, scene.high, scene.map, scene.radius, scene.decoding);
   for (const SetMap& m : scene.set_maps) renderer.add_set_map(m.kind, m.image);
   renderer.set_overlays(overlays);
+  upload_udim_tiles(renderer, scene);
 
   State s;
   s.renderer = &renderer;

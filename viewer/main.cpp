@@ -7,6 +7,7 @@
 //   nmview LOW.obj normal.png HIGH.ply --compare       appearance and normal-angle difference, a verdict
 //   nmview LOW.obj 'crate_<MAP>.png' HIGH.ply          the texture set: AO lit, A and M keys, --show MAP
 //   nmview LOW.obj normal.png HIGH.ply --report r.json --show masks,cage   nmbake's masks and cage (K, C keys)
+//   nmview LOW.obj 'suz.<UDIM>.png' HIGH.ply           UDIM tiles (udim_tiles.h): each face samples its tile
 //
 // main only parses arguments and wires the stages together; errors print "error: <what>" and
 // exit with the baker's codes (errors.h).
@@ -37,6 +38,7 @@
 #include "overlays.h"
 #include "renderer.h"
 #include "scene.h"
+#include "udim_textures.h"
 
 namespace {
 
@@ -167,6 +169,7 @@ int run(const Options& o) {
   nmview::Renderer renderer(scene.low, scene.high, scene.map, scene.radius, scene.decoding);
   for (const nmview::SetMap& m : scene.set_maps) renderer.add_set_map(m.kind, m.image);
   renderer.set_overlays(overlays);
+  nmview::upload_udim_tiles(renderer, scene);
 
   if (o.compare) {
     // Each view is measured at the size of one pane of the --size window, lit and without AO: the
@@ -212,7 +215,10 @@ int run_command_line(int argc, char** argv) {
                  "meshes and images are told apart by their content. LOW: the low-poly mesh with UVs (OBJ, PLY, OFF, STL, "
                  "glTF, FBX, DAE...), as given to nmbake. MAP: the normal map baked for it (any size; its nmbake:* "
                  "metadata says how it was baked), or the texture set as nmbake -o wrote it, with <MAP> for each map's "
-                 "name (crate_<MAP>.png: every map found is loaded, the normal map is required). HIGH: the high-poly "
+                 "name (crate_<MAP>.png: every map found is loaded, the normal map is required), and/or <UDIM> for each UDIM "
+                 "tile's number (suz.<UDIM>.png: every tile 1001-2000 found is loaded, each face samples the tile of its "
+                 "UV centroid; a face whose tile has no file is drawn magenta and one warning lists those tiles). HIGH: the "
+                 "high-poly "
                  "mesh (its normals, else computed ones)")
       ->expected(2, 3)
       ->required()

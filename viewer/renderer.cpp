@@ -12,6 +12,7 @@
 #include "overlays.h"
 #include "shaders.h"
 #include "texture_set.h"
+#include "udim_textures.h"
 
 namespace nmview {
 namespace {
@@ -153,7 +154,8 @@ std::vector<Rect> pane_layout(int width, int height, bool difference) {
 Renderer::Renderer(const LowVertices& low, const HighVertices& high, const nmbake::Image& map, float radius,
                    const MapDecoding& decoding)
     : radius_(radius), decoding_(decoding) {
-  low_program_ = link(shaders::kLowVertex, shaders::kLowFragment, "low", shaders::kLighting);
+  low_program_ = link(shaders::kLowVertex, shaders::kLowFragment, "low", (shaders::kLighting + udim_shader_prelude()).c_str());
+  set_udim_sampler_units(low_program_);
   high_program_ = link(shaders::kHighVertex, shaders::kHighFragment, "high", shaders::kLighting);
   wire_program_ = link(shaders::kWireVertex, shaders::kFlatFragment, "wire");
   background_program_ = link(shaders::kFullscreenVertex, shaders::kBackgroundFragment, "background");
@@ -207,6 +209,12 @@ void Renderer::set_overlays(const OverlayData& data) {
 
 bool Renderer::has_masks() const { return overlays_ && overlays_->has_masks(); }
 bool Renderer::has_cage() const { return overlays_ && overlays_->has_cage(); }
+
+void Renderer::set_udim_faces(const std::vector<std::int32_t>& face_cells) { udim_ = std::make_unique<UdimTextures>(face_cells); }
+
+void Renderer::add_udim_map(nmbake::MapKind kind, const std::vector<UdimTileImage>& tiles) {
+  if (udim_) udim_->add(kind, tiles, kind != nmbake::MapKind::normal && shown_texel_exact(kind));
+}
 
 bool Renderer::has_map(nmbake::MapKind kind) const { return kind == nmbake::MapKind::normal || set_textures_[int(kind)] != 0; }
 
@@ -323,6 +331,7 @@ void Renderer::draw_model(int which, const CameraMatrices& camera, const Toggles
     glBindTexture(GL_TEXTURE_2D, shown);
     glUniform1i(uniform(program, "u_shown"), 2);
     glActiveTexture(GL_TEXTURE0);
+    if (udim_) udim_->bind(program, show ? toggles.shown : nmbake::MapKind::normal);
     const int lit_mode = toggles.map && variant != MapVariant::no_map ? 0 : 1;
     glUniform1i(uniform(program, "u_mode"), normals ? lit_mode : show ? 3 : toggles.tangent_colours ? 2 : lit_mode);
     glUniform1i(uniform(program, "u_object"), decoding_.object_space ? 1 : 0);

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -18,6 +19,7 @@
 #include "core/image.h"
 #include "core/maps.h"
 #include "metrics.h"
+#include "udim_tiles.h"
 #include "vertex_data.h"
 #include "view.h"
 
@@ -49,6 +51,8 @@ class OverlayRenderer;
 struct OverlayData;
 
 // Pixel rectangle, origin at the lower left (GL convention).
+class UdimTextures;
+
 struct Rect {
   int x = 0, y = 0, width = 0, height = 0;
 };
@@ -72,6 +76,13 @@ class Renderer {
   // get nearest filtering and are drawn without multisampling, so every covered pixel is exactly one
   // texel's colour. Throws like the constructor for a map over the GL texture limit.
   void add_set_map(nmbake::MapKind kind, const nmbake::Image& image);
+  // UDIM tiles (udim_tiles.h, udim_textures.h): each triangle's cell (face_udim_cells of the
+  // constructor's `low`), then each map's tiles (its add_set_map image or the constructor's map
+  // stays for has_map and the labels). From then on every map is sampled from the face's tile, and
+  // a face whose tile has no normal map is drawn kMissingTileColour (its normal marked w = 2 in
+  // render_normals, the difference pane in that colour). Throws like add_set_map.
+  void set_udim_faces(const std::vector<std::int32_t>& face_cells);
+  void add_udim_map(nmbake::MapKind kind, const std::vector<UdimTileImage>& tiles);
   // Whether `kind` can be shown: normal always, the others once added.
   bool has_map(nmbake::MapKind kind) const;
   // normal, then every added map, in MapKind order (the order the display cycles through).
@@ -133,7 +144,8 @@ class Renderer {
   float radius_ = 1.0f;
   MapDecoding decoding_;
   std::unique_ptr<OverlayRenderer> overlays_;
-  std::string overlay_legends_[4];  // overlay_legend() by toggles: [masks + 2 * cage]
+  std::string overlay_legends_[4];      // overlay_legend() by toggles: [masks + 2 * cage]
+  std::unique_ptr<UdimTextures> udim_;  // null without UDIM tiles
 };
 
 // An offscreen RGBA8 framebuffer for headless frames.

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -32,6 +33,10 @@ struct Scene {
   std::vector<SetMap> set_maps;
   // The low-poly's Mesh::origin (load_mesh), shared by the high-poly and an overlay's cage.
   glm::dvec3 origin{0.0};
+  // With <UDIM> (map_files.udim): the normal map's tiles as read (`map` is a copy of the first), and
+  // each triangle's tile as u + 10 v (-1 in none; udim_tiles.h), in scene.low's index order.
+  std::vector<UdimTileImage> map_tiles;
+  std::vector<std::int32_t> face_cells;
 };
 
 // Throws nmbake::InputError (from the loaders, or "<map>: has N channel(s); a normal map needs
@@ -42,6 +47,10 @@ struct Scene {
 // a tangent-space map that does not look like one) go to `log`.
 // `uv_set` is the low-poly's UV set the map was baked into (nmbake --uv-set, LoadOptions::uv_set:
 // 0 the first, below nmbake::kMaxUvSets); its UVs and tangent frames are the ones shown.
+// With <UDIM>: every tile of every member is read (tiles of one map must have one size), the
+// decoding comes from the normal map's first tile, a note lists the tiles found and one warning
+// lists the tiles that faces use but that have no file (and the faces in no tile). Without it, a
+// note says when faces lie beyond the unit UV square (the map repeats over them).
 Scene load_scene(const std::string& low_path, const TextureSetFiles& maps, const std::string& high_path, std::ostream& log,
                  const DecodingOverrides& overrides = {}, unsigned uv_set = 0);
 

@@ -62,7 +62,8 @@ void main() {
 // ao map's value.
 // u_output 1 writes the shading normal itself (xyz, alpha 1 = covered) instead of the shaded colour,
 // for the angle difference (angle_metrics.h); u_swap exchanges the texel's red and green before the
-// decoding, and --compare's green-flipped variant passes the opposite u_green. A zero-length
+// decoding, and --compare's green-flipped variant passes the opposite u_green. With UDIM tiles
+// every map is read through map_texel (udim_textures.h) from the face's tile. A zero-length
 // perturbed normal (a grey 0.5 texel) falls back to the interpolated normal, so no NaN is shaded.
 inline const char* kLowFragment = R"(
 in vec3 v_position;
@@ -89,11 +90,18 @@ vec3 unit_or(vec3 v, vec3 fallback) {
 void main() {
   vec3 N = v_normal;
   vec3 T = v_tangent.xyz;
+  bool found = true;  // with UDIM tiles (udim_textures.h): the face's tile has a file of that map
   if (u_mode == 3) {
-    frag_color = vec4(texture(u_shown, v_uv).rgb, 1.0);
+    vec3 shown = map_texel(u_shown, u_shown_tiles, 2, v_uv, found).rgb;
+    frag_color = vec4(found ? shown : kMissingTile, 1.0);
     return;
   }
-  vec3 texel = texture(u_map, v_uv).rgb;
+  vec3 texel = map_texel(u_map, u_map_tiles, 0, v_uv, found).rgb;
+  if (!found && u_mode != 1) {
+    // No normal map on this face: the missing-tile colour; as a normal, the bare one marked w = 2.
+    frag_color = u_output == 1 ? vec4(unit_or(N, vec3(0.0, 0.0, 1.0)), 2.0) : vec4(kMissingTile, 1.0);
+    return;
+  }
   if (u_mode == 2) {
     frag_color = vec4(texel, 1.0);
     return;
@@ -116,7 +124,8 @@ void main() {
     frag_color = vec4(n, 1.0);
     return;
   }
-  float occlusion = u_ao == 1 ? texture(u_ao_map, v_uv).r : 1.0;
+  float ao = map_texel(u_ao_map, u_ao_tiles, 1, v_uv, found).r;
+  float occlusion = u_ao == 1 && found ? ao : 1.0;
   frag_color = vec4(shade(n, v_position, occlusion), 1.0);
 }
 )";
@@ -212,6 +221,10 @@ void main() {
   if (!in_a && !in_b) discard;
   if (!in_a || !in_b) {
     frag_color = vec4(0.15, 0.35, 0.85, 1.0);
+    return;
+  }
+  if (a.a > 1.5) {  // a face of a UDIM tile without a normal map (kMissingTileColour)
+    frag_color = vec4(1.0, 0.0, 1.0, 1.0);
     return;
   }
   float angle = degrees(atan(length(cross(a.xyz, b.xyz)), dot(a.xyz, b.xyz)));

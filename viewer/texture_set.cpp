@@ -20,30 +20,44 @@ TextureSetFiles find_texture_set(const std::string& pattern) {
   TextureSetFiles files;
   files.pattern = pattern;
   files.has_token = nmbake::has_map_token(pattern);
-  if (!files.has_token) {
-    files.found.push_back({nmbake::MapKind::normal, pattern});
+  files.udim = has_udim_token(pattern);
+  if (!files.has_token && !files.udim) {
+    files.found.push_back({nmbake::MapKind::normal, pattern, {}});
     return files;
   }
   for (int k = 0; k < nmbake::kMapKinds; ++k) {
     const auto kind = nmbake::MapKind(k);
-    const std::string path = nmbake::map_path(pattern, kind);
+    if (!files.has_token && kind != nmbake::MapKind::normal) continue;
+    const std::string path = files.has_token ? nmbake::map_path(pattern, kind) : pattern;
+    if (files.udim) {
+      std::vector<UdimTileFile> tiles = find_udim_files(path);
+      if (tiles.empty()) files.missing.push_back(kind);
+      else files.found.push_back({kind, path, std::move(tiles)});
+      continue;
+    }
     // status() follows links: a dangling link is "no such file"; any other failure (a folder we
     // may not search) counts as found, so that the loader names the real problem.
     std::error_code error;
     const std::filesystem::file_status status = std::filesystem::status(path, error);
     if (status.type() == std::filesystem::file_type::not_found) files.missing.push_back(kind);
-    else files.found.push_back({kind, path});
+    else files.found.push_back({kind, path, {}});
   }
   return files;
 }
 
 void require_normal_map(const TextureSetFiles& files) {
+  if (files.found.empty() && !files.has_token)
+    throw nmbake::InputError(files.pattern + ": no UDIM tile exists (<UDIM> replaced by " + std::to_string(kUdimFirstTile) +
+                             " to " + std::to_string(kUdimFirstTile + kUdimCells - 1) + ": " +
+                             udim_tile_path(files.pattern, kUdimFirstTile) + ", " +
+                             udim_tile_path(files.pattern, kUdimFirstTile + 1) + ", ...)");
   if (files.found.empty()) {
     std::string examples;
     for (nmbake::MapKind k : {nmbake::MapKind::normal, nmbake::MapKind::ao})
-      examples += (examples.empty() ? "" : ", ") + nmbake::map_path(files.pattern, k);
+      examples += (examples.empty() ? "" : ", ") + udim_tile_path(nmbake::map_path(files.pattern, k), kUdimFirstTile);
     throw nmbake::InputError(files.pattern + ": no file of the texture set exists (<MAP> replaced by each of " +
-                             nmbake::map_name_list() + ": " + examples + ", ...)");
+                             nmbake::map_name_list() + (files.udim ? ", <UDIM> by 1001 to 2000" : "") + ": " + examples +
+                             ", ...)");
   }
   if (!files.find(nmbake::MapKind::normal)) {
     std::string names;
@@ -60,17 +74,33 @@ std::string describe_set(const TextureSetFiles& files) {
   return "found " + (found.empty() ? std::string("none") : found) + (missing.empty() ? "" : "; not found: " + missing);
 }
 
+namespace {
+
+// One file of a member (the member itself, or one of its UDIM tiles), read and checked.
+nmbake::Image read_set_file(const std::string& path, nmbake::MapKind kind, std::ostream& log) {
+  nmbake::Image image = nmbake::read_image(path);
+  if (image.width <= 0 || image.height <= 0 || image.channels <= 0) throw nmbake::InputError(path + ": empty image");
+  const std::map<std::string, std::string> metadata = nmbake::read_image_metadata(path);
+  if (const auto it = metadata.find("nmbake:map"); it != metadata.end() && it->second != nmbake::map_name(kind))
+    log << "nmview: warning: " << path << ": its nmbake:map metadata says '" << it->second << "'; shown as the name says, "
+        << nmbake::map_name(kind) << "\n";
+  return image;
+}
+
+}  // namespace
+
 SetMap load_set_map(const SetFile& file, std::ostream& log) {
   SetMap map;
   map.kind = file.kind;
   map.path = file.path;
-  map.image = nmbake::read_image(file.path);
-  if (map.image.width <= 0 || map.image.height <= 0 || map.image.channels <= 0)
-    throw nmbake::InputError(file.path + ": empty image");
-  const std::map<std::string, std::string> metadata = nmbake::read_image_metadata(file.path);
-  if (const auto it = metadata.find("nmbake:map"); it != metadata.end() && it->second != nmbake::map_name(file.kind))
-    log << "nmview: warning: " << file.path << ": its nmbake:map metadata says '" << it->second << "'; shown as the name says, "
-        << nmbake::map_name(file.kind) << "\n";
+  if (file.tiles.empty()) {
+    map.image = read_set_file(file.path, file.kind, log);
+    return map;
+  }
+  for (const UdimTileFile& tile : file.tiles)
+    map.tiles.push_back({tile.number, tile.path, read_set_file(tile.path, file.kind, log)});
+  check_tile_sizes(map.tiles);
+  map.image = map.tiles.front().image;
   return map;
 }
 
