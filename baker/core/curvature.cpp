@@ -104,64 +104,49 @@ struct Sums {
   std::vector<double> area;
 };
 
-// Face t's twice-area cross product (corner 0's edges).
-glm::dvec3 face_cross(const Mesh& m, std::size_t t) {
-  const glm::dvec3 p0(m.corner_position(t, 0)), p1(m.corner_position(t, 1)), p2(m.corner_position(t, 2));
-  return glm::cross(p1 - p0, -(p0 - p2));
-}
-
-// Face t's terms at its corner k, added to one vertex's sums.
-void add_corner(const Mesh& m, std::size_t t, int k, glm::dvec3& laplace, glm::dvec3& normal, double& area_sum) {
-  const glm::dvec3 p[3] = {glm::dvec3(m.corner_position(t, 0)), glm::dvec3(m.corner_position(t, 1)),
-                           glm::dvec3(m.corner_position(t, 2))};
-  const glm::dvec3 e[3] = {p[2] - p[1], p[0] - p[2], p[1] - p[0]};  // e[k]: the edge opposite corner k
-  const glm::dvec3 cross = glm::cross(e[2], -e[1]);
-  const double len = glm::length(cross);
-  const glm::dvec3 n = cross / len;
-  const double area = 0.5 * len;
-  // Corner k's dot product of its two edges: negative at an obtuse corner; cot = dot / len.
-  const double dot[3] = {-glm::dot(e[2], e[1]), -glm::dot(e[0], e[2]), -glm::dot(e[1], e[0])};
-  const int obtuse = dot[0] < 0.0 ? 0 : dot[1] < 0.0 ? 1 : dot[2] < 0.0 ? 2 : -1;
-  // (cot a + cot b)-weighted edges of this face at corner k, in closed form: n x (opposite edge),
-  // whose length is the opposite edge's however thin the face.
-  laplace += glm::cross(n, e[k]);
-  normal += cross;
-  double mixed;
-  if (obtuse < 0) {
-    // Voronoi area: |edge to corner k+1|^2 cot(corner k+2) + |edge to corner k+2|^2 cot(corner k+1), over 8.
-    const int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
-    mixed = (glm::dot(e[k2], e[k2]) * dot[k2] + glm::dot(e[k1], e[k1]) * dot[k1]) / (8.0 * len);
-    mixed = std::clamp(mixed, 0.0, area);
-  } else {
-    mixed = obtuse == k ? 0.5 * area : 0.25 * area;
-  }
-  area_sum += mixed;
-}
-
-// The zero-area faces marked first (a zero-area face has no normal and no area gradient: it
-// contributes nothing), then each vertex's sums gathered over its faces in face order: the order a
-// face-by-face pass would add them in, so the same sums to the bit on any number of threads.
-Sums accumulate(const Mesh& m, Welded& w, int threads) {
-  parallel_chunks(threads, m.triangle_count(), kFaceChunk, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t t = begin; t < end; ++t) {
-      if (w.state[t] != kGood) continue;
-      const double len = glm::length(face_cross(m, t));
-      if (!(len > 0.0) || !std::isfinite(len)) w.state[t] = kZeroArea;
-    }
-  });
+// One pass over the faces in order, each adding its terms to its three vertices (a gather per
+// vertex would give the same sums but compute each face three times: this pass is the cheaper one,
+// and runs beside the trace's preparation). A zero-area face has no normal and no area gradient: it
+// is marked and contributes nothing.
+Sums accumulate(const Mesh& m, Welded& w) {
   Sums s;
   s.laplace.assign(w.vertices, glm::dvec3(0.0));
   s.normal.assign(w.vertices, glm::dvec3(0.0));
   s.area.assign(w.vertices, 0.0);
-  parallel_chunks(threads, w.vertices, kVertexChunk, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t v = begin; v < end; ++v)
-      for (std::uint32_t i = w.first[v]; i < w.first[v + 1]; ++i) {
-        const std::uint32_t t = w.faces[i];
-        if (w.state[t] != kGood) continue;
-        const int k = w.corner[3 * t] == v ? 0 : w.corner[3 * t + 1] == v ? 1 : 2;
-        add_corner(m, t, k, s.laplace[v], s.normal[v], s.area[v]);
+  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+    if (w.state[t] != kGood) continue;
+    const glm::dvec3 p[3] = {glm::dvec3(m.corner_position(t, 0)), glm::dvec3(m.corner_position(t, 1)),
+                             glm::dvec3(m.corner_position(t, 2))};
+    const glm::dvec3 e[3] = {p[2] - p[1], p[0] - p[2], p[1] - p[0]};  // e[k]: the edge opposite corner k
+    const glm::dvec3 cross = glm::cross(e[2], -e[1]);
+    const double len = glm::length(cross);
+    if (!(len > 0.0) || !std::isfinite(len)) {
+      w.state[t] = kZeroArea;
+      continue;
+    }
+    const glm::dvec3 n = cross / len;
+    const double area = 0.5 * len;
+    // Corner k's dot product of its two edges: negative at an obtuse corner; cot = dot / len.
+    const double dot[3] = {-glm::dot(e[2], e[1]), -glm::dot(e[0], e[2]), -glm::dot(e[1], e[0])};
+    const int obtuse = dot[0] < 0.0 ? 0 : dot[1] < 0.0 ? 1 : dot[2] < 0.0 ? 2 : -1;
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t v = w.corner[3 * t + std::size_t(k)];
+      // (cot a + cot b)-weighted edges of this face at corner k, in closed form: n x (opposite edge),
+      // whose length is the opposite edge's however thin the face.
+      s.laplace[v] += glm::cross(n, e[k]);
+      s.normal[v] += cross;
+      double mixed;
+      if (obtuse < 0) {
+        // Voronoi area: |edge to corner k+1|^2 cot(corner k+2) + |edge to corner k+2|^2 cot(corner k+1), over 8.
+        const int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+        mixed = (glm::dot(e[k2], e[k2]) * dot[k2] + glm::dot(e[k1], e[k1]) * dot[k1]) / (8.0 * len);
+        mixed = std::clamp(mixed, 0.0, area);
+      } else {
+        mixed = obtuse == k ? 0.5 * area : 0.25 * area;
       }
-  });
+      s.area[v] += mixed;
+    }
+  }
   return s;
 }
 
@@ -195,7 +180,7 @@ std::vector<float> vertex_mean_curvature(const Mesh& mesh, const CurvatureOption
   const int threads = opt.threads;
   Welded w = weld_mesh(mesh, threads);
   st.welded_vertices = w.vertices;
-  const Sums s = accumulate(mesh, w, threads);
+  const Sums s = accumulate(mesh, w);
 
   // Interior vertices: every edge shared by exactly two kept faces. H = K.n / 2 with
   // K = laplace / (2 area): the normal part of the mean-curvature normal, whose tangential part on
