@@ -97,6 +97,7 @@ TEST(CageCli, SavedAutomaticCageBakesTheSameMap) {
   EXPECT_TRUE(contains(saved.out, "nmbake: wrote auto.png (128x128")) << saved.out;
   EXPECT_TRUE(contains(saved.err, "nmbake: automatic cage: front ")) << saved.err;
   EXPECT_EQ(saved.report["cage"]["source"], "automatic");
+  EXPECT_EQ(saved.report["options"]["save_cage"], "cage.obj");  // what nmview --report draws as the cage
   ASSERT_TRUE(test::exists(dir + "/cage.obj"));
 
   const CliRun file = run_nmbake(bake_args_sample("file.png") + " --cage cage.obj", "", dir);

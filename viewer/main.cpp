@@ -125,7 +125,7 @@ nmview::OverlayFiles resolve_overlays(const Options& o, const nmview::Toggles& t
                                                               " names none: that bake made its own cage; nmbake --save-cage "
                                                               "FILE writes it)") +
                              "; give --cage FILE (a cage nmbake took with --cage or wrote with --save-cage), or --report "
-                             "FILE of a bake with --cage");
+                             "FILE of a bake with --cage or --save-cage");
   return files;
 }
 
@@ -283,7 +283,8 @@ int run_command_line(int argc, char** argv) {
                  "A cage with the low-poly's topology (as given to nmbake --cage, or written by --save-cage): its edges drawn "
                  "green over the low-poly with --show cage or the C key");
   app.add_option("--report", o.overlays.report,
-                 "nmbake --report's JSON: the miss mask, suspect mask and cage it names (relative paths from the current "
+                 "nmbake --report's JSON: the miss mask, suspect mask and cage (--cage, else --save-cage) it names (relative "
+                 "paths from the current "
                  "folder, else the report's) are loaded where --miss-mask, --suspect-mask, --cage are not given");
   app.add_option("--show", o.show,
                  "Start with toggles on: wire,diff (the normal-angle difference pane),tangent,specular,nolabels,masks (K),cage "

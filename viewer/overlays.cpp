@@ -206,6 +206,8 @@ OverlayFiles read_report_overlays(const std::string& report_path) {
   files.miss_mask = report_path_of(options, "miss_mask", "miss mask", report_path);
   files.suspect_mask = report_path_of(options, "suspect_mask", "suspect mask", report_path);
   files.cage = report_path_of(options, "cage", "cage", report_path);
+  // A bake with the automatic cage that saved it (--save-cage): that file is the cage it used.
+  if (files.cage.empty()) files.cage = report_path_of(options, "save_cage", "saved cage", report_path);
   return files;
 }
 

@@ -409,6 +409,7 @@ RunInfo run_info(const Args& a, const std::vector<std::string>& command, int bit
   run.high_path = a.highs.front();
   run.high_paths = a.highs;
   run.cage_path = a.cage;
+  run.save_cage_path = a.save_cage;
   run.output_path = a.output;
   run.miss_mask_path = a.miss_mask;
   run.suspect_mask_path = a.suspect_mask;

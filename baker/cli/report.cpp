@@ -104,6 +104,7 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
       {"low", r.low_path},
       {"high", r.high_path},
       {"cage", r.cage_path.empty() ? json(nullptr) : json(r.cage_path)},
+      {"save_cage", r.save_cage_path.empty() ? json(nullptr) : json(r.save_cage_path)},
       {"output", r.output_path},
       {"miss_mask", r.miss_mask_path.empty() ? json(nullptr) : json(r.miss_mask_path)},
       {"suspect_mask", r.suspect_mask_path.empty() ? json(nullptr) : json(r.suspect_mask_path)},

@@ -18,6 +18,7 @@ namespace nmbake {
 
 struct RunInfo {
   std::string low_path, high_path, cage_path, output_path, miss_mask_path, suspect_mask_path;
+  std::string save_cage_path;  // --save-cage: where the cage the bake used was written
   int bits = 8;
   std::string compression;  // the EXR compression written ("zip", ...), "" for other formats
   bool dither = false;

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -325,6 +326,10 @@ TEST(OverlayUnits, ReportPathsFromTheCurrentFolderElseBesideTheReport) {
   EXPECT_EQ(merged.miss_mask, "mine.png");
   EXPECT_EQ(merged.cage, found.cage);
   EXPECT_THROW(nmview::read_report_overlays(s.dir + "/none.json"), nmbake::InputError);
+  // A bake with the automatic cage and --save-cage names no cage but the saved one: that is drawn.
+  const std::string saved = s.dir + "/saved_cage_report.json";
+  std::ofstream(saved) << R"({"options": {"cage": null, "miss_mask": null, "save_cage": ")" << s.cage << R"("}})";
+  EXPECT_EQ(fs::weakly_canonical(nmview::read_report_overlays(saved).cage), fs::weakly_canonical(s.cage));
 }
 
 }  // namespace
