@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/errors.h"
+#include "gl_program.h"
 #include "io/image_io.h"
 #include "io/mesh_io.h"
 #include "scene.h"
@@ -101,42 +102,6 @@ uniform vec4 u_color;
 out vec4 frag_color;
 void main() { frag_color = u_color; }
 )";
-
-GLuint compile_overlay_shader(GLenum type, const char* source, const char* name) {
-  const std::string text = std::string("#version 330 core\n") + source;
-  const char* pointer = text.c_str();
-  GLuint shader = glCreateShader(type);
-  glShaderSource(shader, 1, &pointer, nullptr);
-  glCompileShader(shader);
-  GLint ok = 0;
-  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    char log[2048] = {};
-    glGetShaderInfoLog(shader, sizeof(log), nullptr, log);
-    glDeleteShader(shader);
-    throw nmbake::OutputError(std::string("shader ") + name + " does not compile: " + log);
-  }
-  return shader;
-}
-
-// `prelude`: GLSL functions put before the fragment shader (kMaskPaint).
-GLuint link_overlay_program(const char* vertex, const char* fragment, const char* name, const char* prelude = "") {
-  GLuint vs = compile_overlay_shader(GL_VERTEX_SHADER, vertex, name);
-  GLuint fs = compile_overlay_shader(GL_FRAGMENT_SHADER, (std::string(prelude) + fragment).c_str(), name);
-  GLuint program = glCreateProgram();
-  glAttachShader(program, vs);
-  glAttachShader(program, fs);
-  glLinkProgram(program);
-  glDeleteShader(vs);
-  glDeleteShader(fs);
-  GLint ok = 0;
-  glGetProgramiv(program, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    glDeleteProgram(program);
-    throw nmbake::OutputError(std::string("shader program ") + name + " does not link");
-  }
-  return program;
-}
 
 // A mask as a texture sampled like the map (rows flipped so texture t = mesh v). Magnified texel
 // for texel (nearest: a painted texel is one the mask marks, not a blend reaching into the next
@@ -282,10 +247,10 @@ std::string overlay_legend(bool masks, bool cage, const OverlayData& data) {
 }
 
 OverlayRenderer::OverlayRenderer(const OverlayData& data) {
-  mask_program_ = link_overlay_program(kMaskVertex, kMaskFragment, "masks", kMaskPaint);
-  cage_program_ = link_overlay_program(kCageVertex, kCageFragment, "cage");
-  uv_map_program_ = link_overlay_program(kUvFullscreenVertex, kUvMapFragment, "uv map", kMaskPaint);
-  uv_edge_program_ = link_overlay_program(kUvEdgeVertex, kCageFragment, "uv edges");
+  mask_program_ = link_program(kMaskVertex, kMaskFragment, "masks", kMaskPaint);
+  cage_program_ = link_program(kCageVertex, kCageFragment, "cage");
+  uv_map_program_ = link_program(kUvFullscreenVertex, kUvMapFragment, "uv map", kMaskPaint);
+  uv_edge_program_ = link_program(kUvEdgeVertex, kCageFragment, "uv edges");
   if (data.has_miss()) miss_ = upload_mask(data.miss_mask, "miss mask");
   if (data.has_suspect()) suspect_ = upload_mask(data.suspect_mask, "suspect mask");
   const float black[3] = {0.0f, 0.0f, 0.0f};

@@ -9,6 +9,7 @@
 
 #include "core/errors.h"
 #include "font.h"
+#include "gl_program.h"
 #include "overlays.h"
 #include "shaders.h"
 #include "texture_set.h"
@@ -16,44 +17,6 @@
 
 namespace nmview {
 namespace {
-
-GLuint compile(GLenum type, const std::string& source, const char* name) {
-  GLuint shader = glCreateShader(type);
-  const char* text = source.c_str();
-  glShaderSource(shader, 1, &text, nullptr);
-  glCompileShader(shader);
-  GLint ok = 0;
-  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    char log[2048] = {};
-    glGetShaderInfoLog(shader, sizeof(log), nullptr, log);
-    glDeleteShader(shader);
-    throw nmbake::OutputError(std::string("shader ") + name + " does not compile: " + log);
-  }
-  return shader;
-}
-
-// `prelude`: GLSL functions put before the fragment shader (shaders::kLighting, kAngleColour).
-GLuint link(const char* vertex, const char* fragment, const char* name, const char* prelude = "") {
-  const std::string header = "#version 330 core\n";
-  GLuint vs = compile(GL_VERTEX_SHADER, header + vertex, name);
-  GLuint fs = compile(GL_FRAGMENT_SHADER, header + prelude + fragment, name);
-  GLuint program = glCreateProgram();
-  glAttachShader(program, vs);
-  glAttachShader(program, fs);
-  glLinkProgram(program);
-  glDeleteShader(vs);
-  glDeleteShader(fs);
-  GLint ok = 0;
-  glGetProgramiv(program, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    char log[2048] = {};
-    glGetProgramInfoLog(program, sizeof(log), nullptr, log);
-    glDeleteProgram(program);
-    throw nmbake::OutputError(std::string("shader program ") + name + " does not link: " + log);
-  }
-  return program;
-}
 
 GLint uniform(GLuint program, const char* name) { return glGetUniformLocation(program, name); }
 
@@ -154,15 +117,17 @@ std::vector<Rect> pane_layout(int width, int height, bool difference) {
 Renderer::Renderer(const LowVertices& low, const HighVertices& high, const nmbake::Image& map, float radius,
                    const MapDecoding& decoding)
     : radius_(radius), decoding_(decoding) {
-  low_program_ = link(shaders::kLowVertex, shaders::kLowFragment, "low", (shaders::kLighting + udim_shader_prelude()).c_str());
+  low_program_ =
+      link_program(shaders::kLowVertex, shaders::kLowFragment, "low", (shaders::kLighting + udim_shader_prelude()).c_str());
   set_udim_sampler_units(low_program_);
-  high_program_ = link(shaders::kHighVertex, shaders::kHighFragment, "high", shaders::kLighting);
-  wire_program_ = link(shaders::kWireVertex, shaders::kFlatFragment, "wire");
-  background_program_ = link(shaders::kFullscreenVertex, shaders::kBackgroundFragment, "background");
-  pane_program_ = link(shaders::kFullscreenVertex, shaders::kPaneFragment, "pane");
-  difference_program_ = link(shaders::kFullscreenVertex, shaders::kDifferenceFragment, "difference", shaders::kAngleColour);
-  legend_program_ = link(shaders::kFullscreenVertex, shaders::kLegendFragment, "legend", shaders::kAngleColour);
-  text_program_ = link(shaders::kTextVertex, shaders::kFlatFragment, "text");
+  high_program_ = link_program(shaders::kHighVertex, shaders::kHighFragment, "high", shaders::kLighting);
+  wire_program_ = link_program(shaders::kWireVertex, shaders::kFlatFragment, "wire");
+  background_program_ = link_program(shaders::kFullscreenVertex, shaders::kBackgroundFragment, "background");
+  pane_program_ = link_program(shaders::kFullscreenVertex, shaders::kPaneFragment, "pane");
+  difference_program_ =
+      link_program(shaders::kFullscreenVertex, shaders::kDifferenceFragment, "difference", shaders::kAngleColour);
+  legend_program_ = link_program(shaders::kFullscreenVertex, shaders::kLegendFragment, "legend", shaders::kAngleColour);
+  text_program_ = link_program(shaders::kTextVertex, shaders::kFlatFragment, "text");
 
   upload(low, {{0, 3}, {1, 3}, {2, 4}, {3, 2}, {4, 3}}, low_.vao, low_.vbo, low_.ebo);
   low_.index_count = low.indices.size();
