@@ -41,6 +41,7 @@ using nmbake::test::write_file;
 constexpr int kPane = 128;  // screenshots are 2 panes of kPane x kPane
 
 using Result = nmview::test::ToolRun;
+using nmview::test::error_line;
 using nmview::test::quote;
 
 using nmview::test::nmview;
@@ -249,18 +250,6 @@ TEST(NmviewSet, MapTokenFindsTheSet) {
   ASSERT_EQ(single.found.size(), 1u);
   EXPECT_EQ(single.found[0].kind, MapKind::normal);
   EXPECT_FALSE(single.has_token);
-}
-
-// The one "error: ..." line among stderr's notes.
-std::string error_line(const std::string& err) {
-  std::istringstream in(err);
-  std::string found;
-  for (std::string line; std::getline(in, line);)
-    if (line.rfind("error: ", 0) == 0) {
-      EXPECT_TRUE(found.empty()) << "two error lines:\n" << err;
-      found = line;
-    }
-  return found;
 }
 
 TEST(NmviewSet, BakedSetIsFoundAndShown) {

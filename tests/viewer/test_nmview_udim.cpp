@@ -31,6 +31,7 @@ namespace fs = std::filesystem;
 using nmbake::test::contains;
 using nmbake::test::scratch_dir;
 using nmbake::test::write_file;
+using nmview::test::error_line;
 using nmview::test::quote;
 
 constexpr int kUdimPane = 128;  // screenshots are panes of kUdimPane x kUdimPane
@@ -258,33 +259,21 @@ TEST(NmviewUdim, MissingTileIsMagentaWithOneWarning) {
   for (int c = 0; c < 3; ++c) EXPECT_EQ(image.at(px, py)[c], image.at(qx, qy)[c]) << c;
 }
 
-// The one "error: ..." line among stderr's notes.
-std::string udim_error_line(const std::string& err) {
-  std::istringstream in(err);
-  std::string found;
-  for (std::string line; std::getline(in, line);)
-    if (line.rfind("error: ", 0) == 0) {
-      EXPECT_TRUE(found.empty()) << "two error lines:\n" << err;
-      found = line;
-    }
-  return found;
-}
-
 TEST(NmviewUdim, PatternWithoutTilesIsOneError) {
   const UdimScene s = make_udim_scene();
   const std::string pattern = s.dir + "/none.<UDIM>.png";
   const ViewRun v = view_plane(s, s.two_tiles, pattern, "none");
   EXPECT_EQ(v.run.exit_code, 2) << v.run.err;  // as a missing map
-  EXPECT_EQ(udim_error_line(v.run.err), "error: " + pattern + ": no UDIM tile exists (<UDIM> replaced by 1001 to 2000: " + s.dir +
-                                            "/none.1001.png, " + s.dir + "/none.1002.png, ...)");
+  EXPECT_EQ(error_line(v.run.err), "error: " + pattern + ": no UDIM tile exists (<UDIM> replaced by 1001 to 2000: " + s.dir +
+                                       "/none.1001.png, " + s.dir + "/none.1002.png, ...)");
   EXPECT_FALSE(fs::exists(s.dir + "/none.png"));
   // Tiles of two sizes are refused, naming both.
   write_tile(s.dir + "/tile.1002.png", 1, 2 * kTileTexels);
   const ViewRun sizes = view_plane(s, s.two_tiles, s.pattern, "sizes");
   EXPECT_EQ(sizes.run.exit_code, 2) << sizes.run.err;
-  EXPECT_EQ(udim_error_line(sizes.run.err), "error: " + s.dir + "/tile.1002.png is 32x32 but " + s.dir +
-                                                "/tile.1001.png is 16x16; every UDIM tile of a map must have one size (bake "
-                                                "them with one --size)");
+  EXPECT_EQ(error_line(sizes.run.err), "error: " + s.dir + "/tile.1002.png is 32x32 but " + s.dir +
+                                           "/tile.1001.png is 16x16; every UDIM tile of a map must have one size (bake "
+                                           "them with one --size)");
 }
 
 TEST(NmviewUdim, BakedTileSetIsFoundAndShown) {

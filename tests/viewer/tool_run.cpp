@@ -3,6 +3,9 @@
 #include <sys/wait.h>
 
 #include <cstdlib>
+#include <sstream>
+
+#include <gtest/gtest.h>
 
 #include "test_support.h"
 
@@ -29,5 +32,16 @@ ToolRun run_tool(const std::string& dir, const std::string& program, const std::
 }
 
 ToolRun nmview(const std::string& dir, const std::string& args) { return run_tool(dir, NMVIEW_EXE, args); }
+
+std::string error_line(const std::string& err) {
+  std::istringstream in(err);
+  std::string found;
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind("error: ", 0) == 0) {
+      EXPECT_TRUE(found.empty()) << "two error lines:\n" << err;
+      found = line;
+    }
+  return found;
+}
 
 }  // namespace nmview::test

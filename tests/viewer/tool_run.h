@@ -22,4 +22,7 @@ ToolRun run_tool(const std::string& dir, const std::string& program, const std::
 // run_tool of the nmview binary (NMVIEW_EXE).
 ToolRun nmview(const std::string& dir, const std::string& args);
 
+// The one "error: ..." line among a run's stderr notes ("" when none; a second one fails the test).
+std::string error_line(const std::string& err);
+
 }  // namespace nmview::test
