@@ -4,8 +4,10 @@
 // time it predicts at 16 threads; then the whole bake's predicted speed-up from 2 to 16 threads
 // against the targets. A prediction, not a measurement: this machine has 2 cores.
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "amdahl.h"
@@ -27,6 +29,30 @@ constexpr int kSerialRowCount = kSerialStageCount + 2;
 std::string serial_row_name(int row) {
   if (row < kSerialStageCount) return kSerialStages[row];
   return row == kSerialStageCount ? "rest of the report's total" : "process start and exit (wall - total)";
+}
+
+// Spins a fixed amount of integer work (xorshift steps); returns a value so it is not optimised away.
+std::uint64_t serial_spin(std::uint64_t seed) {
+  std::uint64_t x = seed | 1u;
+  for (int i = 0; i < 150000000; ++i) x ^= x << 13, x ^= x >> 7, x ^= x << 17;
+  return x;
+}
+
+// How much of a second core the host gives now: the same spin on 1 thread, then on 2 threads at
+// once (each doing it): 2 T1 / T2, 2.0 when both cores are free, 1.0 when only one is.
+double host_parallelism() {
+  volatile std::uint64_t sink = 0;
+  const auto t0 = Clock::now();
+  sink = sink + serial_spin(1);
+  const double one = since(t0);
+  std::uint64_t r[2] = {0, 0};
+  const auto t1 = Clock::now();
+  std::thread other([&r] { r[1] = serial_spin(2); });
+  r[0] = serial_spin(3);
+  other.join();
+  const double two = since(t1);
+  sink = sink + r[0] + r[1];
+  return amdahl_speedup(2.0 * one, two);
 }
 
 // One bake of the section, and the target for its predicted speed-up (0: none).
@@ -51,7 +77,10 @@ std::vector<double> serial_rows_of(const CommandRun& r) {
 
 // Runs one bake `rounds` times at 1 and 2 threads (1, 2, 1, 2, ...), prints its table and adds its targets.
 void run_serial_bake(BenchRun& run, const SerialBake& bake) {
-  std::printf("#### %s\n\nLoad average before: %s.\n\n", bake.label.c_str(), load_average().c_str());
+  std::printf(
+      "#### %s\n\nLoad average before: %s; two threads of a fixed spin did %.2fx the work of one in the same time "
+      "(2.00: both cores free).\n\n",
+      bake.label.c_str(), load_average().c_str(), host_parallelism());
   flush();
   std::vector<double> rows[2][kSerialRowCount];  // [threads - 1][row]: seconds per round
   std::vector<double> wall[2];
@@ -130,7 +159,8 @@ void run_serial_shares(BenchRun& run, const Scenes& scenes) {
       "The whole process's predicted speed-up from 2 to %d threads is the sum of T2 over the rows against the sum of T%d.\n"
       "This is a prediction from a 2-core machine, not a %d-thread measurement; with other load on the machine the\n"
       "2-thread time is not a clean figure (it takes the other processes' share of the second core, which reads as serial\n"
-      "time): see the load averages.\n\n",
+      "time): see the load averages, and the spin check before each bake (2 threads of a fixed integer loop against 1:\n"
+      "below about 1.8x the host did not give the second core, and the fit below is not to be read).\n\n",
       kSerialPredictThreads, kSerialPredictThreads, kSerialPredictThreads, kSerialPredictThreads, kSerialPredictThreads,
       kSerialPredictThreads);
   const std::string low = scenes.s4 + "/low.obj ";
