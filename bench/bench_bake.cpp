@@ -20,10 +20,9 @@
 // $TMPDIR/nmbake-bench); each run's maps and reports go to a subfolder removed at the end.
 //
 // The sections live in bench_tracing.cpp (1, 2), bench_commands.cpp (3, 6), bench_scaling.cpp
-// (4, 5), bench_floods.cpp (7), bench_batch.cpp (8), bench_png.cpp (9), bench_blender.cpp (10,
-// with blender_bake.py; Blender is $NMBAKE_BLENDER or `blender` on PATH, else nmbake's rows alone)
-// bench_memory.cpp (11) and bench_maps.cpp (12, texture sets);
-// this file parses the arguments, prints the machine, generates the scenes (0) and prints the
+// (4, 5; 5's serial shares in bench_serial.cpp), bench_floods.cpp (7), bench_batch.cpp (8), bench_png.cpp (9), bench_blender.cpp
+// (10, with blender_bake.py; Blender is $NMBAKE_BLENDER or `blender` on PATH, else nmbake's rows alone) bench_memory.cpp (11) and
+// bench_maps.cpp (12, texture sets); this file parses the arguments, prints the machine, generates the scenes (0) and prints the
 // targets. `bench_bake --measure-child CMD ARGS...` is not for people: section 10 starts each
 // command through it (bench_bake.h).
 #include <unistd.h>

@@ -108,6 +108,7 @@ void run_bvh_quality(const BenchRun& run, const Scenes& scenes, std::vector<Qual
 CommandRun run_whole_commands(BenchRun& run, const Scenes& scenes);              // 3; returns the 1M 2048^2 .png row for 5
 void run_loading(BenchRun& run, const Scenes& scenes);                           // 4
 void run_scaling(BenchRun& run, const Scenes& scenes, const CommandRun& m1_2k);  // 5
+void run_serial_shares(BenchRun& run, const Scenes& scenes);                     // 5's last part (bench_serial.cpp)
 void run_far_geometry(BenchRun& run, const Scenes& scenes);                      // 6
 void run_floods(BenchRun& run, const Scenes& scenes);                            // 7 (bench_floods.cpp)
 void run_batch(BenchRun& run, const Scenes& scenes);                             // 8 (bench_batch.cpp)

@@ -1,5 +1,6 @@
 // Sections 4 and 5 of the bake bench: nmbake's mesh loaders against OpenMesh's readers on the same
-// files, and how the bake scales with threads, high-poly triangles and texels.
+// files, and how the bake scales with threads, high-poly triangles and texels (and, last, each stage's serial
+// share at 1 and 2 threads with Amdahl's prediction at 16: bench_serial.cpp).
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -168,6 +169,7 @@ void run_scaling(BenchRun& run, const Scenes& scenes, const CommandRun& m1_2k) {
   run_thread_scaling(run, scenes);
   run_triangle_scaling(run, scenes, m1_2k);
   run_texel_scaling(run, scenes);
+  run_serial_shares(run, scenes);
 }
 
 }  // namespace nmbake::bench
