@@ -51,8 +51,15 @@ run_and_signal() {
   code=$?
 }
 
+# A test started with SIGHUP ignored (nohup) passes that on to nmbake, which keeps it ignored by
+# design (command.h): the SIGHUP case cannot run then, and says so.
+hup_ignored=$((0x$(awk '/^SigIgn:/ {print $2}' /proc/self/status) & 1))
 for case in TERM:bake:143 HUP:bake:129 TERM:write:143 INT:write:130; do
   IFS=: read -r sig when expect <<<"$case"
+  if [ "$sig" = HUP ] && [ "$hup_ignored" = 1 ]; then
+    echo "skip SIGHUP during the bake: SIGHUP is ignored in this test's process (nohup), so nmbake ignores it too"
+    continue
+  fi
   run_and_signal "$sig" "$when"
   # Less the progress line (its redraws end in carriage returns) and the clearing of it.
   err=$(tr '\r' '\n' <"$log/stderr.txt" | grep -v -e '^ *$' -e '^nmbake: ')
