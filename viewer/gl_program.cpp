@@ -1,8 +1,10 @@
 #include "gl_program.h"
 
 #include <string>
+#include <vector>
 
 #include "core/errors.h"
+#include "texture_set.h"
 
 namespace nmview {
 namespace {
@@ -44,6 +46,27 @@ GLuint link_program(const char* vertex, const char* fragment, const char* name, 
     throw nmbake::OutputError(std::string("shader program ") + name + " does not link: " + log);
   }
   return program;
+}
+
+GLuint upload_rgb_texture(const nmbake::Image& image, const std::string& what, TextureSampling sampling) {
+  GLint max_size = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+  if (image.width > max_size || image.height > max_size)
+    throw nmbake::OutputError(what + " is " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+                              ", larger than this OpenGL's texture limit " + std::to_string(max_size));
+  const std::vector<float> rgb = display_rgb(image);
+  const bool exact = sampling == TextureSampling::exact;
+  GLuint texture = 0;
+  glGenTextures(1, &texture);
+  glBindTexture(GL_TEXTURE_2D, texture);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB16, image.width, image.height, 0, GL_RGB, GL_FLOAT, rgb.data());
+  if (!exact) glGenerateMipmap(GL_TEXTURE_2D);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, exact ? GL_NEAREST : GL_LINEAR_MIPMAP_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, sampling == TextureSampling::smooth ? GL_LINEAR : GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  return texture;
 }
 
 }  // namespace nmview

@@ -103,30 +103,6 @@ out vec4 frag_color;
 void main() { frag_color = u_color; }
 )";
 
-// A mask as a texture sampled like the map (rows flipped so texture t = mesh v). Magnified texel
-// for texel (nearest: a painted texel is one the mask marks, not a blend reaching into the next
-// island or wrapping from the far edge); minified mipmapped.
-GLuint upload_mask(const nmbake::Image& mask, const char* name) {
-  GLint max_size = 0;
-  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
-  if (mask.width > max_size || mask.height > max_size)
-    throw nmbake::OutputError(std::string("the ") + name + " is " + std::to_string(mask.width) + "x" +
-                              std::to_string(mask.height) + ", larger than this OpenGL's texture limit " +
-                              std::to_string(max_size));
-  const std::vector<float> rgb = display_rgb(mask);
-  GLuint texture = 0;
-  glGenTextures(1, &texture);
-  glBindTexture(GL_TEXTURE_2D, texture);
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB16, mask.width, mask.height, 0, GL_RGB, GL_FLOAT, rgb.data());
-  glGenerateMipmap(GL_TEXTURE_2D);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
-  return texture;
-}
-
 void set_view_projection(GLuint program, const CameraMatrices& camera) {
   const glm::mat4 vp = camera.projection * camera.view;
   glUniformMatrix4fv(glGetUniformLocation(program, "u_view_projection"), 1, GL_FALSE, &vp[0][0]);
@@ -251,8 +227,8 @@ OverlayRenderer::OverlayRenderer(const OverlayData& data) {
   cage_program_ = link_program(kCageVertex, kCageFragment, "cage");
   uv_map_program_ = link_program(kUvFullscreenVertex, kUvMapFragment, "uv map", kMaskPaint);
   uv_edge_program_ = link_program(kUvEdgeVertex, kCageFragment, "uv edges");
-  if (data.has_miss()) miss_ = upload_mask(data.miss_mask, "miss mask");
-  if (data.has_suspect()) suspect_ = upload_mask(data.suspect_mask, "suspect mask");
+  if (data.has_miss()) miss_ = upload_rgb_texture(data.miss_mask, "the miss mask", TextureSampling::texels_magnified);
+  if (data.has_suspect()) suspect_ = upload_rgb_texture(data.suspect_mask, "the suspect mask", TextureSampling::texels_magnified);
   const float black[3] = {0.0f, 0.0f, 0.0f};
   glGenTextures(1, &fallback_);
   glBindTexture(GL_TEXTURE_2D, fallback_);

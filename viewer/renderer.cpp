@@ -51,30 +51,6 @@ void set_camera(GLuint program, const CameraMatrices& camera) {
   if (eye >= 0) glUniform3fv(eye, 1, &camera.eye[0]);
 }
 
-// A map as an RGB texture (texture_set.h display_rgb: rows flipped so that texture t = mesh v,
-// grey repeated). 16-bit storage keeps 16-bit maps exact; 8-bit maps are exact in it too. `exact`:
-// nearest filtering and no mipmaps, so every sample is one texel's value (ID maps).
-GLuint upload_map(const nmbake::Image& map, const char* name, bool exact) {
-  GLint max_size = 0;
-  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
-  if (map.width > max_size || map.height > max_size)
-    throw nmbake::OutputError(std::string("the ") + name + " map is " + std::to_string(map.width) + "x" +
-                              std::to_string(map.height) + ", larger than this OpenGL's texture limit " +
-                              std::to_string(max_size));
-  const std::vector<float> rgb = display_rgb(map);
-  GLuint texture = 0;
-  glGenTextures(1, &texture);
-  glBindTexture(GL_TEXTURE_2D, texture);
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB16, map.width, map.height, 0, GL_RGB, GL_FLOAT, rgb.data());
-  if (!exact) glGenerateMipmap(GL_TEXTURE_2D);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, exact ? GL_NEAREST : GL_LINEAR_MIPMAP_LINEAR);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, exact ? GL_NEAREST : GL_LINEAR);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
-  return texture;
-}
-
 }  // namespace
 
 std::string with_thousands(std::size_t n) {
@@ -134,7 +110,7 @@ Renderer::Renderer(const LowVertices& low, const HighVertices& high, const nmbak
   upload(high, {{0, 3}, {1, 3}}, high_.vao, high_.vbo, high_.ebo);
   high_.index_count = high.indices.size();
 
-  map_texture_ = upload_map(map, "normal", false);
+  map_texture_ = upload_rgb_texture(map, "the normal map", TextureSampling::smooth);
 
   glGenVertexArrays(1, &empty_vao_);
   glGenVertexArrays(1, &text_vao_);
@@ -158,7 +134,8 @@ void Renderer::add_set_map(nmbake::MapKind kind, const nmbake::Image& image) {
   if (kind == nmbake::MapKind::normal) return;  // the constructor's map
   unsigned& texture = set_textures_[int(kind)];
   glDeleteTextures(1, &texture);
-  texture = upload_map(image, nmbake::map_name(kind), shown_texel_exact(kind));
+  texture = upload_rgb_texture(image, std::string("the ") + nmbake::map_name(kind) + " map",
+                               shown_texel_exact(kind) ? TextureSampling::exact : TextureSampling::smooth);
   if (GLenum error = glGetError(); error == GL_OUT_OF_MEMORY)
     throw nmbake::ResourceError(std::string("out of memory uploading the ") + nmbake::map_name(kind) +
                                 " map to OpenGL (GL_OUT_OF_MEMORY)");
