@@ -18,6 +18,14 @@ endif()
 add_library(nmbake_oiio INTERFACE)
 add_library(nmbake::oiio ALIAS nmbake_oiio)
 target_link_libraries(nmbake_oiio INTERFACE PkgConfig::OIIO)
+# OpenImageIO's libraries are most of every start's dynamic linking: the heaviest go first.
+include(${CMAKE_CURRENT_LIST_DIR}/NmbakeLoadOrder.cmake)
+set(_nmbake_oiio_lib "${OIIO_LINK_LIBRARIES}")
+list(FILTER _nmbake_oiio_lib INCLUDE REGEX "/libOpenImageIO\\.so")
+if(_nmbake_oiio_lib)
+  list(GET _nmbake_oiio_lib 0 _nmbake_oiio_lib)
+  nmbake_load_order(nmbake_oiio "${_nmbake_oiio_lib}")
+endif()
 # libpng: the bench's and tests' reference PNG encoder (bench/png_libpng.cpp).
 nmbake_require(PNG libpng-dev)
 # zlib compresses PNG's bands on several threads (baker/io/png_write.cpp).
