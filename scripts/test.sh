@@ -13,6 +13,17 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 build=${NMBAKE_BUILD_DIR:-$root/build}
 parts=${NMBAKE_TEST_PARTS:-lint unit asan fuzz}
 NMBAKE_TEST_DEPS=1 bash "$root/scripts/install-deps.sh"
+# A compiler cache (ccache, tests/packages.txt) for the three builds, kept outside the checkout
+# (ccache's own default, ~/.cache/ccache): a run on a machine that ran the tests before compiles only
+# what changed, wherever the checkout is (paths under the checkout are hashed relative to it; the
+# precompiled headers' defines and timestamps are not hashed, so their users hit too).
+# NMBAKE_CCACHE=0, or a CMAKE_CXX_COMPILER_LAUNCHER of one's own, turns this off.
+if [ "${NMBAKE_CCACHE:-1}" = 1 ] && [ -z "${CMAKE_CXX_COMPILER_LAUNCHER:-}" ] && command -v ccache >/dev/null; then
+  export CMAKE_CXX_COMPILER_LAUNCHER=ccache CMAKE_C_COMPILER_LAUNCHER=ccache
+  export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$root} CCACHE_NOHASHDIR=${CCACHE_NOHASHDIR:-1}
+  export CCACHE_SLOPPINESS=${CCACHE_SLOPPINESS:-pch_defines,time_macros,include_file_mtime,include_file_ctime}
+  echo "test.sh: compiler cache: ccache in ${CCACHE_DIR:-$(ccache -k cache_dir 2>/dev/null || echo '~/.cache/ccache')}"
+fi
 summary=()
 for part in $parts; do
   start=$(date +%s)
