@@ -5,6 +5,7 @@
 #include <new>
 #include <stdexcept>
 #include <system_error>
+#include <CLI/CLI.hpp>
 
 #include "cli/shell.h"
 #include "core/errors.h"

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <tuple>
+#include <CLI/CLI.hpp>
 
 #include "cli/map_outputs.h"
 #include "cli/outputs.h"

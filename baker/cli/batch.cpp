@@ -7,6 +7,7 @@
 #include <set>
 
 #include <unistd.h>
+#include <CLI/CLI.hpp>
 
 #include "cli/job.h"
 #include "cli/json_file.h"

@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <string>
+#include <CLI/CLI.hpp>
 
 namespace nmbake {
 

@@ -3,7 +3,11 @@
 
 #include <string>
 
-#include <CLI/CLI.hpp>
+// CLI11's App, declared: CLI/CLI.hpp costs seconds of compile time in every translation unit that
+// includes it, so only the .cpp files that parse do.
+namespace CLI {
+class App;
+}  // namespace CLI
 
 namespace nmbake {
 

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <new>
 #include <system_error>
+#include <CLI/CLI.hpp>
 
 namespace nmbake {
 

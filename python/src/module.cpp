@@ -27,6 +27,7 @@
 #include <vector>
 
 #include <nlohmann/json.hpp>
+#include <CLI/CLI.hpp>
 
 #include "cli/args.h"
 #include "cli/command.h"
