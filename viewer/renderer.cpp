@@ -156,6 +156,11 @@ void Renderer::set_udim_faces(const std::vector<std::int32_t>& face_cells) { udi
 
 void Renderer::add_udim_map(nmbake::MapKind kind, const std::vector<UdimTileImage>& tiles) {
   if (udim_) udim_->add(kind, tiles, kind != nmbake::MapKind::normal && shown_texel_exact(kind));
+  if (udim_ && kind == nmbake::MapKind::normal) {
+    std::vector<int> numbers;
+    for (const UdimTileImage& t : tiles) numbers.push_back(t.number);
+    udim_label_ = udim_range_label(numbers);
+  }
 }
 
 bool Renderer::has_map(nmbake::MapKind kind) const { return kind == nmbake::MapKind::normal || set_textures_[int(kind)] != 0; }
@@ -561,7 +566,8 @@ void Renderer::render(unsigned target, int width, int height, const OrbitView& v
                              : toggles.map             ? std::string(ao ? "WITH NORMAL MAP X AO" : "WITH NORMAL MAP")
                                                        : std::string(ao ? "NO MAP (BARE SHADING) X AO" : "NO MAP (BARE SHADING)");
     const bool lit_with_map = toggles.map && !(toggles.show_map && has_map(toggles.shown)) && !toggles.tangent_colours && !uv;
-    const std::string convention = convention_label(decoding_);
+    // With UDIM tiles the normal map's tile range first: "MAP 1001-1004, GREEN UP (OPENGL) ...".
+    const std::string convention = (udim_label_.empty() ? "" : udim_label_ + ", ") + convention_label(decoding_);
     const std::vector<std::vector<std::string>> titles = {
         {"LOW  " + with_thousands(low_triangles()) + " TRIS", mode, lit_with_map ? convention : "",
          overlay_legends_[(toggles.masks ? 1 : 0) + (toggles.cage && !uv ? 2 : 0)], marks_.label},

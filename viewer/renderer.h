@@ -164,6 +164,7 @@ class Renderer {
   std::unique_ptr<OverlayRenderer> overlays_;
   std::string overlay_legends_[4];      // overlay_legend() by toggles: [masks + 2 * cage]
   std::unique_ptr<UdimTextures> udim_;  // null without UDIM tiles
+  std::string udim_label_;              // udim_range_label of the normal map's tiles ("" without)
   Marks marks_;
 };
 
