@@ -171,7 +171,8 @@ TEST(NmviewUvCursor, OptionErrorsAreOneUsageLine) {
   };
   for (const Case& c :
        {Case{"--uv-cursor 0.5", "error: --uv-cursor: expected U,V"}, Case{"--uv-cursor a,b", "error: --uv-cursor: expected U,V"},
-        Case{"--frame-selection", "error: --frame-selection: nothing selected"}}) {
+        Case{"--frame-selection", "error: --frame-selection: nothing selected"},
+        Case{"--uv-cursor 0.5,0.5 --compare", "error: --uv-cursor: --compare keeps its fixed views"}}) {
     const CursorShot r = cursor_render("bad", c.options);
     EXPECT_EQ(r.exit_code, 1) << c.options << "\n" << r.err;
     EXPECT_TRUE(nmbake::test::contains(r.err, c.error)) << r.err;
