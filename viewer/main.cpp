@@ -8,6 +8,8 @@
 //   nmview LOW.obj 'crate_<MAP>.png' HIGH.ply          the texture set: AO lit, A and M keys, --show MAP
 //   nmview LOW.obj normal.png HIGH.ply --report r.json --show masks,cage   nmbake's masks and cage (K, C keys)
 //   nmview LOW.obj 'suz.<UDIM>.png' HIGH.ply           UDIM tiles (udim_tiles.h): each face samples its tile
+//   nmview LOW.obj normal.png HIGH.ply --show uv --uv-cursor 0.3,0.6 --frame-selection --screenshot at.png
+//                                                      the texel at UV 0.3,0.6 marked on the model, framed
 //
 // main only parses arguments and wires the stages together; errors print "error: <what>" and
 // exit with the baker's codes (errors.h).
@@ -39,6 +41,7 @@
 #include "renderer.h"
 #include "scene.h"
 #include "udim_textures.h"
+#include "uv_cursor.h"
 
 namespace {
 
@@ -55,6 +58,8 @@ struct Options {
   bool no_map = false;
   bool no_ao = false;
   bool compare = false;
+  std::string uv_cursor;                          // --uv-cursor U,V ("" none)
+  bool frame_selection = false;                   // --frame-selection: the view frames the UV cursor's point
   double diff_scale = nmview::kDefaultDiffScale;  // degrees at the top of the difference pane's colour scale
   unsigned uv_set = 0;                            // the low-poly's UV set the map was baked into (nmbake --uv-set)
   nmview::DecodingOverrides decoding;
@@ -154,10 +159,41 @@ int run(const Options& o) {
   nmview::check_screenshot(o.screenshot, o.low, maps, o.high);
   nmbake::check_output_files(nmview::overlay_inputs(overlay_files), {{"--screenshot", o.screenshot, "the screenshot"}});
 
+  const std::optional<glm::vec2> uv_cursor =
+      o.uv_cursor.empty() ? std::nullopt : std::optional<glm::vec2>(nmview::parse_uv_cursor(o.uv_cursor));
+  if (o.frame_selection && !uv_cursor)
+    throw nmbake::UsageError(
+        "--frame-selection: nothing selected; give --uv-cursor U,V (the point of the low-poly at that UV is "
+        "framed)");
+  if (o.compare && uv_cursor)
+    throw nmbake::UsageError(
+        "--uv-cursor: --compare keeps its fixed views and marks nothing; use it with --screenshot or the "
+        "window");
+
   const nmview::Scene scene = nmview::load_scene(o.low, maps, o.high, std::cerr, o.decoding, o.uv_set);
   // The target is given in the meshes' object space; the renderer's scene is re-centred.
   io.view = nmview::resolve_view(view, scene.bounds.centre());
   const nmview::OverlayData overlays = nmview::load_overlays(overlay_files, scene, std::cerr);
+
+  // The UV cursor: its texel's point on the low-poly is marked and selected (F frames it).
+  nmview::Marks marks;
+  if (uv_cursor) {
+    const std::optional<nmview::UvPoint> point = nmview::find_uv_point(scene.low, *uv_cursor);
+    marks.uv = uv_cursor;
+    marks.label = nmview::describe_uv_point(*uv_cursor, point);
+    if (point) {
+      marks.points.push_back(point->position);
+      const glm::vec3 p = point->position + scene.bounds.centre();
+      std::cerr << "nmview: --uv-cursor " << o.uv_cursor << ": triangle " << point->triangle
+                << (point->tile > 0 ? " (tile " + std::to_string(point->tile) + ")" : std::string()) << " of the low-poly, at "
+                << p.x << "," << p.y << "," << p.z << ": marked\n";
+      if (o.frame_selection) io.view = nmview::frame_point(io.view, point->position);
+    } else {
+      std::cerr << "nmview: --uv-cursor " << o.uv_cursor << ": in no triangle of the low-poly's UV layout: no marker"
+                << (o.frame_selection ? ", nothing to frame (the view as given)" : "") << "\n";
+    }
+  }
+  io.uv_cursor = uv_cursor;
 
   if (!o.compare && o.screenshot.empty()) {
     nmview::run_interactive(scene, io, overlays);
@@ -195,6 +231,7 @@ int run(const Options& o) {
   }
 
   nmview::Framebuffer target(io.width, io.height);
+  renderer.set_marks(marks);
   renderer.render(target.id(), io.width, io.height, io.view, io.light, io.toggles);
   nmview::write_screenshot(o.screenshot, nmview::Renderer::read_framebuffer(target.id(), io.width, io.height), scene);
   std::cerr << "nmview: wrote " << o.screenshot << " (" << io.width << "x" << io.height << ")\n";
@@ -254,6 +291,14 @@ int run_command_line(int argc, char** argv) {
                "union_rmse=<0..1> interior_share=<fraction> angle_mean=<deg> angle_p95=<deg> no_map_angle_mean=<deg> "
                "no_map_angle_p95=<deg> flipped_angle_mean=<deg> swapped_angle_mean=<deg> map_removes=<share> "
                "verdict=<good|green_flipped|swapped_channels|barely_helps>");
+  app.add_option("--uv-cursor", o.uv_cursor,
+                 "U,V: the UV cursor at the low-poly's UV (U,V), as the mouse puts it over the UV view (U key, --show uv): "
+                 "a cyan cross there, and the texel's point on the model (the first triangle holding that UV; any UDIM tile, "
+                 "1.5,0.5 is in 1002) marked with a cyan cross in the 3D panes, drawn over the models (not depth-tested); "
+                 "that point is the selection (F frames it). Outside every UV triangle: no marker, and a line says so");
+  app.add_flag("--frame-selection", o.frame_selection,
+               "With --uv-cursor: the view frames the selected point (the target at it, a tenth of the models' radius "
+               "around it shown: the F key), keeping --view's angles");
   app.add_option("--diff-scale", o.diff_scale,
                  "Difference pane (D, --show diff): the angle in degrees between the low-poly's shading normal and the "
                  "high-poly's normal at the top of its colour scale (black 0, red, yellow, white at DEG; keys [ and ] "

@@ -156,6 +156,11 @@ void Renderer::set_udim_faces(const std::vector<std::int32_t>& face_cells) { udi
 
 void Renderer::add_udim_map(nmbake::MapKind kind, const std::vector<UdimTileImage>& tiles) {
   if (udim_) udim_->add(kind, tiles, kind != nmbake::MapKind::normal && shown_texel_exact(kind));
+  if (udim_ && kind == nmbake::MapKind::normal) {
+    std::vector<int> numbers;
+    for (const UdimTileImage& t : tiles) numbers.push_back(t.number);
+    udim_label_ = udim_range_label(numbers);
+  }
 }
 
 bool Renderer::has_map(nmbake::MapKind kind) const { return kind == nmbake::MapKind::normal || set_textures_[int(kind)] != 0; }
@@ -408,6 +413,65 @@ void Renderer::draw_text(const std::string& text, float x, float y, float scale,
   glBindVertexArray(0);
 }
 
+void Renderer::draw_flat(const std::vector<glm::vec2>& triangles, glm::vec4 colour, int target_width, int target_height) {
+  if (triangles.empty()) return;
+  glUseProgram(text_program_);
+  glUniform2f(uniform(text_program_, "u_target_size"), float(target_width), float(target_height));
+  glUniform2f(uniform(text_program_, "u_offset"), 0.0f, 0.0f);
+  glUniform4fv(uniform(text_program_, "u_color"), 1, &colour[0]);
+  glBindVertexArray(text_vao_);
+  glBindBuffer(GL_ARRAY_BUFFER, text_vbo_);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(triangles.size() * sizeof(glm::vec2)), triangles.data(), GL_STREAM_DRAW);
+  glDrawArrays(GL_TRIANGLES, 0, GLsizei(triangles.size()));
+  glBindVertexArray(0);
+}
+
+void append_cross_triangles(glm::vec2 centre, float arm, float thickness, std::vector<glm::vec2>& out) {
+  const auto box = [&](glm::vec2 lo, glm::vec2 hi) { out.insert(out.end(), {lo, {hi.x, lo.y}, hi, lo, hi, {lo.x, hi.y}}); };
+  const float t = 0.5f * thickness;
+  box({centre.x - arm, centre.y - t}, {centre.x + arm, centre.y + t});
+  box({centre.x - t, centre.y - arm}, {centre.x + t, centre.y + arm});
+}
+
+void Renderer::draw_marks(const std::vector<Rect>& layout, const OrbitView& view, const Toggles& toggles, float scale,
+                          int target_width, int target_height) {
+  const bool uv_view = toggles.uv_layout && overlays_;
+  // Each mark's centre in target pixels (y down) with its pane, clipped to that pane.
+  std::vector<std::pair<std::size_t, glm::vec2>> centres;
+  for (std::size_t i = 0; i < layout.size(); ++i) {
+    const Rect& r = layout[i];
+    if (i == 0 && uv_view) {
+      if (!marks_.uv) continue;
+      const UvSquare square = uv_square(r.width, r.height);
+      const float x = float(r.x + square.x) + marks_.uv->x * float(square.side);
+      const float y = float(r.y + square.y) + marks_.uv->y * float(square.side);
+      centres.push_back({i, {x, float(target_height) - y}});
+      continue;
+    }
+    for (const glm::vec3& p : marks_.points) {
+      const std::optional<glm::vec2> ndc = project_point(view, radius_, float(r.width) / float(r.height), p);
+      if (!ndc || std::abs(ndc->x) > 1.0f || std::abs(ndc->y) > 1.0f) continue;
+      const float x = float(r.x) + (0.5f * ndc->x + 0.5f) * float(r.width);
+      const float y = float(r.y) + (0.5f * ndc->y + 0.5f) * float(r.height);
+      centres.push_back({i, {x, float(target_height) - y}});
+    }
+  }
+  if (centres.empty()) return;
+  // A dark outline one font pixel wider all round, then the bright cross.
+  const float arm = 6.0f * scale, thickness = 2.0f * scale;
+  glEnable(GL_SCISSOR_TEST);
+  for (const auto& [pane, centre] : centres) {
+    const Rect& r = layout[pane];
+    glScissor(r.x, r.y, r.width, r.height);
+    std::vector<glm::vec2> outline, cross;
+    append_cross_triangles(centre, arm + scale, thickness + 2.0f * scale, outline);
+    append_cross_triangles(centre, arm, thickness, cross);
+    draw_flat(outline, {0.0f, 0.0f, 0.0f, 1.0f}, target_width, target_height);
+    draw_flat(cross, glm::vec4(kMarkColour, 1.0f), target_width, target_height);
+  }
+  glDisable(GL_SCISSOR_TEST);
+}
+
 namespace {
 
 // "30", "2.5": a scale value in the labels' words.
@@ -488,6 +552,7 @@ void Renderer::render(unsigned target, int width, int height, const OrbitView& v
   glViewport(0, 0, width, height);
   const float scale = std::max(1.0f, std::floor(float(height) / 400.0f));
   const float margin = 4.0f * scale;
+  draw_marks(layout, view, toggles, scale, width, height);
   if (toggles.labels) {
     // Up to three lines per pane, clipped to the pane: what it is with its triangle count, its mode,
     // and the convention the map is decoded with wherever it is (decoding.h, with where it came from).
@@ -501,10 +566,11 @@ void Renderer::render(unsigned target, int width, int height, const OrbitView& v
                              : toggles.map             ? std::string(ao ? "WITH NORMAL MAP X AO" : "WITH NORMAL MAP")
                                                        : std::string(ao ? "NO MAP (BARE SHADING) X AO" : "NO MAP (BARE SHADING)");
     const bool lit_with_map = toggles.map && !(toggles.show_map && has_map(toggles.shown)) && !toggles.tangent_colours && !uv;
-    const std::string convention = convention_label(decoding_);
+    // With UDIM tiles the normal map's tile range first: "MAP 1001-1004, GREEN UP (OPENGL) ...".
+    const std::string convention = (udim_label_.empty() ? "" : udim_label_ + ", ") + convention_label(decoding_);
     const std::vector<std::vector<std::string>> titles = {
         {"LOW  " + with_thousands(low_triangles()) + " TRIS", mode, lit_with_map ? convention : "",
-         overlay_legends_[(toggles.masks ? 1 : 0) + (toggles.cage && !uv ? 2 : 0)]},
+         overlay_legends_[(toggles.masks ? 1 : 0) + (toggles.cage && !uv ? 2 : 0)], marks_.label},
         {"HIGH  " + with_thousands(high_triangles()) + " TRIS", "OWN NORMALS, NO MAP"},
         {"ANGLE LOW TO HIGH NORMAL", "BLUE: ONE MODEL ONLY", toggles.map ? "LOW: " + convention : "LOW: NO MAP"}};
     glEnable(GL_SCISSOR_TEST);

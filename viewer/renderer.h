@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,6 +50,16 @@ enum class MapVariant { as_decoded, no_map, green_flipped, swapped };
 
 class OverlayRenderer;
 struct OverlayData;
+
+// What the UV cursor and the selection mark (issue 36, items 2 and 4): crosses of kMarkColour with a
+// dark outline, drawn over the composed panes without a depth test, so a point on the far side of
+// a model is marked all the same (where it projects).
+struct Marks {
+  std::optional<glm::vec2> uv;    // the UV view's cursor (uv_cursor.h): a cross at this UV in the UV view
+  std::vector<glm::vec3> points;  // re-centred scene points: a cross where each projects in every 3D pane
+  std::string label;              // a line under the low pane's titles ("" none), with the labels on
+};
+constexpr glm::vec3 kMarkColour{0.0f, 1.0f, 1.0f};  // cyan: no other overlay, map or scale uses it
 
 // Pixel rectangle, origin at the lower left (GL convention).
 class UdimTextures;
@@ -94,6 +105,9 @@ class Renderer {
   bool has_masks() const;
   bool has_cage() const;
 
+  // The marks every later frame draws (none by default).
+  void set_marks(const Marks& marks) { marks_ = marks; }
+
   // A whole frame into framebuffer `target` (0 = the window) of `width` x `height` pixels.
   // `help` lines are printed at the bottom left.
   void render(unsigned target, int width, int height, const OrbitView& view, const Light& light, const Toggles& toggles,
@@ -132,6 +146,10 @@ class Renderer {
                   bool normals = false);
   void draw_legend(const Rect& pane, float scale, float margin, float top, float diff_scale, int target_width, int target_height);
   void draw_text(const std::string& text, float x, float y, float scale, int target_width, int target_height);
+  // Triangles in target pixels (y down) of one flat colour, through the text program.
+  void draw_flat(const std::vector<glm::vec2>& triangles, glm::vec4 colour, int target_width, int target_height);
+  void draw_marks(const std::vector<Rect>& layout, const OrbitView& view, const Toggles& toggles, float scale, int target_width,
+                  int target_height);
 
   Model low_, high_;
   unsigned map_texture_ = 0;
@@ -146,7 +164,13 @@ class Renderer {
   std::unique_ptr<OverlayRenderer> overlays_;
   std::string overlay_legends_[4];      // overlay_legend() by toggles: [masks + 2 * cage]
   std::unique_ptr<UdimTextures> udim_;  // null without UDIM tiles
+  std::string udim_label_;              // udim_range_label of the normal map's tiles ("" without)
+  Marks marks_;
 };
+
+// A cross centred on `centre` (target pixels, y down): a horizontal and a vertical bar of
+// `thickness`, each reaching `arm` from the centre; 4 triangles appended to `out`.
+void append_cross_triangles(glm::vec2 centre, float arm, float thickness, std::vector<glm::vec2>& out);
 
 // An offscreen RGBA8 framebuffer for headless frames.
 class Framebuffer {

@@ -1,5 +1,6 @@
 #include "udim_tiles.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <system_error>
@@ -92,6 +93,15 @@ std::string tile_number_list(const std::vector<int>& numbers) {
   std::string text;
   for (int number : numbers) text += (text.empty() ? "" : ", ") + std::to_string(number);
   return text;
+}
+
+std::string udim_range_label(const std::vector<int>& numbers) {
+  if (numbers.empty()) return "";
+  const auto [low, high] = std::minmax_element(numbers.begin(), numbers.end());
+  if (*low == *high) return "MAP " + std::to_string(*low);
+  std::string label = "MAP " + std::to_string(*low) + "-" + std::to_string(*high);
+  if (std::size_t(*high - *low + 1) != numbers.size()) label += ", " + std::to_string(numbers.size()) + " TILES";
+  return label;
 }
 
 }  // namespace nmview

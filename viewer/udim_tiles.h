@@ -79,4 +79,9 @@ std::string describe_missing_tiles(const UdimUse& use, const std::vector<int>& m
 // "1001, 1002, 1011"
 std::string tile_number_list(const std::vector<int>& numbers);
 
+// The pane label's tile range of a map's tiles (any order): "MAP 1001-1004" when every number in
+// the range has a tile, "MAP 1001-1011, 3 TILES" when some are missing, "MAP 1002" for one tile,
+// "" for none (the renderer adds the convention after a comma).
+std::string udim_range_label(const std::vector<int>& numbers);
+
 }  // namespace nmview

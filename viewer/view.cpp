@@ -131,6 +131,21 @@ OrbitView frame_view(const OrbitView& view) {
   return v;
 }
 
+OrbitView frame_point(const OrbitView& view, glm::vec3 point) {
+  OrbitView v = view;
+  v.target = point;
+  v.zoom = kSelectionZoom;
+  return v;
+}
+
+std::optional<glm::vec2> project_point(const OrbitView& view, float radius, float aspect, glm::vec3 point) {
+  const CameraFrame f = camera_frame(view, radius, aspect);
+  const glm::vec3 d = point - f.eye;
+  const float depth = glm::dot(d, f.forward);
+  if (!(depth > 0.0f)) return std::nullopt;
+  return glm::vec2(glm::dot(d, f.right) / (depth * f.tan_half_fovx), glm::dot(d, f.up) / (depth * f.tan_half_fovy));
+}
+
 std::optional<float> intersect_triangle(const Ray& ray, glm::vec3 a, glm::vec3 b, glm::vec3 c) {
   const glm::vec3 e1 = b - a, e2 = c - a;
   const glm::vec3 p = glm::cross(ray.direction, e2);

@@ -101,6 +101,19 @@ OrbitView pan_view(const OrbitView& view, float radius, float aspect, glm::vec2 
 // The view framing both models: the target back at the scene centre and zoom 1, the angles kept.
 OrbitView frame_view(const OrbitView& view);
 
+// How close F frames a selection: the zoom that fits a sphere of this share of the scene's radius
+// around the selected point (a tenth: the point's neighbourhood, whatever the mesh's units).
+constexpr float kSelectionZoom = 0.1f;
+
+// The view framing a selected `point` (re-centred scene): the target at it, so it is the pane's
+// centre, and zoom kSelectionZoom; the angles kept.
+OrbitView frame_point(const OrbitView& view, glm::vec3 point);
+
+// Where `point` (re-centred scene) projects in a pane of `aspect`: normalized device coordinates
+// (view.h's -1..1, y up; outside that range off the pane), or nullopt when it is not in front of the
+// camera (at or behind the eye's plane).
+std::optional<glm::vec2> project_point(const OrbitView& view, float radius, float aspect, glm::vec3 point);
+
 // Distance along `ray` to triangle (a, b, c), either side facing, if the ray crosses it at t > 0
 // (Moller and Trumbore 1997). Degenerate triangles are never hit.
 std::optional<float> intersect_triangle(const Ray& ray, glm::vec3 a, glm::vec3 b, glm::vec3 c);

@@ -339,4 +339,12 @@ TEST(NmviewUdim, TileRulesAsTheBaker) {
   EXPECT_EQ(set.found[1].tiles[0].number, 1002);
 }
 
+TEST(NmviewUdim, PaneLabelNamesTheTileRange) {
+  EXPECT_EQ(nmview::udim_range_label({1001, 1002, 1003, 1004}), "MAP 1001-1004");
+  EXPECT_EQ(nmview::udim_range_label({1004, 1001, 1003, 1002}), "MAP 1001-1004");  // any order
+  EXPECT_EQ(nmview::udim_range_label({1001, 1002, 1011}), "MAP 1001-1011, 3 TILES");
+  EXPECT_EQ(nmview::udim_range_label({1002}), "MAP 1002");
+  EXPECT_EQ(nmview::udim_range_label({}), "");
+}
+
 }  // namespace nmview_udim_test
