@@ -132,7 +132,12 @@ class Redirect {
 
 int run_nmbake_in(const std::vector<std::string>& words, const std::string& dir, const std::string& out_name,
                   const std::string& err_name) {
-  std::vector<std::string> args{"nmbake"};
+  return run_command_in(nmbake_command, "nmbake", words, dir, out_name, err_name);
+}
+
+int run_command_in(int (*command)(int, char**), const std::string& name, const std::vector<std::string>& words,
+                   const std::string& dir, const std::string& out_name, const std::string& err_name) {
+  std::vector<std::string> args{name};
   args.insert(args.end(), words.begin(), words.end());
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
@@ -146,7 +151,7 @@ int run_nmbake_in(const std::vector<std::string>& words, const std::string& dir,
     const Redirect in(0, "/dev/null", O_RDONLY);
     const Redirect out(1, out_name, O_WRONLY | O_CREAT | O_TRUNC);
     const Redirect err(2, err_name, O_WRONLY | O_CREAT | O_TRUNC);
-    code = nmbake_command(int(args.size()), argv.data());
+    code = command(int(args.size()), argv.data());
     std::fflush(stdout);
     std::fflush(stderr);
   }

@@ -69,6 +69,11 @@ CliRun run_nmbake(const std::string& args, const std::string& prefix = "", const
 int run_nmbake_in(const std::vector<std::string>& words, const std::string& dir, const std::string& out_name = "out.txt",
                   const std::string& err_name = "err.txt");
 
+// The same for any command with a main()'s signature (nmdiff_command of nmdiff/command.h, say):
+// runs `command` with the program name `name` and the arguments `words` in folder `dir`.
+int run_command_in(int (*command)(int, char**), const std::string& name, const std::vector<std::string>& words,
+                   const std::string& dir, const std::string& out_name = "out.txt", const std::string& err_name = "err.txt");
+
 // The words of a command line as bash splits them: single and double quotes and backslashes; an
 // unquoted shell operator, glob or $ throws std::invalid_argument (nothing here runs a shell).
 std::vector<std::string> shell_words(const std::string& line);

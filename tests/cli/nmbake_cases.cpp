@@ -5,13 +5,15 @@
 // (absolute), then the arguments, each with \\, \t and \n for a backslash, a tab and a newline. For each case it prints "case K:
 // FOLDER" on stdout before running it, runs the command in FOLDER with stdin from /dev/null and stdout and stderr in stdout.txt
 // and stderr.txt there, and then writes "STATUS MILLISECONDS" to code.txt there. A case that crashes ends the program: the cases
-// after it have no code.txt. Exit 0 when every case ran, 2 for a bad CASES file.
+// after it have no code.txt. A case whose first argument is --nmdiff runs nmdiff's command
+// (nmdiff/command.h) with the arguments after it. Exit 0 when every case ran, 2 for a bad CASES file.
 #include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <string>
 #include <vector>
 
+#include "command.h"
 #include "io/output_files.h"
 #include "test_support.h"
 
@@ -59,9 +61,12 @@ int main(int argc, char** argv) {
     }
     std::printf("case %d: %s\n", k, fields[0].c_str());
     std::fflush(stdout);
-    const std::vector<std::string> args(fields.begin() + 1, fields.end());
+    const bool nmdiff = fields.size() > 1 && fields[1] == "--nmdiff";
+    const std::vector<std::string> args(fields.begin() + (nmdiff ? 2 : 1), fields.end());
     const auto start = std::chrono::steady_clock::now();
-    const int code = nmbake::test::run_nmbake_in(args, fields[0], "stdout.txt", "stderr.txt");
+    const int code =
+        nmdiff ? nmbake::test::run_command_in(nmbake::nmdiff_command, "nmdiff", args, fields[0], "stdout.txt", "stderr.txt")
+               : nmbake::test::run_nmbake_in(args, fields[0], "stdout.txt", "stderr.txt");
     const long long ms = std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - start).count();
     std::ofstream(fields[0] + "/code.txt") << code << ' ' << ms << '\n';
   }

@@ -1,5 +1,5 @@
 # Sourced by the command-line tests that try a list of inputs (hostile.sh, assimp_malformed.sh,
-# numbers.sh). case_line FOLDER ARGS... appends a case to the file named by $cases: the folder
+# numbers.sh, ../tool_numbers.sh). case_line FOLDER ARGS... appends a case to the file named by $cases: the folder
 # (absolute) and nmbake's arguments, tab-separated, with \\, \t and \n for a backslash, a tab and
 # a newline. run_cases NMBAKE CASES LIMIT runs every case of CASES and leaves in each case's folder stdout.txt,
 # stderr.txt and code.txt ("STATUS MILLISECONDS"; absent when the case never ended).
@@ -25,6 +25,8 @@ run_cases() {
     done
     args+=("$rest")
     for ((k = 0; k < ${#args[@]}; ++k)); do printf -v 'args[k]' '%b' "${args[k]}"; done
+    # A case for nmdiff (nmbake_cases --nmdiff): NMBAKE is then nmdiff's binary.
+    [ "${args[1]:-}" = --nmdiff ] && args=("${args[0]}" "${args[@]:2}")
     dir=${args[0]}
     start=$(date +%s%N)
     (cd "$dir" && timeout -k 5 "$limit" "$nmbake" "${args[@]:1}" >stdout.txt 2>stderr.txt </dev/null)

@@ -14,10 +14,36 @@ case "$tool" in
   *) echo "usage: tool_numbers.sh nmdiff|nmview EXE REPO WORK"; exit 1 ;;
 esac
 fail=0
+values=('' ' ' '1 ' ' 1' '1x' '0x1' '1,5')
+if [ "$tool" = nmdiff ]; then
+  # nmdiff's cases run in one process under ctest (../run_cases.sh, nmbake_cases --nmdiff), each in
+  # its own folder; nmview's start a window each.
+  source "$(dirname "$0")/run_cases.sh"
+  cases=$work/cases.txt
+  : >"$cases"
+  k=0
+  for option in "${options[@]}"; do
+    for value in "${values[@]}"; do
+      mkdir -p "$work/case$k"
+      case_line "$work/case$k" --nmdiff "${args[@]}" "$option" "$value"
+      k=$((k + 1))
+    done
+  done
+  run_cases "$exe" "$cases" 60
+fi
+k=0
 for option in "${options[@]}"; do
-  for value in '' ' ' '1 ' ' 1' '1x' '0x1' '1,5'; do
-    "$exe" "${args[@]}" "$option" "$value" >stdout.txt 2>stderr.txt
-    got=$?
+  for value in "${values[@]}"; do
+    if [ "$tool" = nmdiff ]; then
+      dir=$work/case$k
+      case_result "$dir"
+      cp "$dir/stderr.txt" stderr.txt 2>/dev/null || : >stderr.txt
+      [ -e "$dir/$out" ] && touch "$out"
+    else
+      "$exe" "${args[@]}" "$option" "$value" >stdout.txt 2>stderr.txt
+      got=$?
+    fi
+    k=$((k + 1))
     lines=$(wc -l <stderr.txt)
     if [ "$got" != "$code" ] || [ "$lines" != 1 ] || ! grep -q '^error: ' stderr.txt || ! grep -qF -- "$option" stderr.txt ||
       [ -e "$out" ]; then
