@@ -58,16 +58,18 @@ Welded weld_mesh(const Mesh& m, int threads) {
   // A repeated face is found at its lowest vertex, among the earlier faces listed there. A face is
   // a repeat when any earlier face has its three vertices (the first of them is not itself a
   // repeat, and it is listed there too): each face is decided on its own, on every thread.
+  // The faces listed at the lowest vertex all have it, and three distinct corners: such a face
+  // repeats this one when it also has the other two.
   parallel_chunks(threads, tris, kFaceChunk, [&](std::size_t begin, std::size_t end) {
     for (std::size_t t = begin; t < end; ++t) {
       if (w.state[t] == kCollapsed) continue;
-      std::uint32_t s[3] = {w.corner[3 * t], w.corner[3 * t + 1], w.corner[3 * t + 2]};
-      std::sort(s, s + 3);
-      for (std::uint32_t i = w.first[s[0]]; i < w.first[s[0] + 1] && w.faces[i] < t; ++i) {
-        const std::uint32_t u = w.faces[i];
-        std::uint32_t o[3] = {w.corner[3 * u], w.corner[3 * u + 1], w.corner[3 * u + 2]};
-        std::sort(o, o + 3);
-        if (o[0] == s[0] && o[1] == s[1] && o[2] == s[2]) {
+      const std::uint32_t* c = &w.corner[3 * t];
+      const std::uint32_t low = std::min({c[0], c[1], c[2]});
+      const std::uint32_t a = c[0] == low ? c[1] : c[0], b = c[2] == low ? c[1] : c[2];
+      for (std::uint32_t i = w.first[low]; i < w.first[low + 1] && w.faces[i] < t; ++i) {
+        const std::uint32_t* o = &w.corner[3 * std::size_t(w.faces[i])];
+        const bool has_a = o[0] == a || o[1] == a || o[2] == a, has_b = o[0] == b || o[1] == b || o[2] == b;
+        if (has_a && has_b) {
           w.state[t] = kDuplicate;
           break;
         }
