@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/image.h"
 #include "core/mesh_topology.h"
 #include "core/parallel.h"
 
@@ -35,19 +36,20 @@ Welded weld_mesh(const Mesh& m, int threads) {
   w.weld = weld_positions(m.positions, &w.vertices);
   const std::size_t tris = m.triangle_count();
   w.corner.resize(3 * tris);
-  w.state.assign(tris, kGood);
-  w.first.assign(w.vertices + 1, 0);
-  for (std::size_t t = 0; t < tris; ++t) {
-    const std::uint32_t* c = &w.corner[3 * t];
-    for (int k = 0; k < 3; ++k) w.corner[3 * t + k] = w.weld[m.position_index[3 * t + k]];
-    const bool ok = c[0] != c[1] && c[1] != c[2] && c[0] != c[2] && finite(m.corner_position(t, 0)) &&
-                    finite(m.corner_position(t, 1)) && finite(m.corner_position(t, 2));
-    if (!ok) {
-      w.state[t] = kCollapsed;
-      continue;
+  w.state.resize(tris);
+  parallel_chunks(threads, tris, kFaceChunk, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t t = begin; t < end; ++t) {
+      std::uint32_t* c = &w.corner[3 * t];
+      for (int k = 0; k < 3; ++k) c[k] = w.weld[m.position_index[3 * t + k]];
+      const bool ok = c[0] != c[1] && c[1] != c[2] && c[0] != c[2] && finite(m.corner_position(t, 0)) &&
+                      finite(m.corner_position(t, 1)) && finite(m.corner_position(t, 2));
+      w.state[t] = ok ? kGood : kCollapsed;
     }
-    for (int k = 0; k < 3; ++k) ++w.first[c[k] + 1];
-  }
+  });
+  w.first.assign(w.vertices + 1, 0);
+  for (std::size_t t = 0; t < tris; ++t)
+    if (w.state[t] != kCollapsed)
+      for (int k = 0; k < 3; ++k) ++w.first[w.corner[3 * t + k] + 1];
   for (std::size_t v = 0; v < w.vertices; ++v) w.first[v + 1] += w.first[v];
   w.faces.resize(w.first[w.vertices]);
   std::vector<std::uint32_t> fill(w.first.begin(), w.first.end() - 1);
@@ -154,19 +156,26 @@ Sums accumulate(const Mesh& m, Welded& w) {
 
 // The area-weighted mean over each vertex's faces of the faces' mean corner value, `passes` times;
 // each vertex's sums gathered over its faces in face order (the same sums on any number of threads).
+// A face's weighted value is worked out once per pass, not once per corner.
 void smooth(const Welded& w, const std::vector<double>& face_area, int passes, int threads, std::vector<double>& h) {
   std::vector<double> next(w.vertices);
+  std::vector<double, DefaultInitAllocator<double>> face_value(w.state.size());  // written for every kept face
   for (int pass = 0; pass < passes; ++pass) {
+    parallel_chunks(threads, w.state.size(), kFaceChunk, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t t = begin; t < end; ++t) {
+        if (w.state[t] != kGood) continue;
+        const std::uint32_t* c = &w.corner[3 * t];
+        face_value[t] = face_area[t] * (h[c[0]] + h[c[1]] + h[c[2]]) / 3.0;
+      }
+    });
     parallel_chunks(threads, w.vertices, kVertexChunk, [&](std::size_t begin, std::size_t end) {
       for (std::size_t v = begin; v < end; ++v) {
         double sum = 0.0, weight = 0.0;
         for (std::uint32_t i = w.first[v]; i < w.first[v + 1]; ++i) {
           const std::uint32_t t = w.faces[i];
           if (w.state[t] != kGood) continue;
-          const std::uint32_t* c = &w.corner[3 * t];
-          const double a = face_area[t], value = a * (h[c[0]] + h[c[1]] + h[c[2]]) / 3.0;
-          sum += value;
-          weight += a;
+          sum += face_value[t];
+          weight += face_area[t];
         }
         next[v] = weight > 0.0 ? sum / weight : h[v];
       }
