@@ -101,6 +101,24 @@ void edge_neighbours(const Welded& w, std::uint32_t v, std::vector<std::uint32_t
   }
 }
 
+// Whether some edge at `v` is not shared by exactly two kept faces (edge_neighbours' counts, not
+// all 2): its neighbours, sorted, must come in pairs of one vertex each.
+bool on_border(const Welded& w, std::uint32_t v, std::vector<std::uint32_t>& scratch) {
+  scratch.clear();
+  for (std::uint32_t i = w.first[v]; i < w.first[v + 1]; ++i) {
+    const std::uint32_t t = w.faces[i];
+    if (w.state[t] == kDuplicate) continue;
+    for (int k = 0; k < 3; ++k)
+      if (w.corner[3 * t + k] != v) scratch.push_back(w.corner[3 * t + k]);
+  }
+  std::sort(scratch.begin(), scratch.end());
+  const std::size_t n = scratch.size();
+  if (n % 2) return true;
+  for (std::size_t i = 0; i < n; i += 2)
+    if (scratch[i] != scratch[i + 1] || (i + 2 < n && scratch[i + 2] == scratch[i])) return true;
+  return false;
+}
+
 // Sums per vertex over the non-degenerate faces: twice the area gradient (the cotangent terms),
 // the area-weighted normal (twice the area), and the mixed area.
 struct Sums {
@@ -157,7 +175,7 @@ Sums accumulate(const Mesh& m, Welded& w) {
 // The area-weighted mean over each vertex's faces of the faces' mean corner value, `passes` times;
 // each vertex's sums gathered over its faces in face order (the same sums on any number of threads).
 // A face's weighted value is worked out once per pass, not once per corner.
-void smooth(const Welded& w, const std::vector<double>& face_area, int passes, int threads, std::vector<double>& h) {
+void smooth(const Welded& w, const double* face_area, int passes, int threads, std::vector<double>& h) {
   std::vector<double> next(w.vertices);
   std::vector<double, DefaultInitAllocator<double>> face_value(w.state.size());  // written for every kept face
   for (int pass = 0; pass < passes; ++pass) {
@@ -196,16 +214,13 @@ std::vector<float> vertex_mean_curvature(const Mesh& mesh, const CurvatureOption
   // Interior vertices: every edge shared by exactly two kept faces. H = K.n / 2 with
   // K = laplace / (2 area): the normal part of the mean-curvature normal, whose tangential part on
   // an irregular mesh is discretisation error. 0 where it has no meaning yet.
-  std::vector<std::uint8_t> border(w.vertices, 0);
+  std::vector<std::uint8_t, DefaultInitAllocator<std::uint8_t>> border(w.vertices);  // written for every vertex
   std::vector<double> h(w.vertices, 0.0);
   std::vector<std::uint8_t> valued(w.vertices, 0);
   parallel_chunks(threads, w.vertices, kVertexChunk, [&](std::size_t begin, std::size_t end) {
     std::vector<std::uint32_t> scratch;
-    std::vector<std::pair<std::uint32_t, int>> nb;
     for (std::size_t v = begin; v < end; ++v) {
-      edge_neighbours(w, std::uint32_t(v), scratch, nb);
-      for (const auto& e : nb)
-        if (e.second != 2) border[v] = 1;
+      border[v] = on_border(w, std::uint32_t(v), scratch);
       const double nlen = glm::length(s.normal[v]);
       if (border[v] || !(s.area[v] > 0.0) || !(nlen > 0.0) || !std::isfinite(nlen)) continue;
       const double value = glm::dot(s.laplace[v], s.normal[v] / nlen) / (4.0 * s.area[v]);
@@ -218,7 +233,7 @@ std::vector<float> vertex_mean_curvature(const Mesh& mesh, const CurvatureOption
 
   // The others from their neighbours: first those next to a valued vertex, then those next to one
   // of these (a grid's corner), each the plain mean of the distinct neighbours valued before it.
-  std::vector<double> fill(w.vertices);
+  std::vector<double, DefaultInitAllocator<double>> fill(w.vertices);  // read only where `filled`, written each round
   std::vector<std::uint8_t> filled(w.vertices);
   for (std::uint8_t round = 2; round <= 3; ++round) {
     parallel_chunks(threads, w.vertices, kVertexChunk, [&](std::size_t begin, std::size_t end) {
@@ -246,7 +261,7 @@ std::vector<float> vertex_mean_curvature(const Mesh& mesh, const CurvatureOption
   for (std::size_t v = 0; v < w.vertices; ++v) st.unvalued_vertices += valued[v] == 0;
 
   if (opt.smoothing > 0) {
-    std::vector<double> face_area(mesh.triangle_count(), 0.0);
+    std::vector<double, DefaultInitAllocator<double>> face_area(mesh.triangle_count());  // read for kept faces only
     parallel_chunks(threads, mesh.triangle_count(), kFaceChunk, [&](std::size_t begin, std::size_t end) {
       for (std::size_t t = begin; t < end; ++t) {
         if (w.state[t] != kGood) continue;
@@ -255,7 +270,7 @@ std::vector<float> vertex_mean_curvature(const Mesh& mesh, const CurvatureOption
                                                     glm::dvec3(mesh.corner_position(t, 2)) - p0));
       }
     });
-    smooth(w, face_area, opt.smoothing, threads, h);
+    smooth(w, face_area.data(), opt.smoothing, threads, h);
   }
 
   for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
