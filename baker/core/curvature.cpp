@@ -19,11 +19,12 @@ enum FaceState : std::uint8_t { kGood, kZeroArea, kCollapsed, kDuplicate };
 // The welded mesh: corners as welded ids, each face's state, and the faces around each vertex.
 struct Welded {
   std::size_t vertices = 0;
-  std::vector<std::uint32_t> weld;    // per position
-  std::vector<std::uint32_t> corner;  // 3 per triangle
-  std::vector<std::uint8_t> state;    // per triangle, FaceState
-  std::vector<std::uint32_t> first;   // vertices + 1 offsets into `faces`
-  std::vector<std::uint32_t> faces;   // the non-collapsed faces around each vertex, in face order
+  std::vector<std::uint32_t> weld;        // per position
+  const std::uint32_t* corner = nullptr;  // 3 per triangle: the mesh's position_index when welding changed nothing, else own
+  std::vector<std::uint32_t> own_corner;
+  std::vector<std::uint8_t> state;   // per triangle, FaceState
+  std::vector<std::uint32_t> first;  // vertices + 1 offsets into `faces`
+  std::vector<std::uint32_t> faces;  // the non-collapsed faces around each vertex, in face order
 };
 
 constexpr std::size_t kFaceChunk = 1 << 14;    // faces a thread takes at once
@@ -35,12 +36,17 @@ Welded weld_mesh(const Mesh& m, int threads) {
   Welded w;
   w.weld = weld_positions(m.positions, &w.vertices);
   const std::size_t tris = m.triangle_count();
-  w.corner.resize(3 * tris);
+  // A mesh whose positions are all distinct (an indexed PLY) welds to itself: its own indices serve.
+  bool same = w.vertices == m.positions.size();
+  for (std::size_t i = 0; same && i < w.weld.size(); ++i) same = w.weld[i] == i;
+  if (!same) w.own_corner.resize(3 * tris);
+  w.corner = same ? m.position_index.data() : w.own_corner.data();
   w.state.resize(tris);
   parallel_chunks(threads, tris, kFaceChunk, [&](std::size_t begin, std::size_t end) {
     for (std::size_t t = begin; t < end; ++t) {
-      std::uint32_t* c = &w.corner[3 * t];
-      for (int k = 0; k < 3; ++k) c[k] = w.weld[m.position_index[3 * t + k]];
+      if (!same)
+        for (int k = 0; k < 3; ++k) w.own_corner[3 * t + k] = w.weld[m.position_index[3 * t + k]];
+      const std::uint32_t* c = &w.corner[3 * t];
       const bool ok = c[0] != c[1] && c[1] != c[2] && c[0] != c[2] && finite(m.corner_position(t, 0)) &&
                       finite(m.corner_position(t, 1)) && finite(m.corner_position(t, 2));
       w.state[t] = ok ? kGood : kCollapsed;
@@ -209,7 +215,7 @@ std::vector<float> vertex_mean_curvature(const Mesh& mesh, const CurvatureOption
   const int threads = opt.threads;
   Welded w = weld_mesh(mesh, threads);
   st.welded_vertices = w.vertices;
-  const Sums s = accumulate(mesh, w);
+  Sums s = accumulate(mesh, w);
 
   // Interior vertices: every edge shared by exactly two kept faces. H = K.n / 2 with
   // K = laplace / (2 area): the normal part of the mean-curvature normal, whose tangential part on
@@ -230,6 +236,7 @@ std::vector<float> vertex_mean_curvature(const Mesh& mesh, const CurvatureOption
     }
   });
   for (std::size_t v = 0; v < w.vertices; ++v) st.border_vertices += border[v];
+  s = Sums();  // freed now: the smoothing's buffers reuse the memory (no fresh pages to zero)
 
   // The others from their neighbours: first those next to a valued vertex, then those next to one
   // of these (a grid's corner), each the plain mean of the distinct neighbours valued before it.
