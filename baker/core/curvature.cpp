@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/image.h"
 #include "core/mesh_topology.h"
 #include "core/parallel.h"
 
@@ -18,11 +19,12 @@ enum FaceState : std::uint8_t { kGood, kZeroArea, kCollapsed, kDuplicate };
 // The welded mesh: corners as welded ids, each face's state, and the faces around each vertex.
 struct Welded {
   std::size_t vertices = 0;
-  std::vector<std::uint32_t> weld;    // per position
-  std::vector<std::uint32_t> corner;  // 3 per triangle
-  std::vector<std::uint8_t> state;    // per triangle, FaceState
-  std::vector<std::uint32_t> first;   // vertices + 1 offsets into `faces`
-  std::vector<std::uint32_t> faces;   // the non-collapsed faces around each vertex, in face order
+  std::vector<std::uint32_t> weld;        // per position
+  const std::uint32_t* corner = nullptr;  // 3 per triangle: the mesh's position_index when welding changed nothing, else own
+  std::vector<std::uint32_t> own_corner;
+  std::vector<std::uint8_t> state;   // per triangle, FaceState
+  std::vector<std::uint32_t> first;  // vertices + 1 offsets into `faces`
+  std::vector<std::uint32_t> faces;  // the non-collapsed faces around each vertex, in face order
 };
 
 constexpr std::size_t kFaceChunk = 1 << 14;    // faces a thread takes at once
@@ -34,20 +36,26 @@ Welded weld_mesh(const Mesh& m, int threads) {
   Welded w;
   w.weld = weld_positions(m.positions, &w.vertices);
   const std::size_t tris = m.triangle_count();
-  w.corner.resize(3 * tris);
-  w.state.assign(tris, kGood);
-  w.first.assign(w.vertices + 1, 0);
-  for (std::size_t t = 0; t < tris; ++t) {
-    const std::uint32_t* c = &w.corner[3 * t];
-    for (int k = 0; k < 3; ++k) w.corner[3 * t + k] = w.weld[m.position_index[3 * t + k]];
-    const bool ok = c[0] != c[1] && c[1] != c[2] && c[0] != c[2] && finite(m.corner_position(t, 0)) &&
-                    finite(m.corner_position(t, 1)) && finite(m.corner_position(t, 2));
-    if (!ok) {
-      w.state[t] = kCollapsed;
-      continue;
+  // A mesh whose positions are all distinct (an indexed PLY) welds to itself: its own indices serve.
+  bool same = w.vertices == m.positions.size();
+  for (std::size_t i = 0; same && i < w.weld.size(); ++i) same = w.weld[i] == i;
+  if (!same) w.own_corner.resize(3 * tris);
+  w.corner = same ? m.position_index.data() : w.own_corner.data();
+  w.state.resize(tris);
+  parallel_chunks(threads, tris, kFaceChunk, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t t = begin; t < end; ++t) {
+      if (!same)
+        for (int k = 0; k < 3; ++k) w.own_corner[3 * t + k] = w.weld[m.position_index[3 * t + k]];
+      const std::uint32_t* c = &w.corner[3 * t];
+      const bool ok = c[0] != c[1] && c[1] != c[2] && c[0] != c[2] && finite(m.corner_position(t, 0)) &&
+                      finite(m.corner_position(t, 1)) && finite(m.corner_position(t, 2));
+      w.state[t] = ok ? kGood : kCollapsed;
     }
-    for (int k = 0; k < 3; ++k) ++w.first[c[k] + 1];
-  }
+  });
+  w.first.assign(w.vertices + 1, 0);
+  for (std::size_t t = 0; t < tris; ++t)
+    if (w.state[t] != kCollapsed)
+      for (int k = 0; k < 3; ++k) ++w.first[w.corner[3 * t + k] + 1];
   for (std::size_t v = 0; v < w.vertices; ++v) w.first[v + 1] += w.first[v];
   w.faces.resize(w.first[w.vertices]);
   std::vector<std::uint32_t> fill(w.first.begin(), w.first.end() - 1);
@@ -58,16 +66,18 @@ Welded weld_mesh(const Mesh& m, int threads) {
   // A repeated face is found at its lowest vertex, among the earlier faces listed there. A face is
   // a repeat when any earlier face has its three vertices (the first of them is not itself a
   // repeat, and it is listed there too): each face is decided on its own, on every thread.
+  // The faces listed at the lowest vertex all have it, and three distinct corners: such a face
+  // repeats this one when it also has the other two.
   parallel_chunks(threads, tris, kFaceChunk, [&](std::size_t begin, std::size_t end) {
     for (std::size_t t = begin; t < end; ++t) {
       if (w.state[t] == kCollapsed) continue;
-      std::uint32_t s[3] = {w.corner[3 * t], w.corner[3 * t + 1], w.corner[3 * t + 2]};
-      std::sort(s, s + 3);
-      for (std::uint32_t i = w.first[s[0]]; i < w.first[s[0] + 1] && w.faces[i] < t; ++i) {
-        const std::uint32_t u = w.faces[i];
-        std::uint32_t o[3] = {w.corner[3 * u], w.corner[3 * u + 1], w.corner[3 * u + 2]};
-        std::sort(o, o + 3);
-        if (o[0] == s[0] && o[1] == s[1] && o[2] == s[2]) {
+      const std::uint32_t* c = &w.corner[3 * t];
+      const std::uint32_t low = std::min({c[0], c[1], c[2]});
+      const std::uint32_t a = c[0] == low ? c[1] : c[0], b = c[2] == low ? c[1] : c[2];
+      for (std::uint32_t i = w.first[low]; i < w.first[low + 1] && w.faces[i] < t; ++i) {
+        const std::uint32_t* o = &w.corner[3 * std::size_t(w.faces[i])];
+        const bool has_a = o[0] == a || o[1] == a || o[2] == a, has_b = o[0] == b || o[1] == b || o[2] == b;
+        if (has_a && has_b) {
           w.state[t] = kDuplicate;
           break;
         }
@@ -95,6 +105,24 @@ void edge_neighbours(const Welded& w, std::uint32_t v, std::vector<std::uint32_t
     out.emplace_back(scratch[i], int(j - i));
     i = j;
   }
+}
+
+// Whether some edge at `v` is not shared by exactly two kept faces (edge_neighbours' counts, not
+// all 2): its neighbours, sorted, must come in pairs of one vertex each.
+bool on_border(const Welded& w, std::uint32_t v, std::vector<std::uint32_t>& scratch) {
+  scratch.clear();
+  for (std::uint32_t i = w.first[v]; i < w.first[v + 1]; ++i) {
+    const std::uint32_t t = w.faces[i];
+    if (w.state[t] == kDuplicate) continue;
+    for (int k = 0; k < 3; ++k)
+      if (w.corner[3 * t + k] != v) scratch.push_back(w.corner[3 * t + k]);
+  }
+  std::sort(scratch.begin(), scratch.end());
+  const std::size_t n = scratch.size();
+  if (n % 2) return true;
+  for (std::size_t i = 0; i < n; i += 2)
+    if (scratch[i] != scratch[i + 1] || (i + 2 < n && scratch[i + 2] == scratch[i])) return true;
+  return false;
 }
 
 // Sums per vertex over the non-degenerate faces: twice the area gradient (the cotangent terms),
@@ -152,19 +180,26 @@ Sums accumulate(const Mesh& m, Welded& w) {
 
 // The area-weighted mean over each vertex's faces of the faces' mean corner value, `passes` times;
 // each vertex's sums gathered over its faces in face order (the same sums on any number of threads).
-void smooth(const Welded& w, const std::vector<double>& face_area, int passes, int threads, std::vector<double>& h) {
+// A face's weighted value is worked out once per pass, not once per corner.
+void smooth(const Welded& w, const double* face_area, int passes, int threads, std::vector<double>& h) {
   std::vector<double> next(w.vertices);
+  std::vector<double, DefaultInitAllocator<double>> face_value(w.state.size());  // written for every kept face
   for (int pass = 0; pass < passes; ++pass) {
+    parallel_chunks(threads, w.state.size(), kFaceChunk, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t t = begin; t < end; ++t) {
+        if (w.state[t] != kGood) continue;
+        const std::uint32_t* c = &w.corner[3 * t];
+        face_value[t] = face_area[t] * (h[c[0]] + h[c[1]] + h[c[2]]) / 3.0;
+      }
+    });
     parallel_chunks(threads, w.vertices, kVertexChunk, [&](std::size_t begin, std::size_t end) {
       for (std::size_t v = begin; v < end; ++v) {
         double sum = 0.0, weight = 0.0;
         for (std::uint32_t i = w.first[v]; i < w.first[v + 1]; ++i) {
           const std::uint32_t t = w.faces[i];
           if (w.state[t] != kGood) continue;
-          const std::uint32_t* c = &w.corner[3 * t];
-          const double a = face_area[t], value = a * (h[c[0]] + h[c[1]] + h[c[2]]) / 3.0;
-          sum += value;
-          weight += a;
+          sum += face_value[t];
+          weight += face_area[t];
         }
         next[v] = weight > 0.0 ? sum / weight : h[v];
       }
@@ -180,21 +215,18 @@ std::vector<float> vertex_mean_curvature(const Mesh& mesh, const CurvatureOption
   const int threads = opt.threads;
   Welded w = weld_mesh(mesh, threads);
   st.welded_vertices = w.vertices;
-  const Sums s = accumulate(mesh, w);
+  Sums s = accumulate(mesh, w);
 
   // Interior vertices: every edge shared by exactly two kept faces. H = K.n / 2 with
   // K = laplace / (2 area): the normal part of the mean-curvature normal, whose tangential part on
   // an irregular mesh is discretisation error. 0 where it has no meaning yet.
-  std::vector<std::uint8_t> border(w.vertices, 0);
+  std::vector<std::uint8_t, DefaultInitAllocator<std::uint8_t>> border(w.vertices);  // written for every vertex
   std::vector<double> h(w.vertices, 0.0);
   std::vector<std::uint8_t> valued(w.vertices, 0);
   parallel_chunks(threads, w.vertices, kVertexChunk, [&](std::size_t begin, std::size_t end) {
     std::vector<std::uint32_t> scratch;
-    std::vector<std::pair<std::uint32_t, int>> nb;
     for (std::size_t v = begin; v < end; ++v) {
-      edge_neighbours(w, std::uint32_t(v), scratch, nb);
-      for (const auto& e : nb)
-        if (e.second != 2) border[v] = 1;
+      border[v] = on_border(w, std::uint32_t(v), scratch);
       const double nlen = glm::length(s.normal[v]);
       if (border[v] || !(s.area[v] > 0.0) || !(nlen > 0.0) || !std::isfinite(nlen)) continue;
       const double value = glm::dot(s.laplace[v], s.normal[v] / nlen) / (4.0 * s.area[v]);
@@ -204,10 +236,11 @@ std::vector<float> vertex_mean_curvature(const Mesh& mesh, const CurvatureOption
     }
   });
   for (std::size_t v = 0; v < w.vertices; ++v) st.border_vertices += border[v];
+  s = Sums();  // freed now: the smoothing's buffers reuse the memory (no fresh pages to zero)
 
   // The others from their neighbours: first those next to a valued vertex, then those next to one
   // of these (a grid's corner), each the plain mean of the distinct neighbours valued before it.
-  std::vector<double> fill(w.vertices);
+  std::vector<double, DefaultInitAllocator<double>> fill(w.vertices);  // read only where `filled`, written each round
   std::vector<std::uint8_t> filled(w.vertices);
   for (std::uint8_t round = 2; round <= 3; ++round) {
     parallel_chunks(threads, w.vertices, kVertexChunk, [&](std::size_t begin, std::size_t end) {
@@ -235,7 +268,7 @@ std::vector<float> vertex_mean_curvature(const Mesh& mesh, const CurvatureOption
   for (std::size_t v = 0; v < w.vertices; ++v) st.unvalued_vertices += valued[v] == 0;
 
   if (opt.smoothing > 0) {
-    std::vector<double> face_area(mesh.triangle_count(), 0.0);
+    std::vector<double, DefaultInitAllocator<double>> face_area(mesh.triangle_count());  // read for kept faces only
     parallel_chunks(threads, mesh.triangle_count(), kFaceChunk, [&](std::size_t begin, std::size_t end) {
       for (std::size_t t = begin; t < end; ++t) {
         if (w.state[t] != kGood) continue;
@@ -244,7 +277,7 @@ std::vector<float> vertex_mean_curvature(const Mesh& mesh, const CurvatureOption
                                                     glm::dvec3(mesh.corner_position(t, 2)) - p0));
       }
     });
-    smooth(w, face_area, opt.smoothing, threads, h);
+    smooth(w, face_area.data(), opt.smoothing, threads, h);
   }
 
   for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {

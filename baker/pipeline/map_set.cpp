@@ -254,9 +254,13 @@ std::vector<BakedMap> finish_maps(const BakeOptions& opt, const Prepared& s, con
         const std::vector<std::string> names = kind == MapKind::object_id ? object_names(high) : material_names(high);
         const std::vector<glm::vec3> colors = id_colors(names);
         for (std::size_t i = 0; i < names.size(); ++i) m.colors.push_back({names[i], colors[i]});
+        // The index rounded half away from zero (std::lround) without a library call: a float's
+        // d + 0.5 is exact in double, so d + 0.5 < size says lround(d) < size; -1 (a miss), NaN and
+        // indices out of range are black.
+        const double size = double(colors.size());
         each([&](float* p) {
-          const long id = std::lround(p[0]);
-          const glm::vec3 c = id >= 0 && std::size_t(id) < colors.size() ? colors[std::size_t(id)] : glm::vec3(0.0f);
+          const double d = p[0];
+          const glm::vec3 c = d > -0.5 && d + 0.5 < size ? colors[std::size_t(d + 0.5)] : glm::vec3(0.0f);
           for (int ch = 0; ch < 3; ++ch) p[ch] = c[ch];
         });
         break;

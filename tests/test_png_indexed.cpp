@@ -1,0 +1,97 @@
+// The PNG writer's indexed layout (io/png_write.cpp): an 8-bit RGB image of at most 256 colours
+// (the ID maps' flat colours) is stored as palette indices of 1, 2, 4 or 8 bits. It must read back
+// as exactly the samples the RGB layout stores (quantize8 of the floats), give the same bytes on
+// any number of threads, and not be used for 257 colours or with dither.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "io/image_io.h"
+#include "io/image_write.h"
+#include "io/png_write.h"
+#include "test_support.h"
+
+namespace {
+
+using nmbake::Image;
+
+// `colours` distinct colours in flat patches (runs along rows, islands, single texels), some
+// values off the 8-bit steps (they quantize to the step) and a NaN (it quantizes to 0).
+Image patch_image(int width, int height, int colours) {
+  Image img(width, height, 3);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const int id = ((x / 3) * 31 + (y / 3) * 17 + (x == y ? 3 : 0)) % colours;
+      float* p = img.at(x, y);
+      p[0] = float(id % 16) * 17.0f / 255.0f + 0.0004f;  // off the step, rounds back to it
+      p[1] = float(id / 16) * 17.0f / 255.0f;
+      p[2] = float((id * 37) % 256) / 255.0f;
+    }
+  return img;
+}
+
+// The IHDR's bit depth and colour type (bytes 24 and 25 of the file).
+std::pair<int, int> png_depth_and_type(const std::string& bytes) {
+  return {static_cast<unsigned char>(bytes[24]), static_cast<unsigned char>(bytes[25])};
+}
+
+}  // namespace
+
+TEST(PngIndexed, FlatColoursReadBackExactlyOnAnyThreadCount) {
+  const std::string path = nmbake::test::scratch_dir() + "/indexed.png";
+  const std::pair<int, int> cases[] = {{1, 1}, {2, 1}, {3, 2}, {4, 2}, {5, 4}, {16, 4}, {17, 8}, {256, 8}};
+  for (const auto& [colours, depth] : cases)
+    for (const auto& [w, h] : {std::pair{131, 67}, std::pair{1, 9}, std::pair{9, 1}}) {
+      const Image img = patch_image(w, h, colours);
+      if (w * h < colours) continue;
+      const auto want = nmbake::image_write::quantize8(img.pixels, false, 1);
+      std::string first;
+      for (int threads : {1, 2, 3}) {
+        nmbake::WriteOptions o(8);
+        o.threads = threads;
+        nmbake::write_image(path, img, o);
+        const std::string bytes = nmbake::test::read_file(path);
+        const std::string what = std::to_string(colours) + " colours " + std::to_string(w) + "x" + std::to_string(h) + ", " +
+                                 std::to_string(threads) + " threads";
+        if (threads == 1) first = bytes;
+        else EXPECT_TRUE(bytes == first) << what << ": the bytes depend on the threads";
+        const auto [got_depth, type] = png_depth_and_type(bytes);
+        EXPECT_EQ(type, 3) << what;
+        // Fewer colours than the depth's room may still need it (the image's own count decides).
+        EXPECT_LE(got_depth, depth) << what;
+        const Image back = nmbake::read_image(path);
+        ASSERT_EQ(back.channels, 3) << what;
+        ASSERT_EQ(back.pixels.size(), want.size()) << what;
+        std::size_t differ = 0;
+        for (std::size_t i = 0; i < want.size(); ++i) differ += std::lround(back.pixels[i] * 255.0f) != long(want[i]);
+        EXPECT_EQ(differ, 0u) << what;
+      }
+    }
+}
+
+TEST(PngIndexed, ManyColoursOrDitherKeepTheRgbLayout) {
+  const std::string path = nmbake::test::scratch_dir() + "/rgb.png";
+  for (bool dither : {false, true}) {
+    const Image img = patch_image(97, 61, dither ? 2 : 257);
+    nmbake::WriteOptions o(8);
+    o.dither = dither;
+    o.threads = 2;
+    nmbake::write_image(path, img, o);
+    const std::string bytes = nmbake::test::read_file(path);
+    const auto q = nmbake::image_write::quantize8(img.pixels, dither, 1);
+    if (!dither) {  // the image does have 257 colours
+      std::vector<int> seen;
+      for (std::size_t i = 0; i < q.size(); i += 3) seen.push_back(q[i] << 16 | q[i + 1] << 8 | q[i + 2]);
+      std::sort(seen.begin(), seen.end());
+      ASSERT_EQ(std::unique(seen.begin(), seen.end()) - seen.begin(), 257);
+    }
+    std::string error;
+    const std::vector<unsigned char> want = nmbake::encode_png(q.data(), 97, 61, 3, 8, {}, nmbake::PngSettings{}, 1, &error);
+    ASSERT_FALSE(want.empty()) << error;
+    EXPECT_EQ(png_depth_and_type(bytes), std::make_pair(8, 2)) << "dither " << dither;
+    EXPECT_TRUE(bytes == std::string(want.begin(), want.end())) << "dither " << dither;
+  }
+}
