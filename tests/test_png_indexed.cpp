@@ -52,6 +52,7 @@ TEST(PngIndexed, FlatColoursReadBackExactlyOnAnyThreadCount) {
       for (int threads : {1, 2, 3}) {
         nmbake::WriteOptions o(8);
         o.threads = threads;
+        o.indexed = true;
         nmbake::write_image(path, img, o);
         const std::string bytes = nmbake::test::read_file(path);
         const std::string what = std::to_string(colours) + " colours " + std::to_string(w) + "x" + std::to_string(h) + ", " +
@@ -79,6 +80,7 @@ TEST(PngIndexed, ManyColoursOrDitherKeepTheRgbLayout) {
     nmbake::WriteOptions o(8);
     o.dither = dither;
     o.threads = 2;
+    o.indexed = true;
     nmbake::write_image(path, img, o);
     const std::string bytes = nmbake::test::read_file(path);
     const auto q = nmbake::image_write::quantize8(img.pixels, dither, 1);
@@ -94,4 +96,17 @@ TEST(PngIndexed, ManyColoursOrDitherKeepTheRgbLayout) {
     EXPECT_EQ(png_depth_and_type(bytes), std::make_pair(8, 2)) << "dither " << dither;
     EXPECT_TRUE(bytes == std::string(want.begin(), want.end())) << "dither " << dither;
   }
+}
+
+// Without WriteOptions::indexed (every map but the IDs) a few flat colours stay RGB: a normal map
+// of one colour is still the 8-bit RGB file the tools that read normal maps expect.
+TEST(PngIndexed, OnlyWhenAskedFor) {
+  const std::string path = nmbake::test::scratch_dir() + "/flat.png";
+  const Image img = patch_image(33, 17, 2);
+  nmbake::WriteOptions o(8);
+  nmbake::write_image(path, img, o);
+  EXPECT_EQ(png_depth_and_type(nmbake::test::read_file(path)), std::make_pair(8, 2));
+  o.indexed = true;
+  nmbake::write_image(path, img, o);
+  EXPECT_EQ(png_depth_and_type(nmbake::test::read_file(path)).second, 3);
 }

@@ -222,6 +222,7 @@ void write_outputs(const JobEnv& env, OutputSet& outputs, const Args& a, const B
       WriteOptions mo = wo;
       mo.metadata = extra_metadata(o, m);
       mo.dither = wo.dither && !map_is_flat(m.kind);  // an ID's colour is exact
+      mo.indexed = map_is_flat(m.kind);               // and few: a PNG palette
       add(map_name(m.kind), f.tile, f.extra[i], m.image, std::move(mo), true);
     }
     for (const auto& [name, path, image] : {std::tuple{"miss-mask", &f.miss_mask, &f.result->miss_mask},

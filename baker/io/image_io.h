@@ -34,6 +34,10 @@ struct WriteOptions {
   // 8-bit output: triangular noise of one step before rounding, the same for a texel whatever
   // thread or run writes it.
   bool dither = false;
+  // PNG: an 8-bit RGB image of at most 256 colours (without dither) is stored indexed (colour type
+  // 3, png_write.h), the same samples to a reader in a fraction of the bytes. For maps of flat
+  // colours (the ID maps); other maps stay RGB, as the tools that read normal maps expect them.
+  bool indexed = false;
   // Threads an encoder may use (the quantization to 8 or 16 bits, PNG's bands, png_write.h): 0 =
   // all cores. The bytes written do not depend on it.
   int threads = 0;

@@ -359,7 +359,7 @@ void write_png_image(const std::string& path, const Image& image, const WriteOpt
     image_write::fail_write(path, "invalid IHDR data (size, channels or bit depth)");
   std::vector<unsigned char> bytes;
   IndexedColors indexed;
-  if (bits == 8 && image.channels == 3 && !options.dither && index_colors(image, indexed)) {
+  if (options.indexed && bits == 8 && image.channels == 3 && !options.dither && index_colors(image, indexed)) {
     Layout layout;
     layout.color_type = 3;
     layout.depth = indexed.depth;

@@ -35,8 +35,8 @@ std::vector<unsigned char> encode_png(const void* rows, int width, int height, i
 
 // write_image (image_io.h) for a .png path: quantized as every writer does, encoded with the
 // default PngSettings on options.threads threads, written to the temporary file and renamed as
-// write_image documents. An 8-bit RGB image of at most 256 colours without dither (a map of flat
-// colours: the ID maps) is stored indexed (colour type 3, palette in order of first use, indices
+// write_image documents. With options.indexed, an 8-bit RGB image of at most 256 colours without
+// dither (a map of flat colours: the ID maps) is stored indexed (colour type 3, palette in order of first use, indices
 // of 1, 2, 4 or 8 bits, filter up, RLE): a reader expands it to the very samples the RGB layout
 // would store, and it is a fraction of the bytes to filter and deflate.
 void write_png_image(const std::string& path, const Image& image, const WriteOptions& options);
