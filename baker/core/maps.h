@@ -65,6 +65,9 @@ struct MapOptions {
   // The secondary rays' random streams (keyed by texel, sample and this): 0 gives the maps every
   // release bakes; another value, rays independent of them (the accuracy bench's reference).
   std::uint64_t ray_seed = 0;
+  // The accuracy bench's baseline only: independent random directions per ray (the release before
+  // stratified chains) instead of each texel's Owen-scrambled Sobol chains; maps otherwise alike.
+  bool ao_independent_rays = false;
   bool ao_occluders_all = false;  // with --match names: every object occludes, not only the group's
   // Height: the distance mapped to 0 and to 1 (scene units); not given: the bake's own range,
   // symmetric about 0.
