@@ -46,7 +46,7 @@ struct AoResults {
 // auto at each of `max_errors`. Progress on stderr.
 void run_ao_rows(const AccuracyScene& sc, int size, const std::vector<double>& max_errors, int threads, AoResults& out);
 
-// `out`/ao.csv, ao.md (the table, and per scene auto against fixed 256: time and error ratios)
+// `out`/ao.csv, ao.md (the table, and per scene auto against fixed 256, random and stratified: time and error ratios)
 // and ao.png (RMS error against CPU seconds, log-log). Throws OutputError when a file cannot be written.
 void write_ao_files(const std::string& out, const AoResults& results, const RunInfo& info, const std::string& font);
 
