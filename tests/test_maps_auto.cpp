@@ -1,6 +1,6 @@
 // --ao-rays auto (MapOptions::ao_rays_auto) and the bent normal against known answers: beside a
 // wall auto's AO reaches the standard error asked and its noise is what it reports; it spends its
-// rays where occlusion is partial; it does not depend on the thread count. The bent normal beside
+// rays where occlusion is partial; at a fixed count, the stratified rays beat independent ones. The bent normal beside
 // a tall wall tilts away from it by atan(2 / pi) (cosine-weighted rays, no distance limit), in
 // tangent space with either green convention; on open ground it is the normal.
 #include <gtest/gtest.h>
@@ -83,12 +83,46 @@ TEST(MapsAoAuto, FewerRaysOnOpenTexelsThanOnPartialOnes) {
   const BakeResult open = bake_normal_map(test::make_grid(4, 4, -2, 2, 1.5, 4), high, nullptr, o);
   const BakeResult partial = bake_normal_map(test::make_grid(4, 4, -2, 2, 0.01f, 0.5), high, nullptr, o);
   const BakedMap &a = baked(open, MapKind::ao), &b = baked(partial, MapKind::ao);
-  // An open texel: 32 rays, all open; its stopping share 33/34 gives a standard error of 0.030 > E,
-  // and the 42 more rays that would reach E by it; then 75/76 gives 0.013: stop at 74.
-  EXPECT_EQ(a.rays_max, 74.0);
-  EXPECT_EQ(a.rays_mean, 74.0);
-  EXPECT_GT(b.rays_mean, 4.0 * a.rays_mean);
+  // An open texel: 32 rays (8 chains of 4), all open; chains that agree are taken to be no finer
+  // than one ray in 4 (standard error sqrt(1 / 96 / 8) = 0.036 > E = 0.02), so it adds the rays
+  // that would reach E at the rate n^-0.7 (42, in whole rounds of 8 chains: 48); at 80 rays (10 a
+  // chain) that floor is 0.0144: stop.
+  EXPECT_EQ(a.rays_max, 80.0);
+  EXPECT_EQ(a.rays_mean, 80.0);
+  EXPECT_GT(b.rays_mean, 1.2 * a.rays_mean);
+  EXPECT_GT(b.rays_max, 2.0 * a.rays_max);
   for (float v : a.image.pixels) EXPECT_EQ(v, 1.0f);
+}
+
+// Beside the wall at a fixed 64 rays: the texel's stratified chains give a smaller error than as
+// many independent random rays (MapOptions::ao_independent_rays), and each reports its noise.
+TEST(MapsAo, StratifiedRaysBeatIndependentOnesBesideAWall) {
+  double rms[2];
+  for (int independent = 0; independent < 2; ++independent) {
+    BakeOptions o = map_options(64, {MapKind::ao});
+    o.maps.ao_distance = 1.0;
+    o.maps.ao_rays = 64;
+    o.maps.ao_independent_rays = independent == 1;
+    const BakeResult r = bake_normal_map(test::make_grid(8, 8, -2, 2, 0, 4), wall_scene(8, 2), nullptr, o);
+    const BakedMap& ao = baked(r, MapKind::ao);
+    double sq_resid = 0.0, sq_se = 0.0, n = 0.0;
+    for (int y = 0; y < 64; ++y)
+      for (int x = 16; x < 48; ++x) {
+        const std::size_t i = std::size_t(y) * 64 + std::size_t(x);
+        const double expect = wall_ao(row_y(y, 64, 0, 4), 1.0);
+        if (expect > 0.9) continue;
+        const double d = ao.image.pixels[i] - expect;
+        sq_resid += d * d, sq_se += double(ao.error.pixels[i]) * ao.error.pixels[i], n += 1.0;
+      }
+    ASSERT_GT(n, 300.0);
+    rms[independent] = std::sqrt(sq_resid / n);
+    const double ratio = rms[independent] / std::sqrt(sq_se / n);
+    EXPECT_GT(ratio, 0.7) << "independent " << independent;
+    EXPECT_LT(ratio, 1.3) << "independent " << independent;
+  }
+  // Independent: about sqrt(p (1 - p) / 64) = 0.055 at p = 0.7 (measured 0.055). Stratified: 0.016
+  // measured (one straight horizon per texel: the stratified case at its best).
+  EXPECT_LT(rms[0], 0.4 * rms[1]) << rms[0] << " " << rms[1];
 }
 
 // Beside a tall, long wall (no distance limit) the unoccluded rays are those heading away from it:

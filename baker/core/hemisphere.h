@@ -53,6 +53,14 @@ inline glm::dvec2 concentric_disk(double u1, double u2) {
   return glm::dvec2(r * std::cos(phi), r * std::sin(phi));
 }
 
+// cosine_direction (below) in a basis made once by orthonormal_basis (t, b, n): many directions
+// about one normal pay for its basis once.
+inline glm::dvec3 cosine_direction(const glm::dvec3& t, const glm::dvec3& b, const glm::dvec3& n, double u1, double u2) {
+  const glm::dvec2 d = concentric_disk(u1, u2);
+  const double z = std::sqrt(std::fmax(0.0, 1.0 - d.x * d.x - d.y * d.y));
+  return d.x * t + d.y * b + z * n;
+}
+
 // The cosine-weighted direction over the hemisphere around n for (u1, u2) uniform in [0, 1)^2:
 // unit length (to rounding), dot(direction, n) >= 0 up to rounding (about 0 only on the disk's
 // rim: grazing), density cos(theta) / pi over the hemisphere, so its mean is
@@ -60,9 +68,7 @@ inline glm::dvec2 concentric_disk(double u1, double u2) {
 inline glm::dvec3 cosine_direction(const glm::dvec3& n_in, double u1, double u2) {
   glm::dvec3 t, b, n;
   orthonormal_basis(n_in, t, b, n);
-  const glm::dvec2 d = concentric_disk(u1, u2);
-  const double z = std::sqrt(std::fmax(0.0, 1.0 - d.x * d.x - d.y * d.y));
-  return d.x * t + d.y * b + z * n;
+  return cosine_direction(t, b, n, u1, u2);
 }
 
 // The same for a float normal, rounded to float for a ray's direction.
@@ -110,5 +116,78 @@ class SampleStream {
  private:
   std::uint64_t state_;
 };
+
+// The depth to which owen_scramble permutes exactly: 2^12 intervals a side, one for each of the
+// first 4096 points of a sequence on each axis (each axis of a (0, m, 2)-net has one point in each
+// interval of depth m), more than a texel's chain casts short of --ao-rays 16384. Below it each
+// value's bits are drawn from a hash of the whole value (a point alone in its interval: the same as
+// scrambling on; several: independent within it, never equal).
+constexpr int kOwenDepth = 12;
+
+// Sobol's first dimension: the bits of index reversed (van der Corput's radical inverse in base 2),
+// as a 32-bit fixed-point value in [0, 1).
+inline std::uint32_t sobol_radical_inverse(std::uint32_t index) {
+  std::uint32_t x = index;
+  x = (x << 16) | (x >> 16);
+  x = ((x & 0x00ff00ffu) << 8) | ((x & 0xff00ff00u) >> 8);
+  x = ((x & 0x0f0f0f0fu) << 4) | ((x & 0xf0f0f0f0u) >> 4);
+  x = ((x & 0x33333333u) << 2) | ((x & 0xccccccccu) >> 2);
+  x = ((x & 0x55555555u) << 1) | ((x & 0xaaaaaaaau) >> 1);
+  return x;
+}
+
+// Sobol's second dimension: the direction numbers v_0 = 2^31, v_i = v_{i-1} xor (v_{i-1} >> 1).
+inline std::uint32_t sobol_second(std::uint32_t index) {
+  std::uint32_t x = 0, v = 0x80000000u;
+  for (; index; index >>= 1, v ^= v >> 1) x ^= v & (0u - (index & 1u));
+  return x;
+}
+
+// The nested uniform scramble of a 32-bit fixed-point value in [0, 1), to a double in [0, 1). Each
+// interval of the subdivision (to kOwenDepth) swaps its halves or not by one bit of a hash: one
+// 64-bit hash per interval at depths 0 and 6 gives the 63 bits of the intervals of the six depths
+// from it (1 + 2 + ... + 32), so a value costs three hashes (the third for the bits below), not 13.
+inline double owen_scramble(std::uint32_t x, std::uint64_t seed) {
+  static_assert(kOwenDepth == 12, "two blocks of six depths");
+  std::uint32_t out = x;
+  for (int d = 0; d < kOwenDepth; d += 6) {
+    // The interval of depth d holding x: its top d bits, tagged by a leading 1 (a heap index).
+    const std::uint64_t node = (std::uint64_t(1) << d) | (d ? std::uint64_t(x >> (32 - d)) : 0u);
+    const std::uint64_t h = mix64(seed ^ (node * 0x9e3779b97f4a7c15ull));
+    // The next six bits of x pick the intervals at depths d .. d + 5 below it (bit 2^t + their top
+    // t bits of h); no branches: the swaps are coin flips, which a branch predictor would miss.
+    const std::uint32_t below = (x << d) >> 26;
+    std::uint32_t flips = 0;
+    for (int t = 0; t < 6; ++t) flips = flips << 1 | std::uint32_t((h >> ((1u << t) | (below >> (6 - t)))) & 1u);
+    out ^= flips << (26 - d);
+  }
+  const std::uint64_t low =
+      mix64(seed ^ (std::uint64_t(x) * 0xd1b54a32d192ed03ull) ^ 0x5851f42d4c957f2dull) >> (64 - (53 - kOwenDepth));
+  return double((std::uint64_t(out >> (32 - kOwenDepth)) << (53 - kOwenDepth)) | low) * 0x1.0p-53;
+}
+
+// Point `index` of the first two dimensions of Sobol's sequence (the (0, 2)-sequence in base 2:
+// van der Corput's radical inverse, and the dimension whose generator is Pascal's triangle mod 2),
+// Owen-scrambled by `seed` (Owen 1995, "Randomly permuted (t,m,s)-nets and (t,s)-sequences"): at
+// every depth d of the binary subdivision of each axis, the intervals' halves swap or not by a hash
+// of the seed and the interval, so every point is uniform in [0, 1)^2 while the points 0 .. 2^m - 1
+// stay a (0, m, 2)-net (one point in each of the 2^m elementary rectangles of area 2^-m). For an
+// integrand with a discontinuity along a curve (visibility), the mean of n such points has variance
+// of order n^-1.5 against n^-1 for independent points; distinct seeds give independent sets.
+// Values in [0, 1); equal (index, seed) give equal points, in any thread.
+// The seeds of the two axes come from `seed` by scramble_seeds; a caller drawing many points of one
+// set makes them once and calls the second form.
+inline void scramble_seeds(std::uint64_t seed, std::uint64_t& seed_x, std::uint64_t& seed_y) {
+  seed_x = mix64(seed ^ 0x243f6a8885a308d3ull);
+  seed_y = mix64(seed ^ 0x13198a2e03707344ull);
+}
+inline glm::dvec2 scrambled_sobol2(std::uint32_t index, std::uint64_t seed_x, std::uint64_t seed_y) {
+  return glm::dvec2(owen_scramble(sobol_radical_inverse(index), seed_x), owen_scramble(sobol_second(index), seed_y));
+}
+inline glm::dvec2 scrambled_sobol2(std::uint32_t index, std::uint64_t seed) {
+  std::uint64_t sx, sy;
+  scramble_seeds(seed, sx, sy);
+  return scrambled_sobol2(index, sx, sy);
+}
 
 }  // namespace nmbake

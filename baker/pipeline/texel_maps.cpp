@@ -14,13 +14,25 @@ namespace {
 constexpr std::size_t kRayBatch = 4096;  // secondary rays cast together
 constexpr std::size_t kAhead = 8;        // samples ahead whose hit data is fetched early
 
-// --ao-rays auto: the first round's rays per texel, the fewest a later round adds, and the rays of
-// each outcome (open, occluded) its stopping rule adds to a texel's AO count (Laplace's rule of
-// succession; on the bench's sculpts 1 spent its rays better than 0 or 0.5, and 2 about as well:
-// bench/accuracy_ao.h).
+// Secondary rays (AO's, thickness's): a texel's rays of one kind are numbered in the order its
+// samples cast them; ray j is point j / R of chain j % R (R chains, below), each chain its own
+// Owen-scrambled Sobol sequence (core/hemisphere.h scrambled_sobol2, seeded by texel, chain and
+// kind). Within a chain the directions are stratified (a visibility integral's error falls much
+// faster than with independent rays); the chains are independent, so the spread of their means
+// gives the texel's standard error honestly (the binomial formula would over-state a stratified
+// estimate's). Splitting a texel's rays in more chains costs stratification (the error of R chains
+// of n / R points grows as R^0.25): a fixed count takes 4 chains (the spread's 3 degrees of freedom
+// make each texel's standard error rough, but right on average); --ao-rays auto takes 8, since it
+// stops on each texel's own estimate, and with 4 too many texels stop on an estimate that came out
+// low by chance (measured on the accuracy bench: the noise 1.3 to 1.45 times the reported standard
+// error with 4 chains, 1.1 to 1.2 with 8).
+constexpr int kFixedChains = 4, kAutoChains = 8, kMaxChains = 8;
+// --ao-rays auto: the first round's rays per texel (4 per chain), and the rate at which a texel's
+// stratified error falls with its rays n (about n^-0.7 on the accuracy bench's sculpts, 64 to 1024
+// rays): a later round adds the rays that would bring the texel's error to E at that rate, at
+// least half as many as it has.
 constexpr int kAutoFirstRays = 32;
-constexpr int kAutoRoundRays = 16;
-constexpr double kAutoPrior = 1.0;
+constexpr double kAutoErrorExponent = 0.7;
 
 // What a covered texel whose samples all miss gets: open, thick, flat, on the low-poly surface
 // (height 0, position the low-poly point), no colour, no ID.
@@ -34,8 +46,8 @@ enum Slot {
   s_position,       // 3: sum of hit points (a miss: the low-poly point, kept apart below)
   s_curvature,      // 1
   s_color,          // 3
-  s_ao,             // 2: unoccluded rays, rays
-  s_thickness,      // 3: sum of min(t, D) / D, sum of its squares, rays
+  s_ao,             // 2 + 2 kMaxChains: unoccluded rays, rays; per chain its unoccluded rays, rays
+  s_thickness,      // 2 + 2 kMaxChains: sum of min(t, D) / D, rays; per chain its sum, rays
   s_object_id,      // 1: the index taken
   s_material_id,    // 1
   s_hits,           // 1: samples that hit
@@ -43,7 +55,7 @@ enum Slot {
   s_miss_position,  // 3: sum of low-poly points of the samples that miss
   kSlots
 };
-constexpr int kSlotWidth[kSlots] = {3, 3, 1, 3, 1, 3, 2, 3, 1, 1, 1, 1, 3};
+constexpr int kSlotWidth[kSlots] = {3, 3, 1, 3, 1, 3, 2 + 2 * kMaxChains, 2 + 2 * kMaxChains, 1, 1, 1, 1, 3};
 
 Slot slot_of(MapKind k) {
   switch (k) {
@@ -61,10 +73,11 @@ Slot slot_of(MapKind k) {
   }
 }
 
-// Secondary rays queued for one cast: per ray its sample, and with match groups its group.
+// Secondary rays queued for one cast: per ray its sample and chain, and with match groups its group.
 struct RayQueue {
   raycast::RayArrays rays{kRayBatch};
   std::vector<std::uint32_t> sample = std::vector<std::uint32_t>(kRayBatch), group;
+  std::vector<std::uint8_t> chain = std::vector<std::uint8_t>(kRayBatch);
   std::vector<std::uint8_t> occluded = std::vector<std::uint8_t>(kRayBatch);
   std::size_t n = 0;
 };
@@ -82,6 +95,27 @@ double most_frequent(std::vector<std::int64_t>& ids) {
     i = j;
   }
   return double(best);
+}
+
+// The standard error of a texel's value (its rays' total over their count) from its chains, given
+// as kMaxChains pairs (chains without rays: not counted) (sum of the values, rays): the spread of the chains' means over sqrt of
+// their number. 0 with fewer than two chains that have rays (one ray has no spread to measure). `resolution`: no less than that
+// of chains whose means cannot be finer than one ray in m (the variance of rounding to a whole ray, 1/6 on average over where the
+// truth falls between two counts, over m^2): stratified chains often agree exactly, which does not make them exact.
+double chain_standard_error(const double* pairs, bool resolution = false) {
+  double sum = 0.0, rays = 0.0, chains = 0.0;
+  for (int c = 0; c < kMaxChains; ++c)
+    if (pairs[2 * c + 1] > 0.0) sum += pairs[2 * c], rays += pairs[2 * c + 1], chains += 1.0;
+  if (chains < 2.0) return 0.0;
+  const double mean = sum / rays, m = rays / chains;
+  double sq = 0.0;
+  for (int c = 0; c < kMaxChains; ++c)
+    if (pairs[2 * c + 1] > 0.0) {
+      const double d = pairs[2 * c] / pairs[2 * c + 1] - mean;
+      sq += d * d;
+    }
+  const double var = sq / (chains - 1.0);
+  return std::sqrt((resolution ? std::max(var, 1.0 / (6.0 * m * m)) : var) / chains);
 }
 
 }  // namespace
@@ -104,23 +138,31 @@ struct TexelMaps::Impl {
   int stride = 0;      // doubles per texel
   std::vector<double> sums, kept;
   bool rays_ao = false, rays_thickness = false, ids = false;
-  // Per sample of the pass: the hit's unit normal, and the secondary rays' sums.
+  // Per sample of the pass: the hit's unit normal and the sum of its open AO directions.
   std::vector<glm::dvec3> hit_normal, bent_sum;
-  std::vector<std::uint32_t> open_rays;
   std::vector<std::int64_t> object_id, material_id;
   RayQueue queue[2];  // AO's (occlusion only), thickness's (first hits)
-  std::vector<double> thick_sum, thick_sq;
   // Per sample of the pass, what its secondary rays start from: the hit point, the geometric
-  // normal on the hit normal's side, the match group; per kind (0: AO's, 1: thickness's) its
-  // random stream (keyed by texel and sample) and the rays cast so far.
+  // normal on the hit normal's side, the match group; per kind (0: AO's, 1: thickness's) the rays
+  // cast so far, and per chain (kMaxChains a sample) the sum of its rays' values (AO: open rays;
+  // thickness: min(t, D) / D) and its rays. With MapOptions::ao_independent_rays, per sample and
+  // kind its random stream (keyed by texel and sample).
   std::vector<glm::dvec3> hit_point, hit_face;
   std::vector<std::uint32_t> ray_group;
-  std::vector<SampleStream> stream[2];
   std::vector<std::uint32_t> rays_cast[2];
-  // --ao-rays auto, per tile texel: its hit samples, rays, sums of their values (and squares), and
-  // the rays each of its hit samples gets in the next round.
+  std::vector<double> chain_sum[2];
+  std::vector<std::uint32_t> chain_rays[2];
+  std::vector<SampleStream> stream[2];
+  const std::uint16_t* sample_texel = nullptr;  // the pass's samples' tile texels
+  // Per tile texel and kind: its chains' seeds (kMaxChains pairs: the two axes') and the rays it
+  // has numbered; the chains a texel's rays are dealt to (kFixedChains or kAutoChains).
+  std::vector<std::uint64_t> texel_seed[2];
+  std::vector<std::uint32_t> texel_next[2];
+  int chains = kFixedChains;
+  // --ao-rays auto, per tile texel: its hit samples, rays, chains' sums (kMaxChains pairs, as
+  // chain_standard_error reads them), and the rays each of its hit samples gets in the next round.
   std::vector<std::uint32_t> texel_hits, texel_more;
-  std::vector<double> texel_rays, texel_sum, texel_sq;
+  std::vector<double> texel_rays, texel_chains;
   std::vector<std::uint32_t> seen;
   std::vector<std::int64_t> vote;
   std::vector<std::uint32_t> start, order, fill;   // the ID vote's counting sort
@@ -146,6 +188,7 @@ struct TexelMaps::Impl {
     rays_ao = in.maps->wants(MapKind::ao) || in.maps->wants(MapKind::bent_normal);
     rays_thickness = in.maps->wants(MapKind::thickness);
     ids = in.maps->wants(MapKind::object_id) || in.maps->wants(MapKind::material_id);
+    chains = in.maps->ao_rays_auto ? kAutoChains : kFixedChains;
     needs_point = has(s_position) || rays_ao || rays_thickness;
     needs_normal = has(s_object_normal) || has(s_bent) || rays_ao || rays_thickness;
     if (in.groups && in.groups->active())
@@ -159,17 +202,22 @@ struct TexelMaps::Impl {
   std::uint32_t source_tri(std::uint32_t t) const { return in.source ? in.source[t] : t; }
 
   // Queues `count` more rays of kind `k` (0: AO's, over the hit normal's hemisphere; 1: thickness's,
-  // over the inverted normal's) from sample r, continuing its stream: the first rays of a sample are
-  // the same whatever the rounds that follow.
+  // over the inverted normal's) from sample r, continuing its texel's numbering (chains and points).
   void queue_rays(int k, std::size_t r, std::size_t count) {
     const bool thick = k == 1;
     RayQueue& q = queue[k];
     const glm::dvec3 axis = thick ? -hit_normal[r] : hit_normal[r];
     const glm::dvec3 org = hit_point[r] + (thick ? -in.epsilon : in.epsilon) * hit_face[r];
-    SampleStream& st = stream[k][r];
-    for (std::size_t j = 0; j < count; ++j) {
-      const double u1 = st.next(), u2 = st.next();
-      const glm::dvec3 d = cosine_direction(axis, u1, u2);
+    glm::dvec3 bt, bb, bn;  // the basis about the axis, once for the sample's rays
+    orthonormal_basis(axis, bt, bb, bn);
+    const std::size_t i = sample_texel[r];
+    std::uint32_t& next = texel_next[k][i];
+    for (std::size_t j = 0; j < count; ++j, ++next) {
+      const std::uint32_t chain = next % chains;
+      const std::uint64_t* seed = &texel_seed[k][(i * kMaxChains + chain) * 2];
+      const glm::dvec2 u =
+          in.maps->ao_independent_rays ? stream[k][r].next2() : scrambled_sobol2(next / chains, seed[0], seed[1]);
+      const glm::dvec3 d = cosine_direction(bt, bb, bn, u.x, u.y);
       raycast::Ray ray;
       ray.origin = glm::vec3(org);
       ray.direction = glm::vec3(d);
@@ -177,53 +225,48 @@ struct TexelMaps::Impl {
       ray.tfar = float(thick ? in.thickness_distance : in.ao_distance);
       q.rays.set(q.n, ray);
       q.sample[q.n] = std::uint32_t(r);
+      q.chain[q.n] = std::uint8_t(chain);
+      ++chain_rays[k][r * kMaxChains + chain];
       if (!q.group.empty()) q.group[q.n] = ray_group[r];
       if (++q.n == kRayBatch) flush(k);
     }
     rays_cast[k][r] += std::uint32_t(count);
   }
 
-  // --ao-rays auto: rounds of more rays of kind `k` for the texels whose standard error is still
-  // above MapOptions::max_ao_error, until none is (or has ao_rays_max rays). A texel's samples
-  // share its round's rays; everything is per texel, so the rounds do not depend on the tiling's
-  // threads.
+  // --ao-rays auto: rounds of more rays of kind `k` for the texels whose standard error (from the
+  // spread of their chains) is still above MapOptions::max_ao_error, until none is (or has
+  // ao_rays_max rays), shared by its hit samples. Everything is
+  // per texel, so the rounds do not depend on the tiling's threads.
   void cast_rounds(int k, const Samples& smp) {
     const MapOptions& mo = *in.maps;
-    const double e2 = mo.max_ao_error * mo.max_ao_error;
     const double cap = double(mo.ao_rays_max);
     const std::size_t n = smp.count;
     for (;;) {
       texel_hits.assign(texels, 0);
       texel_rays.assign(texels, 0.0);
-      texel_sum.assign(texels, 0.0);
-      texel_sq.assign(texels, 0.0);
+      texel_chains.assign(texels * 2 * kMaxChains, 0.0);
       texel_more.assign(texels, 0);
       for (std::size_t r = 0; r < n; ++r) {
         if (smp.hit_tri[r] == raycast::no_hit) continue;
         const std::size_t i = smp.texel[r];
         ++texel_hits[i];
         texel_rays[i] += double(rays_cast[k][r]);
-        texel_sum[i] += k == 0 ? double(open_rays[r]) : thick_sum[r];
-        if (k == 1) texel_sq[i] += thick_sq[r];
+        for (int c = 0; c < chains; ++c) {
+          texel_chains[(i * kMaxChains + std::size_t(c)) * 2] += chain_sum[k][r * kMaxChains + std::size_t(c)];
+          texel_chains[(i * kMaxChains + std::size_t(c)) * 2 + 1] += double(chain_rays[k][r * kMaxChains + std::size_t(c)]);
+        }
       }
       bool more = false;
       for (std::size_t i = 0; i < texels; ++i) {
         const double rays = texel_rays[i], hits = double(texel_hits[i]);
         if (hits == 0.0 || rays >= cap) continue;
-        double var;  // of one ray's value
-        if (k == 0) {
-          // The open share with kAutoPrior rays of each outcome added: a texel whose first rays
-          // all agree is not taken for certain (32 open rays leave p = 0.97 quite likely).
-          const double p = (texel_sum[i] + kAutoPrior) / (rays + 2.0 * kAutoPrior);
-          var = p * (1.0 - p) * rays / std::max(1.0, rays - 1.0);
-        } else {
-          const double mean = texel_sum[i] / rays;
-          var = rays > 1.0 ? std::max(0.0, (texel_sq[i] - rays * mean * mean) / (rays - 1.0)) : 0.0;
-        }
-        if (var <= e2 * rays) continue;  // standard error sqrt(var / rays) at most E
-        // The rays that would bring it to E, at least a round's worth, at most the cap.
-        const double want = std::min(cap - rays, std::max(double(kAutoRoundRays), std::ceil(var / e2 - rays)));
-        const double per = std::min(std::ceil(want / hits), std::floor((cap - rays) / hits));
+        const double se = chain_standard_error(&texel_chains[i * 2 * kMaxChains], true);
+        if (se <= mo.max_ao_error) continue;
+        // The rays that would bring it to E, at least half again, in whole rounds of its chains per
+        // hit sample (so that its chains stay equal), at most the cap.
+        const double want = std::max(0.5 * rays, rays * std::pow(se / mo.max_ao_error, 1.0 / kAutoErrorExponent) - rays);
+        const double c = double(chains);
+        const double per = std::min(c * std::ceil(want / hits / c), std::floor((cap - rays) / hits));
         if (per < 1.0) continue;
         texel_more[i] = std::uint32_t(per);
         more = true;
@@ -251,7 +294,7 @@ struct TexelMaps::Impl {
       for (std::size_t i = 0; i < q.n; ++i) {
         if (q.occluded[i]) continue;
         const std::size_t r = q.sample[i];
-        ++open_rays[r];
+        chain_sum[0][r * kMaxChains + q.chain[i]] += 1.0;
         bent_sum[r] += glm::dvec3(q.rays.direction(0)[i], q.rays.direction(1)[i], q.rays.direction(2)[i]);
       }
     } else {
@@ -262,9 +305,7 @@ struct TexelMaps::Impl {
       for (std::size_t i = 0; i < q.n; ++i) {
         const std::size_t r = q.sample[i];
         const raycast::Hit h = q.rays.hit(i);
-        const double d = h.hit() ? std::min(1.0, double(h.t) / in.thickness_distance) : 1.0;
-        thick_sum[r] += d;
-        thick_sq[r] += d * d;
+        chain_sum[1][r * kMaxChains + q.chain[i]] += h.hit() ? std::min(1.0, double(h.t) / in.thickness_distance) : 1.0;
       }
     }
     q.n = 0;
@@ -296,15 +337,17 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
   if (rays) {  // the secondary rays' per-sample state and sums, only where a map casts them
     m.hit_normal.assign(n, glm::dvec3(0.0));
     m.bent_sum.assign(n, glm::dvec3(0.0));
-    m.open_rays.assign(n, 0);
-    m.thick_sum.assign(n, 0.0);
-    m.thick_sq.assign(n, 0.0);
     m.hit_point.assign(n, glm::dvec3(0.0));
     m.hit_face.assign(n, glm::dvec3(0.0));
     m.ray_group.assign(n, 0);
+    m.sample_texel = smp.texel;
     for (int k = 0; k < 2; ++k) {
-      m.stream[k].assign(n, SampleStream(0));
       m.rays_cast[k].assign(n, 0);
+      m.chain_sum[k].assign(n * kMaxChains, 0.0);
+      m.chain_rays[k].assign(n * kMaxChains, 0);
+      if (in.maps->ao_independent_rays) m.stream[k].assign(n, SampleStream(0));
+      m.texel_seed[k].resize(m.texels * kMaxChains * 2);
+      m.texel_next[k].assign(m.texels, 0);
     }
   }
   if (m.ids) m.object_id.assign(n, -1), m.material_id.assign(n, -1);
@@ -398,8 +441,17 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
     m.ray_group[r] = m.queue[0].group.empty() ? 0u : in.groups->low[tri];
     for (int kind = 0; kind < 2; ++kind) {
       if (kind == 1 ? !m.rays_thickness : !m.rays_ao) continue;
-      m.stream[kind][r] = SampleStream(
-          sample_key(texel, std::uint64_t(level) << 32 | appearance, std::uint64_t(kind) + (in.maps->ray_seed << 8)));
+      const std::uint64_t map_key = std::uint64_t(kind) + (in.maps->ray_seed << 8);
+      if (in.maps->ao_independent_rays)
+        m.stream[kind][r] = SampleStream(sample_key(texel, std::uint64_t(level) << 32 | appearance, map_key));
+      // The texel's chains: one key per texel, pass and kind (the chains' seeds follow from it).
+      if (m.texel_next[kind][i] == 0) {
+        const std::uint64_t key = sample_key(texel, (std::uint64_t(level) << 32) | 0xffffffffu, map_key);
+        for (int c = 0; c < m.chains; ++c) {
+          std::uint64_t* seed = &m.texel_seed[kind][(i * kMaxChains + std::size_t(c)) * 2];
+          scramble_seeds(key + std::uint64_t(c) * 0x9e3779b97f4a7c15ull, seed[0], seed[1]);
+        }
+      }
       m.queue_rays(kind, r, per_sample);
     }
   }
@@ -416,14 +468,17 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
     const bool hit = smp.hit_tri[r] != raycast::no_hit;
     const std::size_t tri = std::size_t(smp.low_tri[r]);
     const double b[3] = {smp.b[0][r], smp.b[1][r], smp.b[2][r]};
-    if (m.has(s_ao) && hit) {
-      m.at(i, s_ao)[0] += double(m.open_rays[r]);
-      m.at(i, s_ao)[1] += double(m.rays_cast[0][r]);
-    }
-    if (m.has(s_thickness) && hit) {
-      m.at(i, s_thickness)[0] += m.thick_sum[r];
-      m.at(i, s_thickness)[1] += m.thick_sq[r];
-      m.at(i, s_thickness)[2] += double(m.rays_cast[1][r]);  // every ray queued is cast
+    for (int k = 0; k < 2 && hit; ++k) {  // every ray queued is cast
+      const Slot slot = k == 0 ? s_ao : s_thickness;
+      if (!m.has(slot)) continue;
+      double* v = m.at(i, slot);
+      for (int c = 0; c < m.chains; ++c) {
+        const double sum = m.chain_sum[k][r * kMaxChains + std::size_t(c)];
+        v[0] += sum;
+        v[2 + 2 * c] += sum;
+        v[3 + 2 * c] += double(m.chain_rays[k][r * kMaxChains + std::size_t(c)]);
+      }
+      v[1] += double(m.rays_cast[k][r]);
     }
     if (m.has(s_bent)) {
       const PixelFrame frame = interpolate_frame(s.low_tris[tri].n, s.low_tris[tri].t, b, in.bitangent);
@@ -509,17 +564,11 @@ void TexelMaps::write(MapTargets& out, int x0, int y0, int w, int h, int side, i
           case MapKind::vertex_color:
             for (int c = 0; c < 3; ++c) px[c] = float(hits > 0.0 ? v[c] / hits : 0.0);
             break;
-          case MapKind::ao: {
-            const double rays = v[1], p = rays > 0.0 ? v[0] / rays : kMissAo;
-            px[0] = float(p);
-            out.ao_error.pixels[g] = float(rays > 1.0 ? std::sqrt(p * (1.0 - p) / (rays - 1.0)) : 0.0);
-            break;
-          }
+          case MapKind::ao:
           case MapKind::thickness: {
-            const double rays = v[2], mean = rays > 0.0 ? v[0] / rays : kMissThickness;
-            px[0] = float(mean);
-            const double var = rays > 1.0 ? std::max(0.0, (v[1] - rays * mean * mean) / (rays - 1.0)) : 0.0;
-            out.thickness_error.pixels[g] = float(rays > 1.0 ? std::sqrt(var / rays) : 0.0);
+            const double rays = v[1];
+            px[0] = float(rays > 0.0 ? v[0] / rays : kind == MapKind::ao ? kMissAo : kMissThickness);
+            (kind == MapKind::ao ? out.ao_error : out.thickness_error).pixels[g] = float(chain_standard_error(v + 2));
             break;
           }
           case MapKind::object_id:
@@ -530,7 +579,7 @@ void TexelMaps::write(MapTargets& out, int x0, int y0, int w, int h, int side, i
         }
       }
       if (!out.ao_rays.pixels.empty()) out.ao_rays.pixels[g] = float(m.at(i, s_ao)[1]);
-      if (!out.thickness_rays.pixels.empty()) out.thickness_rays.pixels[g] = float(m.at(i, s_thickness)[2]);
+      if (!out.thickness_rays.pixels.empty()) out.thickness_rays.pixels[g] = float(m.at(i, s_thickness)[1]);
     }
 }
 

@@ -4,7 +4,7 @@
 // their secondary rays here, from the hit, on the bake's own BVH.
 //
 // Everything a texel gets is computed by the thread that traces its tile, in sample order, with
-// random directions keyed by texel and sample (never by thread): the maps do not depend on the
+// directions keyed by texel (never by thread): the maps do not depend on the
 // thread count.
 #pragma once
 
@@ -56,8 +56,9 @@ struct MapInputs {
 // A texel whose samples all miss gets the map's miss value (texel_maps.cpp, kMiss*).
 struct MapTargets {
   std::vector<Image> raw;  // per MapOptions::maps entry; empty for normal
-  // Per texel, the standard error of the ao / thickness value (its samples' spread over sqrt of
-  // their count); empty unless the map is asked for.
+  // Per texel, the standard error of the ao / thickness value (the spread of the means of its
+  // rays' independent chains over sqrt of their number, texel_maps.cpp); empty unless the map is
+  // asked for.
   Image ao_error, thickness_error;
   // With --ao-rays auto (MapOptions::ao_rays_auto), per texel the AO's / thickness's rays cast
   // (summed over its samples); empty otherwise, or unless the map (ao or bent-normal / thickness) is
@@ -90,7 +91,7 @@ class TexelMaps {
     std::size_t count;
   };
   // Replaces the sums of the texels these samples fall in by theirs. `tile_x0`, `tile_y0`, `side`
-  // and `width` place the tile's texels in the map (random streams are keyed by map texel);
+  // and `width` place the tile's texels in the map (directions are keyed by map texel);
   // `level` (0 = first pass) and `per_texel` (the pass's samples per texel) spread a texel's
   // secondary rays over its samples.
   void shade(const Samples& samples, int tile_x0, int tile_y0, int side, int width, int level, std::size_t per_texel);
