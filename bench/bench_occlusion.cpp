@@ -14,12 +14,13 @@
 // onto its high-poly subdivided) is baked at SIZE^2, 1 sample, by the library: the normal map alone,
 // then normal + ao with --rays rays per texel, each the best of the rounds, so that the AO's share
 // of the trace stage is their difference; then normal + position + object-normal give each covered
-// texel's hit point and interpolated high-poly normal, and from them the AO's rays as the bake draws
-// them (texel-keyed streams, level 0, sample 0, cosine-weighted about the normal, tfar the bake's AO
-// distance; the start offset along the interpolated normal, where the bake takes the face's), in
-// texel order. The bare loop, rtcOccluded1 per ray on a default Embree scene of the high-poly,
-// traces them on the same threads; only the Embree calls are timed (the rays are made per chunk
-// outside the clock). Prints both times and their ratio.
+// texel's hit point and interpolated high-poly normal, and from them as many AO rays per texel as
+// the bake casts, of the same distribution (texel-keyed random streams, cosine-weighted about the
+// normal, tfar the bake's AO distance; the start offset along the interpolated normal, where the bake
+// takes the face's), in texel order. Not the bake's own directions: those are stratified chains
+// (texel_maps.h); the occlusion work per ray is the same. The bare loop, rtcOccluded1 per ray on a default Embree scene of the
+// high-poly, traces them on the same threads; only the Embree calls are timed (the rays are made per chunk outside the clock).
+// Prints both times and their ratio.
 //
 // usage: bench_occlusion [--sculpt DIR] [--subdivide N] [--points P] [--rays N] [--distance F]
 //                        [--rounds R] [--threads T] [--chunk C] [--variants] [--from-bake SIZE]
