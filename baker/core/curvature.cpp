@@ -87,18 +87,23 @@ Welded weld_mesh(const Mesh& m, int threads) {
   return w;
 }
 
-// The distinct vertices sharing a kept face with `v`, each with how many kept faces share the edge.
-void edge_neighbours(const Welded& w, std::uint32_t v, std::vector<std::uint32_t>& scratch,
-                     std::vector<std::pair<std::uint32_t, int>>& out) {
-  scratch.clear();
+// In `out`, sorted, the other corners of every kept face at `v` (a neighbour once per face).
+void sorted_neighbours(const Welded& w, std::uint32_t v, std::vector<std::uint32_t>& out) {
   out.clear();
   for (std::uint32_t i = w.first[v]; i < w.first[v + 1]; ++i) {
     const std::uint32_t t = w.faces[i];
     if (w.state[t] == kDuplicate) continue;
     for (int k = 0; k < 3; ++k)
-      if (w.corner[3 * t + k] != v) scratch.push_back(w.corner[3 * t + k]);
+      if (w.corner[3 * t + k] != v) out.push_back(w.corner[3 * t + k]);
   }
-  std::sort(scratch.begin(), scratch.end());
+  std::sort(out.begin(), out.end());
+}
+
+// The distinct vertices sharing a kept face with `v`, each with how many kept faces share the edge.
+void edge_neighbours(const Welded& w, std::uint32_t v, std::vector<std::uint32_t>& scratch,
+                     std::vector<std::pair<std::uint32_t, int>>& out) {
+  sorted_neighbours(w, v, scratch);
+  out.clear();
   for (std::size_t i = 0; i < scratch.size();) {
     std::size_t j = i;
     while (j < scratch.size() && scratch[j] == scratch[i]) ++j;
@@ -110,14 +115,7 @@ void edge_neighbours(const Welded& w, std::uint32_t v, std::vector<std::uint32_t
 // Whether some edge at `v` is not shared by exactly two kept faces (edge_neighbours' counts, not
 // all 2): its neighbours, sorted, must come in pairs of one vertex each.
 bool on_border(const Welded& w, std::uint32_t v, std::vector<std::uint32_t>& scratch) {
-  scratch.clear();
-  for (std::uint32_t i = w.first[v]; i < w.first[v + 1]; ++i) {
-    const std::uint32_t t = w.faces[i];
-    if (w.state[t] == kDuplicate) continue;
-    for (int k = 0; k < 3; ++k)
-      if (w.corner[3 * t + k] != v) scratch.push_back(w.corner[3 * t + k]);
-  }
-  std::sort(scratch.begin(), scratch.end());
+  sorted_neighbours(w, v, scratch);
   const std::size_t n = scratch.size();
   if (n % 2) return true;
   for (std::size_t i = 0; i < n; i += 2)
