@@ -14,43 +14,37 @@ case "$tool" in
   *) echo "usage: tool_numbers.sh nmdiff|nmview EXE REPO WORK"; exit 1 ;;
 esac
 fail=0
+# Each case in its own folder, through ../run_cases.sh: nmdiff's all in one process under ctest
+# (nmbake_cases --nmdiff), nmview's one process each (each starts a window).
+source "$(dirname "$0")/run_cases.sh"
+cases=$work/cases.txt
+: >"$cases"
+marker=()
+[ "$tool" = nmdiff ] && marker=(--nmdiff)
 values=('' ' ' '1 ' ' 1' '1x' '0x1' '1,5')
-if [ "$tool" = nmdiff ]; then
-  # nmdiff's cases run in one process under ctest (../run_cases.sh, nmbake_cases --nmdiff), each in
-  # its own folder; nmview's start a window each.
-  source "$(dirname "$0")/run_cases.sh"
-  cases=$work/cases.txt
-  : >"$cases"
-  k=0
-  for option in "${options[@]}"; do
-    for value in "${values[@]}"; do
-      mkdir -p "$work/case$k"
-      case_line "$work/case$k" --nmdiff "${args[@]}" "$option" "$value"
-      k=$((k + 1))
-    done
-  done
-  run_cases "$exe" "$cases" 60
-fi
 k=0
 for option in "${options[@]}"; do
   for value in "${values[@]}"; do
-    if [ "$tool" = nmdiff ]; then
-      dir=$work/case$k
-      case_result "$dir"
-      cp "$dir/stderr.txt" stderr.txt 2>/dev/null || : >stderr.txt
-      [ -e "$dir/$out" ] && touch "$out"
-    else
-      "$exe" "${args[@]}" "$option" "$value" >stdout.txt 2>stderr.txt
-      got=$?
-    fi
+    mkdir -p "$work/case$k"
+    case_line "$work/case$k" "${marker[@]}" "${args[@]}" "$option" "$value"
     k=$((k + 1))
-    lines=$(wc -l <stderr.txt)
-    if [ "$got" != "$code" ] || [ "$lines" != 1 ] || ! grep -q '^error: ' stderr.txt || ! grep -qF -- "$option" stderr.txt ||
-      [ -e "$out" ]; then
-      echo "FAIL: $tool $option '$value': exit $got (expected $code), $lines lines: $(head -c 300 stderr.txt)"
+  done
+done
+if [ "$tool" = nmdiff ]; then run_cases "$exe" "$cases" 60; else NMBAKE_CASES='' run_cases "$exe" "$cases" 60; fi
+k=0
+for option in "${options[@]}"; do
+  for value in "${values[@]}"; do
+    dir=$work/case$k
+    k=$((k + 1))
+    case_result "$dir"
+    err=$dir/stderr.txt
+    [ -e "$err" ] || : >"$err"
+    lines=$(wc -l <"$err")
+    if [ "$got" != "$code" ] || [ "$lines" != 1 ] || ! grep -q '^error: ' "$err" || ! grep -qF -- "$option" "$err" ||
+      [ -e "$dir/$out" ]; then
+      echo "FAIL: $tool $option '$value': exit $got (expected $code), $lines lines: $(head -c 300 "$err")"
       fail=1
     fi
-    rm -f "$out"
   done
 done
 # A number still works (a leading zero is decimal).
