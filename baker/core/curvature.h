@@ -59,9 +59,9 @@ struct CurvatureStats {
 //  - a repeated face (same three welded vertices, either winding) counts once;
 //  - faces wound against their neighbours: the Laplacian does not depend on winding; the sign
 //    follows the vertex's area-weighted normal, which such faces partly cancel.
-// Linear time and memory; the welding's lists and the faces' sums on one core, the per-face and
-// per-vertex passes on `threads` (each vertex's sums gathered over its faces in face order, so the same to the bit on any
-// number of threads).
+// Linear time and memory; the welding's lists and the faces' sums (one pass in face order) on one
+// core, the per-face and per-vertex passes on `threads` (the smoothing gathers each vertex's values
+// over its faces in face order), so the same to the bit on any number of threads.
 std::vector<float> vertex_mean_curvature(const Mesh& mesh, const CurvatureOptions& opt = {}, CurvatureStats* stats = nullptr);
 
 }  // namespace nmbake
