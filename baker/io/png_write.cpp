@@ -184,8 +184,12 @@ Layout sample_layout(int width, int channels, int bits) {
   return l;
 }
 
-bool valid_sizes(int width, int height, int channels, int bits) {
-  return width > 0 && height > 0 && width <= 0x7fffffff / 8 && channels >= 1 && channels <= 4 && (bits == 8 || bits == 16);
+// Whether PNG can store the image; if not, why, in `error`.
+bool valid_sizes(int width, int height, int channels, int bits, std::string* error) {
+  if (width > 0 && height > 0 && width <= 0x7fffffff / 8 && channels >= 1 && channels <= 4 && (bits == 8 || bits == 16))
+    return true;
+  *error = "invalid IHDR data (size, channels or bit depth)";
+  return false;
 }
 
 // encode_png with its rows from `row` (layout.row_bytes each), called from every thread (each row
@@ -336,10 +340,7 @@ std::vector<unsigned char> encode_png(const void* rows, int width, int height, i
     std::memcpy(out, in + std::size_t(y) * row_bytes, row_bytes);
     if (bits == 16) big_endian16(out, row_bytes);
   };
-  if (!valid_sizes(width, height, channels, bits)) {
-    *error = "invalid IHDR data (size, channels or bit depth)";
-    return {};
-  }
+  if (!valid_sizes(width, height, channels, bits, error)) return {};
   return encode_rows(row, width, height, sample_layout(width, channels, bits), metadata, settings, threads, error);
 }
 
@@ -355,8 +356,7 @@ void write_png_image(const std::string& path, const Image& image, const WriteOpt
     if (!given) metadata.emplace_back("DateTime", date);
   }
   std::string error;
-  if (!valid_sizes(image.width, image.height, image.channels, bits))
-    image_write::fail_write(path, "invalid IHDR data (size, channels or bit depth)");
+  if (!valid_sizes(image.width, image.height, image.channels, bits, &error)) image_write::fail_write(path, error);
   std::vector<unsigned char> bytes;
   IndexedColors indexed;
   if (options.indexed && bits == 8 && image.channels == 3 && !options.dither && index_colors(image, indexed)) {
