@@ -6,14 +6,10 @@
 #include "angle_metrics.h"
 
 namespace nmview {
-namespace {
-
 void keep_light_in_range(Light& light) {
   light.azimuth = std::remainder(light.azimuth, 360.0f);
   light.elevation = std::clamp(light.elevation, -89.0f, 89.0f);
 }
-
-}  // namespace
 
 void cycle_display(Toggles& toggles, const std::vector<nmbake::MapKind>& maps) {
   if (!toggles.show_map) {

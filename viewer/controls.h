@@ -69,4 +69,8 @@ Marks marks_of(const ViewerState& state);
 // Moves the UV cursor to `uv` (nullopt: the mouse left the UV pane), finding its point on `low`.
 void set_uv_cursor(ViewerState& state, const std::optional<glm::vec2>& uv, const LowVertices& low);
 
+// The light's azimuth wrapped to (-180, 180] degrees and its elevation kept within +-89 (what the
+// keys, a right drag and the orbiting light leave it at).
+void keep_light_in_range(Light& light);
+
 }  // namespace nmview

@@ -148,8 +148,7 @@ void on_cursor(GLFWwindow* window, double x, double y) {
     Light& light = s.viewer.light;
     light.azimuth += dx;
     light.elevation -= dy;
-    light.azimuth = std::remainder(light.azimuth, 360.0f);
-    light.elevation = std::clamp(light.elevation, -89.0f, 89.0f);
+    keep_light_in_range(light);
   }
   s.dirty = true;
 }
@@ -259,8 +258,8 @@ void run_interactive(const Scene& scene, const InteractiveOptions& options, cons
     else glfwWaitEvents();
     const double now = glfwGetTime();
     if (s.viewer.orbit_light) {
-      s.viewer.light.azimuth =
-          std::remainder(s.viewer.light.azimuth + float(now - last_time) * kLightOrbitDegreesPerSecond, 360.0f);
+      s.viewer.light.azimuth += float(now - last_time) * kLightOrbitDegreesPerSecond;
+      keep_light_in_range(s.viewer.light);
       s.dirty = true;
     }
     last_time = now;
