@@ -35,6 +35,7 @@
 #include "core/tangent_frames.h"
 #include "io/image_io.h"
 #include "pipeline/bake.h"
+#include "tests/build_paths.h"
 
 using namespace nmbake;
 using namespace nmbake::bench;
@@ -52,7 +53,7 @@ struct Args {
   std::vector<std::string> ao_scenes{"suz_L4", "torus_s3"};
   int ao_size = 128, ao_threads = 2;
   std::vector<double> max_ao_errors{0.015, kDefaultMaxAoError, 0.025, 0.03};
-  std::string out = "docs/accuracy", data = NMBAKE_SHARED_DATA, nmview = NMBAKE_NMVIEW;
+  std::string out = "docs/accuracy", data = nmbake::build::shared_data_dir(), nmview = nmbake::build::nmview_exe();
   std::string font = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
   std::string command = "nmbake_accuracy";  // the command line as given, for accuracy.md
 };

@@ -9,6 +9,7 @@
 
 #include "accuracy_plot.h"
 #include "core/errors.h"
+#include "tests/build_paths.h"
 
 namespace nmbake::bench {
 
@@ -29,7 +30,7 @@ std::string cpu_model() {
 
 std::string git_commit() {
   const std::string c =
-      command_output("git -C " + shell_quote(NMBAKE_SOURCE_DIR) + " describe --always --dirty --abbrev=12 2>/dev/null");
+      command_output("git -C " + shell_quote(nmbake::build::source_dir()) + " describe --always --dirty --abbrev=12 2>/dev/null");
   return c.empty() ? "unknown (not a git checkout)" : c;
 }
 

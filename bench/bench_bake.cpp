@@ -38,6 +38,7 @@
 #include "bench_bake.h"
 #include "bench_support.h"
 #include "io/mesh_io.h"
+#include "tests/build_paths.h"
 
 using namespace nmbake::bench;
 namespace fs = std::filesystem;
@@ -149,7 +150,7 @@ Args parse_args(int argc, char** argv) {
 
 void print_machine(const BenchRun& run) {
   const Args& args = run.args;
-  const Machine machine = describe_machine(NMBAKE_SOURCE_DIR);
+  const Machine machine = describe_machine(nmbake::build::source_dir());
   std::printf("# nmbake bench\n\n");
   std::printf("- date: %s\n", machine.date.c_str());
   std::printf("- machine: %d cores, %s (%s), %.1f GiB RAM; load average at start %s\n", machine.cores, machine.cpu_model.c_str(),

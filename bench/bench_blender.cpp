@@ -28,6 +28,7 @@
 
 #include "bench_bake.h"
 #include "bench_support.h"
+#include "tests/build_paths.h"
 
 extern char** environ;
 
@@ -162,7 +163,7 @@ void judge(BenchRun& run, const Pair& p, bool m1, const std::string& no_blender)
 
 }  // namespace
 
-std::string blender_script() { return NMBAKE_SOURCE_DIR "/bench/blender_bake.py"; }
+std::string blender_script() { return std::string(nmbake::build::source_dir()) + "/bench/blender_bake.py"; }
 
 bool run_side(const BenchRun& run, Side& side, const std::vector<std::string>& command, const std::string& log) {
   if (!side.failed.empty()) return false;

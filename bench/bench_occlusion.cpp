@@ -45,6 +45,7 @@
 #include "io/mesh_io.h"
 #include "pipeline/bake.h"
 #include "raycast.h"
+#include "tests/build_paths.h"
 
 using namespace nmbake;
 using nmbake::bench::Clock;
@@ -53,7 +54,7 @@ using nmbake::bench::since;
 namespace {
 
 struct Args {
-  std::string sculpt = NMBAKE_SHARED_DATA "/sculpts/suz_L4";
+  std::string sculpt = std::string(nmbake::build::shared_data_dir()) + "/sculpts/suz_L4";
   int subdivide = 1;  // suz_L4 (251,904 triangles) once: 1,007,616
   std::size_t points = 32768;
   int rays = 64;

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "test_support.h"
+#include "build_paths.h"
 
 namespace {
 
@@ -46,7 +47,7 @@ struct Tool {
   std::string failing;              // a command line that fails (a missing input), same outputs
 };
 
-std::string binary(const std::string& relative) { return std::string(NMBAKE_BINARY_DIR) + "/" + relative; }
+std::string binary(const std::string& relative) { return std::string(nmbake::build::binary_dir()) + "/" + relative; }
 
 Tool nmbake_tool() {
   const std::string args = " '" + data_path("sample/torus_low.obj") + "' '" + data_path("sample/torus_high.ply") + "'";

@@ -17,6 +17,7 @@
 #include "core/errors.h"
 #include "io/image_io.h"
 #include "test_support.h"
+#include "build_paths.h"
 
 using nmbake::Image;
 using nmbake::MapKind;
@@ -61,7 +62,7 @@ double distance_at(int x, int y) { return 0.3 * std::sin(0.7 * x) * std::cos(0.4
 
 // Runs the nmdiff binary in `dir`; returns its exit code, stdout in `out`, stderr in `err`.
 int run_nmdiff(const std::string& dir, const std::string& args, std::string& out, std::string& err) {
-  const std::string exe = std::string(NMBAKE_BINARY_DIR) + "/nmdiff/nmdiff";
+  const std::string exe = std::string(nmbake::build::binary_dir()) + "/nmdiff/nmdiff";
   const std::string cmd = "cd '" + dir + "' && '" + exe + "' " + args + " >out.txt 2>err.txt";
   const int status = std::system(cmd.c_str());
   out = nmbake::test::read_file(dir + "/out.txt");

@@ -21,12 +21,15 @@
 #include "io/mesh_io.h"
 #include "pipeline/bake_stages.h"
 #include "pipeline/trace.h"
+#include "build_paths.h"
 
 namespace nmbake::test {
 
-std::string data_path(const std::string& relative) { return std::string(NMBAKE_DATA_DIR) + "/" + relative; }
+std::string data_path(const std::string& relative) { return std::string(nmbake::build::data_dir()) + "/" + relative; }
 
-std::string shared_data_path(const std::string& relative) { return std::string(NMBAKE_SHARED_DATA_DIR) + "/" + relative; }
+std::string shared_data_path(const std::string& relative) {
+  return std::string(nmbake::build::shared_data_dir()) + "/" + relative;
+}
 
 bool exists(const std::string& path) { return std::filesystem::exists(path); }
 
@@ -56,7 +59,7 @@ std::string scratch_dir() {
   std::string name = info ? std::string(info->test_suite_name()) + "." + info->name() : "scratch";
   for (char& c : name)
     if (c == '/') c = '_';
-  std::filesystem::path dir = std::filesystem::path(NMBAKE_BINARY_DIR) / "test-scratch" / name;
+  std::filesystem::path dir = std::filesystem::path(nmbake::build::binary_dir()) / "test-scratch" / name;
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir.string();
@@ -167,7 +170,7 @@ CliRun run_nmbake(const std::string& args, const std::string& prefix, const std:
   if (prefix.empty() && !(process && std::string(process) == "1")) {
     r.code = run_nmbake_in(shell_words(args), r.dir);
   } else {
-    const std::string exe = std::string(NMBAKE_BINARY_DIR) + "/baker/nmbake";
+    const std::string exe = std::string(nmbake::build::binary_dir()) + "/baker/nmbake";
     const std::string cmd = "cd '" + r.dir + "' && " + prefix + " '" + exe + "' " + args + " >out.txt 2>err.txt";
     const int status = std::system(("bash -c \"" + cmd + "\"").c_str());
     r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;

@@ -30,6 +30,7 @@
 #include "scene_maker.h"
 #include "tool_run.h"
 #include "test_support.h"
+#include "build_paths.h"
 
 namespace {
 
@@ -47,7 +48,8 @@ using nmview::test::nmview;
 
 void bake(const std::string& dir, const std::string& low, const std::string& high, const std::string& map,
           const std::string& options = "") {
-  Result r = run(dir, NMBAKE_EXE, quote(low) + " " + quote(high) + " -o " + quote(map) + " --size 512 --quiet " + options);
+  Result r = run(dir, nmbake::build::nmbake_exe(),
+                 quote(low) + " " + quote(high) + " -o " + quote(map) + " --size 512 --quiet " + options);
   ASSERT_EQ(r.exit_code, 0) << "nmbake failed:\n" << r.out << r.err;
 }
 
@@ -277,7 +279,8 @@ NormalCube make_normal_cube() {
 
 std::string bake_cube(const NormalCube& c, const std::string& name, const std::string& options) {
   const std::string map = c.dir + "/" + name;
-  Result r = run(c.dir, NMBAKE_EXE, quote(c.low) + " " + quote(c.high) + " -o " + quote(map) + " --size 256 --quiet " + options);
+  Result r = run(c.dir, nmbake::build::nmbake_exe(),
+                 quote(c.low) + " " + quote(c.high) + " -o " + quote(map) + " --size 256 --quiet " + options);
   EXPECT_EQ(r.exit_code, 0) << "nmbake failed:\n" << r.out << r.err;
   return map;
 }

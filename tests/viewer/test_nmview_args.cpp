@@ -19,6 +19,7 @@
 #include "io/image_io.h"
 #include "test_support.h"
 #include "tool_run.h"
+#include "build_paths.h"
 
 namespace {
 
@@ -165,7 +166,7 @@ PlaneScene make_plane_scene() {
 }
 
 nmview::test::ToolRun nmview_run(const PlaneScene& s, const std::string& args) {
-  return nmview::test::run_tool(s.dir, NMVIEW_EXE, args);
+  return nmview::test::run_tool(s.dir, nmbake::build::nmview_exe(), args);
 }
 
 std::string screenshot(const PlaneScene& s, const std::string& name, const std::string& inputs) {

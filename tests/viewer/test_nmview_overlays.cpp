@@ -22,6 +22,7 @@
 #include "test_support.h"
 #include "tool_run.h"
 #include "view.h"
+#include "build_paths.h"
 
 namespace {
 
@@ -61,7 +62,7 @@ const OverlayScene& overlay_scene() {
                "f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n");
     // Run in the scene's folder with relative names, so the report names its files relative to its
     // own folder (the tests' current folder is another).
-    const std::string bake_command = "cd " + quote(s.dir) + " && " + quote(NMBAKE_EXE) +
+    const std::string bake_command = "cd " + quote(s.dir) + " && " + quote(nmbake::build::nmbake_exe()) +
                                      " low.obj half_high.obj --cage cage.obj -o normal.png --size 32 --miss-mask miss.png "
                                      "--suspect-mask suspect.png --report report.json --no-warnings";
     const nmview::test::ToolRun bake = nmview::test::run_tool(s.dir, "/bin/sh", "-c " + quote(bake_command));

@@ -23,6 +23,7 @@
 #include "../cli/nmdiff/hostile_fixtures.h"
 #include "scene_maker.h"
 #include "test_support.h"
+#include "build_paths.h"
 
 namespace {
 
@@ -58,7 +59,7 @@ Finished run_nmview(const std::string& dir, const std::vector<std::string>& args
       const rlimit limit{rlim_t(limit_mb) << 20, rlim_t(limit_mb) << 20};
       if (::setrlimit(RLIMIT_AS, &limit) != 0) ::_exit(126);
     }
-    std::vector<std::string> all{NMVIEW_EXE};
+    std::vector<std::string> all{nmbake::build::nmview_exe()};
     all.insert(all.end(), args.begin(), args.end());
     std::vector<char*> argv;
     for (const std::string& a : all) argv.push_back(const_cast<char*>(a.c_str()));

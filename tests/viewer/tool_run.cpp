@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "test_support.h"
+#include "build_paths.h"
 
 namespace nmview::test {
 
@@ -31,7 +32,7 @@ ToolRun run_tool(const std::string& dir, const std::string& program, const std::
   return r;
 }
 
-ToolRun nmview(const std::string& dir, const std::string& args) { return run_tool(dir, NMVIEW_EXE, args); }
+ToolRun nmview(const std::string& dir, const std::string& args) { return run_tool(dir, nmbake::build::nmview_exe(), args); }
 
 std::string error_line(const std::string& err) {
   std::istringstream in(err);

@@ -19,7 +19,7 @@ std::string quote(const std::string& s);
 // stderr kept in stdout.txt and stderr.txt in `dir`.
 ToolRun run_tool(const std::string& dir, const std::string& program, const std::string& args);
 
-// run_tool of the nmview binary (NMVIEW_EXE).
+// run_tool of the nmview binary (nmbake::build::nmview_exe()).
 ToolRun nmview(const std::string& dir, const std::string& args);
 
 // The one "error: ..." line among a run's stderr notes ("" when none; a second one fails the test).

@@ -10,6 +10,7 @@
 #include "test_support.h"
 #include "tool_run.h"
 #include "verdict.h"
+#include "build_paths.h"
 
 namespace nmview::test {
 
@@ -38,8 +39,9 @@ VerdictRun compare_verdict(const std::string& dir, const std::string& low, const
 
 void expect_verdicts(const std::string& low, const std::string& high, int map_size, const std::string& size) {
   const std::string dir = nmbake::test::scratch_dir(), map = dir + "/map.png";
-  const ToolRun bake = run_tool(
-      dir, NMBAKE_EXE, quote(low) + " " + quote(high) + " -o " + quote(map) + " --size " + std::to_string(map_size) + " --quiet");
+  const ToolRun bake =
+      run_tool(dir, nmbake::build::nmbake_exe(),
+               quote(low) + " " + quote(high) + " -o " + quote(map) + " --size " + std::to_string(map_size) + " --quiet");
   ASSERT_EQ(bake.exit_code, 0) << bake.err;
   nmbake::Image flipped = nmbake::read_image(map), flat = flipped;
   for (std::size_t i = 0; i < flipped.pixels.size(); i += std::size_t(flipped.channels)) {
