@@ -10,6 +10,6 @@ const char* shared_data_dir();  // the shared meshes (NMBAKE_SHARED_DATA_DIR, NM
 const char* binary_dir();       // the top of the build folder
 const char* source_dir();       // the checkout
 const char* nmbake_exe();
-const char* nmview_exe();       // "" when the viewer is not built
+const char* nmview_exe();  // "" when the viewer is not built
 
 }  // namespace nmbake::build
