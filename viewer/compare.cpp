@@ -9,7 +9,8 @@
 
 namespace nmview {
 
-CompareResult run_compare(Renderer& renderer, int pane_width, int pane_height, const Light& light, const Toggles& toggles) {
+CompareResult run_compare(Renderer& renderer, int pane_width, int pane_height, const Light& light, const Toggles& toggles,
+                          CompareScope scope) {
   CompareResult result;
   for (const OrbitView& view : compare_views()) {
     renderer.render_panes(pane_width, pane_height, view, light, toggles);
@@ -18,6 +19,7 @@ CompareResult run_compare(Renderer& renderer, int pane_width, int pane_height, c
     if (result.views.empty() || d.stats.interior.rmse() > result.views[result.worst].stats.interior.rmse())
       result.worst = result.views.size();
     result.views.push_back(d);
+    if (scope == CompareScope::shading) continue;
 
     // The high-poly's normals once, then the low-poly's in each variant against them.
     renderer.render_normals(pane_width, pane_height, view, MapVariant::as_decoded);

@@ -32,9 +32,16 @@ struct CompareResult {
   AngleStats angles[kMapVariants];
 };
 
+// What run_compare measures: the lit panes only, or the normals of every MapVariant too (what
+// --compare prints). The angle passes draw the high-poly once more and the low-poly four times a
+// view, about half of the work on a dense high-poly.
+enum class CompareScope { shading, shading_and_angles };
+
 // Renders every view at `pane_width` x `pane_height` with `toggles` (map on or off; wireframe and
-// colour modes should be off) and measures; then the normals of every MapVariant.
-CompareResult run_compare(Renderer& renderer, int pane_width, int pane_height, const Light& light, const Toggles& toggles);
+// colour modes should be off) and measures; then, with CompareScope::shading_and_angles, the
+// normals of every MapVariant (with CompareScope::shading, `angles` stay empty).
+CompareResult run_compare(Renderer& renderer, int pane_width, int pane_height, const Light& light, const Toggles& toggles,
+                          CompareScope scope = CompareScope::shading_and_angles);
 
 // One line per view, a blank line, the angle block (each variant's mean and 95th percentile, the
 // share the map removes, the verdict with `decoding` named), then the summary. The last line is

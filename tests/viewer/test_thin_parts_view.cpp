@@ -28,7 +28,8 @@ constexpr double kMarginDb = 0.2;
 
 // The interior PSNR of `map` as `nmview LOW MAP HIGH --compare --size 300x300` measures it (its
 // last line's psnr=), run in this process: the scene loaded and compared by the viewer's own code
-// (scene.h, compare.h) in the test's one headless context, without a process start per map.
+// (scene.h, compare.h) in the test's one headless context, without a process start per map, and
+// without the angle passes, which the PSNR does not need.
 double compare_psnr(const std::string& dir, const std::string& name, const std::string& map) {
   std::ostringstream log;
   const nmview::Scene scene = nmview::load_scene(dir + "/" + name + "_low.obj", nmview::find_texture_set(dir + "/" + map),
@@ -36,7 +37,8 @@ double compare_psnr(const std::string& dir, const std::string& name, const std::
   nmview::Renderer renderer(scene.low, scene.high, scene.map, scene.radius, scene.decoding);
   nmview::Toggles measure;
   measure.map = true;
-  const nmview::CompareResult result = nmview::run_compare(renderer, 150, 300, nmview::Light{}, measure);
+  const nmview::CompareResult result =
+      nmview::run_compare(renderer, 150, 300, nmview::Light{}, measure, nmview::CompareScope::shading);
   return result.total.interior.psnr();
 }
 
