@@ -15,8 +15,8 @@
 # (the target's C++ sources in order, UNITY_BUILD_BATCH_SIZE at a time, default 8) as
 # <build>/.../nmbake_unity/<target>_<n>.cxx with `#include "path/from/the/checkout.cpp"`, found
 # through -I<checkout> (which ccache rewrites to a relative path), and turns CMake's unity off.
-# A source outside the checkout (a generated file) is compiled on its own, as are sources marked
-# SKIP_UNITY_BUILD_INCLUSION.
+# A source outside the checkout or in the build folder (a generated file, nmbake_build_paths's with
+# its absolute paths) is compiled on its own, as are sources marked SKIP_UNITY_BUILD_INCLUSION.
 
 function(_nmbake_unity_targets dir out)
   get_property(targets DIRECTORY "${dir}" PROPERTY BUILDSYSTEM_TARGETS)
@@ -50,7 +50,8 @@ function(_nmbake_unity_target target)
     get_filename_component(path "${source}" ABSOLUTE BASE_DIR "${source_dir}")
     file(RELATIVE_PATH relative "${PROJECT_SOURCE_DIR}" "${path}")
     get_source_file_property(skip "${path}" TARGET_DIRECTORY ${target} SKIP_UNITY_BUILD_INCLUSION)
-    if(relative MATCHES "^\\.\\./" OR skip)
+    string(FIND "${path}/" "${PROJECT_BINARY_DIR}/" in_build)
+    if(relative MATCHES "^\\.\\./" OR in_build EQUAL 0 OR skip)
       list(APPEND kept "${source}")
     else()
       list(APPEND pooled "${relative}")

@@ -3,8 +3,8 @@
 # UndefinedBehaviorSanitizer (NMBAKE_SANITIZE, gcc) in build-asan/ (-O1 -g1: line tables, so the
 # reports name file and line, at a quarter less compile time than -g and half the object size;
 # asserts on, no bench, no viewer) and runs the whole test suite there with ctest, one process per
-# test file (NMBAKE_TEST_PER_PROGRAM: an ASan process start costs ~0.5 s CPU, and ~190 of them
-# were a third of the run). Any ASan/UBSan report fails the test that triggered it; LeakSanitizer ignores only
+# batch of test files (NMBAKE_TEST_PER_PROGRAM, NMBAKE_TEST_BATCH: an ASan process start costs
+# ~0.45 s CPU, and ~190 of them were a third of the run). Any ASan/UBSan report fails the test that triggered it; LeakSanitizer ignores only
 # the known leaks listed in tests/sanitize/lsan.supp.
 # The viewer is off here (not tried under ASan): its tests draw through Mesa's llvmpipe via EGL and
 # GLFW, uninstrumented driver code that is slow on the CPU already and whose allocations would
