@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 
@@ -242,13 +243,21 @@ struct Scene::Impl {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
   std::size_t triangles = 0;
+  // The secondary rays' BVH over the same geometry (kept here to attach it), built once on first
+  // need (Scene::prepare_secondary_rays).
+  RTCGeometry geometry = nullptr;
+  BuildQuality quality = BuildQuality::medium;
+  RTCScene secondary = nullptr;
+  std::once_flag secondary_once;
 
   // Releasing must not throw: an error callback that throws from here (a destructor, maybe while
   // a failed build unwinds) is std::terminate; under ulimit -v a release after a failed
   // rtcCommitScene did exactly that (exit 134).
   ~Impl() {
     if (device) rtcSetDeviceErrorFunction(device, nullptr, nullptr);
+    if (secondary) rtcReleaseScene(secondary);
     if (scene) rtcReleaseScene(scene);
+    if (geometry) rtcReleaseGeometry(geometry);
     if (device) rtcReleaseDevice(device);
   }
 };
@@ -292,8 +301,29 @@ void build(Scene::Impl& impl, const float* positions, std::size_t vertex_count, 
   }
   rtcCommitGeometry(geom);
   rtcAttachGeometry(impl.scene, geom);
-  rtcReleaseGeometry(geom);
+  impl.geometry = geom;  // the reference rtcNewGeometry gave, released with the Impl
+  impl.quality = quality;
   rtcCommitScene(impl.scene);
+}
+
+// The secondary rays' scene: the same geometry without RTC_SCENE_FLAG_ROBUST, so Embree takes its
+// fast node and triangle tests (bench_occlusion: 1.35 to 1.45 times the rays per second on AO's
+// rays). Its test is not watertight: a ray aimed exactly at an edge or vertex two triangles share
+// may pass between them. For the primary rays, one texel each, that would be a texel lost; for
+// AO's and thickness's, dozens of random rays a texel, it is a ray of zero measure (the bake's AO
+// maps through either scene came out identical: raycast.h).
+void build_secondary(Scene::Impl& impl) {
+  RTCScene fast = rtcNewScene(impl.device);
+  try {
+    rtcSetSceneFlags(fast, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
+    rtcSetSceneBuildQuality(fast, to_embree(impl.quality));
+    rtcAttachGeometry(fast, impl.geometry);
+    rtcCommitScene(fast);
+  } catch (...) {
+    rtcReleaseScene(fast);
+    throw;
+  }
+  impl.secondary = fast;
 }
 
 }  // namespace
@@ -308,6 +338,7 @@ Scene::Scene(const float* positions, std::size_t vertex_count, const std::uint32
     // report it and exit). Releasing them after a failed parallel build ended in std::terminate
     // inside Embree under ulimit -v (exit 134).
     impl_->scene = nullptr;
+    impl_->geometry = nullptr;
     impl_->device = nullptr;
     throw;
   }
@@ -316,6 +347,11 @@ Scene::Scene(const float* positions, std::size_t vertex_count, const std::uint32
 Scene::~Scene() = default;
 
 std::size_t Scene::triangle_count() const { return impl_->triangles; }
+
+void Scene::prepare_secondary_rays() const {
+  Impl& impl = *impl_;
+  std::call_once(impl.secondary_once, [&impl] { build_secondary(impl); });
+}
 
 Hit Scene::intersect(const Ray& ray) const {
   RTCIntersectContext context;
@@ -441,62 +477,67 @@ void Scene::intersect(const RayBatch& rays, const HitBatch& hits, std::size_t co
   }
 }
 
-namespace {
-
-// The fields of an Embree ray stream (RTCRayNp) that a RayBatch does not carry, for a block of up
-// to `size` rays: Embree writes tfar, reads the rest.
-struct StreamBlock {
-  static constexpr std::size_t size = 1024;
-  alignas(64) float tfar[size], time[size];
-  alignas(64) unsigned mask[size], id[size], flags[size];
-  StreamBlock() {
-    for (std::size_t k = 0; k < size; ++k) {
-      time[k] = 0.0f;
-      mask[k] = 0xffffffffu;
-      id[k] = unsigned(k);  // for the group filter
-      flags[k] = 0;
-    }
-  }
-  // Rays base .. base + n - 1 of `rays`, tfar copied here.
-  RTCRayNp rays(const RayBatch& rays, std::size_t base, std::size_t n) {
-    std::memcpy(tfar, rays.tfar + base, n * sizeof(float));
-    RTCRayNp r;  // Embree only reads through the const_casts
-    r.org_x = const_cast<float*>(rays.org_x + base);
-    r.org_y = const_cast<float*>(rays.org_y + base);
-    r.org_z = const_cast<float*>(rays.org_z + base);
-    r.dir_x = const_cast<float*>(rays.dir_x + base);
-    r.dir_y = const_cast<float*>(rays.dir_y + base);
-    r.dir_z = const_cast<float*>(rays.dir_z + base);
-    r.tnear = const_cast<float*>(rays.tnear + base);
-    r.tfar = tfar;
-    r.time = time;
-    r.mask = mask;
-    r.id = id;
-    r.flags = flags;
-    return r;
-  }
-};
-
-}  // namespace
-
 void Scene::occluded(const RayBatch& rays, std::uint8_t* occluded, std::size_t count, const SecondaryRayOptions& options) const {
-  // One incoherent stream of arrays per block (rtcOccludedNp): Embree sorts the block's rays by
-  // the octant of their direction and traces each octant's rays (up to 64) together, which on
-  // AO's rays beat every other entry point (bench_occlusion --variants, suz_L4 x4, one core: 1.35
-  // times rtcOccluded8's rays per second (incoherent), 1.45 times rtcOccluded1's in the same
-  // robust scene, 2 to 2.7 times packets of 8 or 16 under the coherent flag, octant-sorted or
-  // not; rtcOccluded1M the same within noise).
-  StreamBlock block;
+  // On the secondary rays' scene, as incoherent streams of RTCRay structs (rtcOccluded1M) in
+  // blocks: Embree sorts a block's rays by the octant of their direction and traces each octant's
+  // rays together, which on AO's rays beat every other entry point (bench_occlusion --variants,
+  // suz_L4 x4, one core: on the fast scene 1.06 times rtcOccludedNp's rays per second and 2 times
+  // rtcOccluded1's; packets of 8 or 16, coherent or not, octant-sorted or not, were slower still).
+  if (count == 0) return;
+  prepare_secondary_rays();
+  constexpr std::size_t kBlock = 1024;
+  alignas(64) RTCRay block[kBlock];
   GroupContext gc(options.group);
   gc.context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
   constexpr float minus_inf = -std::numeric_limits<float>::infinity();
-  for (std::size_t base = 0; base < count; base += StreamBlock::size) {
-    const std::size_t n = std::min(StreamBlock::size, count - base);
-    RTCRayNp r = block.rays(rays, base, n);
+  for (std::size_t base = 0; base < count; base += kBlock) {
+    const std::size_t n = std::min(kBlock, count - base);
+    for (std::size_t k = 0; k < n; ++k) {
+      RTCRay& r = block[k];
+      const std::size_t i = base + k;
+      r.org_x = rays.org_x[i], r.org_y = rays.org_y[i], r.org_z = rays.org_z[i], r.tnear = rays.tnear[i];
+      r.dir_x = rays.dir_x[i], r.dir_y = rays.dir_y[i], r.dir_z = rays.dir_z[i], r.time = 0.0f;
+      r.tfar = rays.tfar[i], r.mask = 0xffffffffu, r.id = unsigned(k), r.flags = 0;  // id: the ray's index for the group filter
+    }
     gc.ray_group = rays.group ? rays.group + base : nullptr;
-    rtcOccludedNp(impl_->scene, &gc.context, &r, unsigned(n));
+    rtcOccluded1M(impl_->secondary, &gc.context, block, unsigned(n), sizeof(RTCRay));
     // Embree sets tfar to -inf when occluded; a ray it skips (tnear > tfar) keeps its own.
-    for (std::size_t k = 0; k < n; ++k) occluded[base + k] = block.tfar[k] == minus_inf && rays.tfar[base + k] != minus_inf;
+    for (std::size_t k = 0; k < n; ++k) occluded[base + k] = block[k].tfar == minus_inf && rays.tfar[base + k] != minus_inf;
+  }
+}
+
+void Scene::first_hits(const RayBatch& rays, const HitBatch& hits, std::size_t count, const SecondaryRayOptions& options) const {
+  // As occluded: the secondary rays' scene, incoherent streams of RTCRayHit structs in blocks.
+  if (count == 0) return;
+  prepare_secondary_rays();
+  constexpr std::size_t kBlock = 512;
+  alignas(64) RTCRayHit block[kBlock];
+  GroupContext gc(options.group);
+  gc.context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+  for (std::size_t base = 0; base < count; base += kBlock) {
+    const std::size_t n = std::min(kBlock, count - base);
+    for (std::size_t k = 0; k < n; ++k) {
+      RTCRay& r = block[k].ray;
+      const std::size_t i = base + k;
+      r.org_x = rays.org_x[i], r.org_y = rays.org_y[i], r.org_z = rays.org_z[i], r.tnear = rays.tnear[i];
+      r.dir_x = rays.dir_x[i], r.dir_y = rays.dir_y[i], r.dir_z = rays.dir_z[i], r.time = 0.0f;
+      r.tfar = rays.tfar[i], r.mask = 0xffffffffu, r.id = unsigned(k), r.flags = 0;
+      block[k].hit.geomID = RTC_INVALID_GEOMETRY_ID;
+      block[k].hit.primID = RTC_INVALID_GEOMETRY_ID;
+      block[k].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    }
+    gc.ray_group = rays.group ? rays.group + base : nullptr;
+    rtcIntersect1M(impl_->secondary, &gc.context, block, unsigned(n), sizeof(RTCRayHit));
+    for (std::size_t k = 0; k < n; ++k) {
+      const RTCRayHit& rh = block[k];
+      const std::size_t i = base + k;
+      const bool hit = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+      hits.triangle[i] = hit ? rh.hit.primID : no_hit;
+      hits.t[i] = rh.ray.tfar;
+      hits.u[i] = rh.hit.u;
+      hits.v[i] = rh.hit.v;
+      if (hits.flags) hits.flags[i] = 0;
+    }
   }
 }
 

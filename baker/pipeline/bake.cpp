@@ -212,6 +212,13 @@ void prepare_trace(const Mesh& low, const Mesh& high, const Mesh* cage, const Ba
     narrow_and_rebuild(high, mode, opt, threads, result, in);
     st.bvh.seconds += seconds_since(t0);
   }
+  if (opt.maps.wants_rays()) {
+    // The secondary rays' own BVH (raycast.h), over the triangles the trace sees.
+    t0 = Clock::now();
+    stage = "building the BVH of the secondary rays";
+    in.scene.scene->prepare_secondary_rays();
+    st.bvh.seconds += seconds_since(t0);
+  }
   st.bvh.quality = quality_name(in.scene.quality);
   st.select.high_triangles_culled = high.triangle_count() - in.scene.triangles;
   in.rays.front = st.distances.front;

@@ -298,10 +298,9 @@ struct TexelMaps::Impl {
         bent_sum[r] += glm::dvec3(q.rays.direction(0)[i], q.rays.direction(1)[i], q.rays.direction(2)[i]);
       }
     } else {
-      raycast::HitRule rule;
-      rule.skip_backfaces = false;
-      rule.group = groups;
-      in.scene->scene->intersect(batch, q.rays.hits(), q.n, groups ? &rule : nullptr);
+      raycast::SecondaryRayOptions so;
+      so.group = groups;
+      in.scene->scene->first_hits(batch, q.rays.hits(), q.n, so);
       for (std::size_t i = 0; i < q.n; ++i) {
         const std::size_t r = q.sample[i];
         const raycast::Hit h = q.rays.hit(i);
