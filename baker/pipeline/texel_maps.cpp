@@ -496,9 +496,19 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
     }
   }
 
-  // The ID maps: per texel the index most of its hit samples take. Samples grouped by texel, in
-  // sample order (a counting sort, once for both maps); a texel of one sample takes its index.
-  if (m.ids) {
+  // The ID maps: per texel the index most of its hit samples take. A pass of at most one sample a
+  // texel (seen[i] <= 1) takes each sample's index as it is; otherwise the samples are grouped by
+  // texel, in sample order (a counting sort, once for both maps), and a texel of one sample takes
+  // its index.
+  const bool single = m.ids && std::all_of(m.seen.begin(), m.seen.end(), [](std::uint32_t c) { return c <= 1; });
+  if (single)
+    for (int which = 0; which < 2; ++which) {
+      const Slot slot = which == 0 ? s_object_id : s_material_id;
+      if (!m.has(slot)) continue;
+      const std::vector<std::int64_t>& id = which == 0 ? m.object_id : m.material_id;
+      for (std::size_t r = 0; r < n; ++r) *m.at(smp.texel[r], slot) = id[r] >= 0 ? double(id[r]) : -1.0;
+    }
+  if (m.ids && !single) {
     std::vector<std::uint32_t>&start = m.start, &order = m.order, &fill = m.fill;
     start.assign(m.texels + 1, 0);
     order.resize(n);
@@ -613,8 +623,7 @@ void TexelMaps::write(MapTargets& out, int x0, int y0, int w, int h, int side, i
       default: break;
     }
   }
-  if (!out.ao_rays.pixels.empty())
-    each([&](std::size_t i, std::size_t g) { out.ao_rays.pixels[g] = float(m.at(i, s_ao)[1]); });
+  if (!out.ao_rays.pixels.empty()) each([&](std::size_t i, std::size_t g) { out.ao_rays.pixels[g] = float(m.at(i, s_ao)[1]); });
   if (!out.thickness_rays.pixels.empty())
     each([&](std::size_t i, std::size_t g) { out.thickness_rays.pixels[g] = float(m.at(i, s_thickness)[1]); });
 }
