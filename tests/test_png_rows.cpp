@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <random>
 #include <string>
@@ -61,4 +62,41 @@ TEST(PngRows, WriteImageMatchesQuantizeThenEncode) {
           }
         }
   EXPECT_EQ(compared, 4 * 3 * 3 * 2);
+}
+
+// quantize8's vector path (16 values at a time) against the scalar rule it mirrors, value for
+// value: NaN, infinities, -0, negatives, values above 1, the half steps (k + 0.5) / 255 and their
+// float neighbours, and a length that leaves a scalar tail.
+TEST(PngRows, Quantize8MatchesTheScalarRule) {
+  std::vector<float> v = {std::numeric_limits<float>::quiet_NaN(),
+                          std::numeric_limits<float>::infinity(),
+                          -std::numeric_limits<float>::infinity(),
+                          -0.0f,
+                          0.0f,
+                          -1e-30f,
+                          1e-30f,
+                          1.0f,
+                          1.5f,
+                          -2.0f,
+                          3e38f};
+  for (int k = 0; k <= 256; ++k) {
+    const float half = float((k + 0.5) / 255.0);
+    v.insert(v.end(), {half, std::nextafter(half, 0.0f), std::nextafter(half, 2.0f), float(k / 255.0)});
+  }
+  std::mt19937 rng(12111);
+  std::uniform_real_distribution<float> any(-0.1f, 1.1f);
+  while (v.size() % 16 != 7) v.push_back(any(rng));
+  for (int i = 0; i < 5000; ++i) v.push_back(any(rng));
+  nmbake::Image::Pixels pixels(v.begin(), v.end());
+  const auto got = nmbake::image_write::quantize8(pixels, false, 1);
+  std::vector<std::uint8_t> run(v.size());
+  nmbake::image_write::quantize8_run(v.data(), 0, v.size(), false, run.data());
+  ASSERT_EQ(got.size(), v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    double want = double(v[i]) * 255.0 + 0.5;
+    if (!(want > 0.0)) want = 0.0;
+    if (want > 255.0) want = 255.0;
+    EXPECT_EQ(int(got[i]), int(std::uint8_t(want))) << "value " << v[i] << " at " << i;
+    EXPECT_EQ(int(run[i]), int(std::uint8_t(want))) << "value " << v[i] << " at " << i;
+  }
 }

@@ -3,6 +3,10 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <atomic>
 #include <cerrno>
 #include <cstdio>
@@ -11,6 +15,7 @@
 #include <ctime>
 #include <filesystem>
 #include <system_error>
+#include <type_traits>
 
 #include "core/errors.h"
 #include "core/parallel.h"
@@ -37,11 +42,36 @@ void quantize_values(const float* values, std::size_t n, double scale, T* out) {
   }
 }
 
+// quantize_values for 8 bits, 16 values at a time in SSE2 (the same IEEE steps lane by lane: the
+// float widened, times 255, plus 0.5; max against 0 gives 0 for NaN and v <= 0 as !(v > 0) does,
+// min against 255 clamps; then truncation), the rest one by one.
+void quantize_values8(const float* values, std::size_t n, std::uint8_t* out) {
+  std::size_t i = 0;
+#if defined(__SSE2__)
+  const __m128d scale = _mm_set1_pd(255.0), half = _mm_set1_pd(0.5), zero = _mm_setzero_pd();
+  const auto four = [&](const float* v) {  // 4 values to 4 int32 lanes
+    const __m128 f = _mm_loadu_ps(v);
+    __m128d lo = _mm_add_pd(_mm_mul_pd(_mm_cvtps_pd(f), scale), half);
+    __m128d hi = _mm_add_pd(_mm_mul_pd(_mm_cvtps_pd(_mm_movehl_ps(f, f)), scale), half);
+    lo = _mm_min_pd(_mm_max_pd(lo, zero), scale);
+    hi = _mm_min_pd(_mm_max_pd(hi, zero), scale);
+    return _mm_unpacklo_epi64(_mm_cvttpd_epi32(lo), _mm_cvttpd_epi32(hi));
+  };
+  for (; i + 16 <= n; i += 16) {
+    const __m128i a = _mm_packs_epi32(four(values + i), four(values + i + 4));
+    const __m128i b = _mm_packs_epi32(four(values + i + 8), four(values + i + 12));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out + i), _mm_packus_epi16(a, b));
+  }
+#endif
+  quantize_values(values + i, n - i, 255.0, out + i);
+}
+
 template <typename T>
 Samples<T> quantize(const Image::Pixels& values, double scale, int threads) {
   Samples<T> out(values.size());  // left unset: every value is written below, on every core
   parallel_chunks(threads, values.size(), kQuantizeChunk, [&](std::size_t begin, std::size_t end) {
-    quantize_values(values.data() + begin, end - begin, scale, out.data() + begin);
+    if constexpr (std::is_same_v<T, std::uint8_t>) quantize_values8(values.data() + begin, end - begin, out.data() + begin);
+    else quantize_values(values.data() + begin, end - begin, scale, out.data() + begin);
   });
   return out;
 }
@@ -106,7 +136,7 @@ Samples<std::uint8_t> quantize8(const Image::Pixels& values, bool dither, int th
 
 void quantize8_run(const float* values, std::size_t first, std::size_t n, bool dither, std::uint8_t* out) {
   if (dither) quantize_dithered(values, first, n, out);
-  else quantize_values(values, n, 255.0, out);
+  else quantize_values8(values, n, out);
 }
 
 void quantize16_run(const float* values, std::size_t n, std::uint16_t* out) { quantize_values(values, n, 65535.0, out); }

@@ -137,6 +137,13 @@ MapInputs make_map_inputs(const BakeOptions& opt, const Prepared& s, const HighS
     in.material.resize(scene.triangles);
     for (std::size_t t = 0; t < scene.triangles; ++t) in.material[t] = high.triangle_material[in.source ? in.source[t] : t];
   }
+  if (opt.maps.wants(MapKind::position)) {
+    glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+    for (const glm::vec3& p : s.high_pos) lo = glm::min(lo, glm::dvec3(p)), hi = glm::max(hi, glm::dvec3(p));
+    in.position_lo = lo, in.position_hi = hi;
+  }
+  if (opt.maps.wants(MapKind::object_id)) in.object_colors = id_colors(object_names(high));
+  if (opt.maps.wants(MapKind::material_id)) in.material_colors = id_colors(material_names(high));
   in.ao_distance = opt.maps.ao_distance > 0.0 ? opt.maps.ao_distance : kAutoAoDistance * s.diagonal;
   in.thickness_distance = opt.maps.thickness_distance > 0.0 ? opt.maps.thickness_distance : kAutoThickness * s.diagonal;
   in.epsilon = 1e-5 * s.diagonal;
@@ -236,33 +243,17 @@ std::vector<BakedMap> finish_maps(const BakeOptions& opt, const Prepared& s, con
         m.metadata.push_back({"nmbake:curvature_scale", number(scale)});
         break;
       }
-      case MapKind::position: {
-        glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
-        for (const glm::vec3& p : s.high_pos) lo = glm::min(lo, glm::dvec3(p)), hi = glm::max(hi, glm::dvec3(p));
-        each([&](float* p) {
-          for (int c = 0; c < 3; ++c)
-            p[c] = hi[c] > lo[c] ? float(std::clamp((double(p[c]) - lo[c]) / (hi[c] - lo[c]), 0.0, 1.0)) : 0.5f;
-        });
-        m.box_min = lo + file_origin, m.box_max = hi + file_origin;
+      case MapKind::position:  // encoded by the trace (TexelMaps::write)
+        m.box_min = in.position_lo + file_origin, m.box_max = in.position_hi + file_origin;
         m.metadata.push_back({"nmbake:position_box", number(m.box_min.x) + "," + number(m.box_min.y) + "," + number(m.box_min.z) +
                                                          ":" + number(m.box_max.x) + "," + number(m.box_max.y) + "," +
                                                          number(m.box_max.z)});
         break;
-      }
       case MapKind::object_id:
-      case MapKind::material_id: {
+      case MapKind::material_id: {  // coloured by the trace (TexelMaps::write)
         const std::vector<std::string> names = kind == MapKind::object_id ? object_names(high) : material_names(high);
-        const std::vector<glm::vec3> colors = id_colors(names);
+        const std::vector<glm::vec3>& colors = kind == MapKind::object_id ? in.object_colors : in.material_colors;
         for (std::size_t i = 0; i < names.size(); ++i) m.colors.push_back({names[i], colors[i]});
-        // The index rounded half away from zero (std::lround) without a library call: a float's
-        // d + 0.5 is exact in double, so d + 0.5 < size says lround(d) < size; -1 (a miss), NaN and
-        // indices out of range are black.
-        const double size = double(colors.size());
-        each([&](float* p) {
-          const double d = p[0];
-          const glm::vec3 c = d > -0.5 && d + 0.5 < size ? colors[std::size_t(d + 0.5)] : glm::vec3(0.0f);
-          for (int ch = 0; ch < 3; ++ch) p[ch] = c[ch];
-        });
         break;
       }
       case MapKind::vertex_color:

@@ -17,7 +17,7 @@ namespace nmbake {
 std::vector<float> map_curvature(const BakeOptions& opt, const Mesh& high);
 
 // The inputs of opt.maps's extra maps over the BVH `scene` of the triangles `selection` keeps,
-// with the curvature of map_curvature.
+// with the curvature of map_curvature, the high-poly's bounding box and its names' colours.
 MapInputs make_map_inputs(const BakeOptions& opt, const Prepared& s, const HighScene& scene, const HighSelection& selection,
                           const Mesh& high, std::vector<float> curvature);
 
@@ -32,8 +32,8 @@ MapRanges map_ranges(const BakeOptions& opt, const Prepared& s, const std::vecto
                      const std::vector<const std::vector<std::uint8_t>*>& coverage);
 
 // The encoded maps of `raw` (MapTargets, trace order of opt.maps), their covered texels (`coverage`)
-// only: height and curvature by `ranges`, position by the high-poly's bounding box, the IDs by their
-// names' colours. Not padded: pad_map (pad.h) pads them with the normal map, in one pass.
+// only: height and curvature by `ranges` (position and the IDs come encoded from the trace, by
+// the bounding box and the colours `in` holds). Not padded: pad_map (pad.h) pads them with the normal map, in one pass.
 std::vector<BakedMap> finish_maps(const BakeOptions& opt, const Prepared& s, const Mesh& high, const MapInputs& in,
                                   const MapRanges& ranges, MapTargets& raw, const std::vector<std::uint8_t>& coverage,
                                   int threads);

@@ -495,9 +495,19 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
     }
   }
 
-  // The ID maps: per texel the index most of its hit samples take. Samples grouped by texel, in
-  // sample order (a counting sort, once for both maps); a texel of one sample takes its index.
-  if (m.ids) {
+  // The ID maps: per texel the index most of its hit samples take. A pass of at most one sample a
+  // texel (seen[i] <= 1) takes each sample's index as it is; otherwise the samples are grouped by
+  // texel, in sample order (a counting sort, once for both maps), and a texel of one sample takes
+  // its index.
+  const bool single = m.ids && std::all_of(m.seen.begin(), m.seen.end(), [](std::uint32_t c) { return c <= 1; });
+  if (single)
+    for (int which = 0; which < 2; ++which) {
+      const Slot slot = which == 0 ? s_object_id : s_material_id;
+      if (!m.has(slot)) continue;
+      const std::vector<std::int64_t>& id = which == 0 ? m.object_id : m.material_id;
+      for (std::size_t r = 0; r < n; ++r) *m.at(smp.texel[r], slot) = id[r] >= 0 ? double(id[r]) : -1.0;
+    }
+  if (m.ids && !single) {
     std::vector<std::uint32_t>&start = m.start, &order = m.order, &fill = m.fill;
     start.assign(m.texels + 1, 0);
     order.resize(n);
@@ -527,59 +537,94 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
 
 void TexelMaps::write(MapTargets& out, int x0, int y0, int w, int h, int side, int width) const {
   const Impl& m = *impl_;
-  const MapOptions& maps = *m.in.maps;
-  const bool flip_y = m.in.space == NormalSpace::tangent && m.in.green_down;
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const std::size_t i = std::size_t(y) * std::size_t(side) + std::size_t(x);
-      const double samples = *m.at(i, s_samples);
-      if (samples <= 0.0) continue;
-      const double hits = *m.at(i, s_hits);
-      const std::size_t g = std::size_t(y0 + y) * std::size_t(width) + std::size_t(x0 + x);
-      for (std::size_t k = 0; k < maps.maps.size(); ++k) {
-        const MapKind kind = maps.maps[k];
-        if (kind == MapKind::normal) continue;
-        const Slot slot = slot_of(kind);
-        if (slot == kSlots) continue;
-        Image& img = out.raw[k];
-        float* px = &img.pixels[g * std::size_t(img.channels)];
-        const double* v = m.at(i, slot);
-        switch (kind) {
-          case MapKind::object_normal:
-          case MapKind::bent_normal: {
-            const double len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-            glm::dvec3 n = len > 0.0 ? glm::dvec3(v[0], v[1], v[2]) / len : glm::dvec3(0, 0, 1);
-            if (kind == MapKind::bent_normal && flip_y) n.y = -n.y;
-            for (int c = 0; c < 3; ++c) px[c] = float(n[c]);
-            break;
-          }
-          case MapKind::height:
-          case MapKind::curvature: px[0] = float(hits > 0.0 ? v[0] / hits : 0.0); break;
-          case MapKind::position: {
-            const double* miss = m.at(i, s_miss_position);
-            for (int c = 0; c < 3; ++c) px[c] = float(hits > 0.0 ? v[c] / hits : miss[c] / samples);
-            break;
-          }
-          case MapKind::vertex_color:
-            for (int c = 0; c < 3; ++c) px[c] = float(hits > 0.0 ? v[c] / hits : 0.0);
-            break;
-          case MapKind::ao:
-          case MapKind::thickness: {
-            const double rays = v[1];
-            px[0] = float(rays > 0.0 ? v[0] / rays : kind == MapKind::ao ? kMissAo : kMissThickness);
-            (kind == MapKind::ao ? out.ao_error : out.thickness_error).pixels[g] = float(chain_standard_error(v + 2));
-            break;
-          }
-          case MapKind::object_id:
-          case MapKind::material_id:
-            for (int c = 0; c < 3; ++c) px[c] = float(v[0]);
-            break;
-          default: break;
-        }
-      }
-      if (!out.ao_rays.pixels.empty()) out.ao_rays.pixels[g] = float(m.at(i, s_ao)[1]);
-      if (!out.thickness_rays.pixels.empty()) out.thickness_rays.pixels[g] = float(m.at(i, s_thickness)[1]);
+  const MapInputs& in = m.in;
+  const MapOptions& maps = *in.maps;
+  const bool flip_y = in.space == NormalSpace::tangent && in.green_down;
+  // f(tile texel, map texel) for each of the tile's texels that have samples, a map at a time.
+  const auto each = [&](auto&& f) {
+    for (int y = 0; y < h; ++y) {
+      const std::size_t row = std::size_t(y) * std::size_t(side), g = std::size_t(y0 + y) * std::size_t(width) + std::size_t(x0);
+      for (int x = 0; x < w; ++x)
+        if (*m.at(row + std::size_t(x), s_samples) > 0.0) f(row + std::size_t(x), g + std::size_t(x));
     }
+  };
+  for (std::size_t k = 0; k < maps.maps.size(); ++k) {
+    const MapKind kind = maps.maps[k];
+    const Slot slot = slot_of(kind);
+    if (slot == kSlots) continue;
+    Image& img = out.raw[k];
+    float* const pixels = img.pixels.data();
+    const std::size_t channels = std::size_t(img.channels);
+    switch (kind) {
+      case MapKind::object_normal:
+      case MapKind::bent_normal:
+        each([&](std::size_t i, std::size_t g) {
+          const double* v = m.at(i, slot);
+          const double len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+          glm::dvec3 n = len > 0.0 ? glm::dvec3(v[0], v[1], v[2]) / len : glm::dvec3(0, 0, 1);
+          if (kind == MapKind::bent_normal && flip_y) n.y = -n.y;
+          for (int c = 0; c < 3; ++c) pixels[3 * g + std::size_t(c)] = float(n[c]);
+        });
+        break;
+      case MapKind::height:
+      case MapKind::curvature:
+        each([&](std::size_t i, std::size_t g) {
+          const double hits = *m.at(i, s_hits);
+          pixels[g] = float(hits > 0.0 ? *m.at(i, slot) / hits : 0.0);
+        });
+        break;
+      case MapKind::position: {
+        // The mean as a float, then to the box as finish_maps would (the same two roundings).
+        const glm::dvec3 lo = in.position_lo, hi = in.position_hi;
+        each([&](std::size_t i, std::size_t g) {
+          const double *v = m.at(i, slot), *miss = m.at(i, s_miss_position);
+          const double hits = *m.at(i, s_hits), samples = *m.at(i, s_samples);
+          for (int c = 0; c < 3; ++c) {
+            const float p = float(hits > 0.0 ? v[c] / hits : miss[c] / samples);
+            pixels[3 * g + std::size_t(c)] =
+                hi[c] > lo[c] ? float(std::clamp((double(p) - lo[c]) / (hi[c] - lo[c]), 0.0, 1.0)) : 0.5f;
+          }
+        });
+        break;
+      }
+      case MapKind::vertex_color:
+        each([&](std::size_t i, std::size_t g) {
+          const double* v = m.at(i, slot);
+          const double hits = *m.at(i, s_hits);
+          for (int c = 0; c < 3; ++c) pixels[3 * g + std::size_t(c)] = float(hits > 0.0 ? v[c] / hits : 0.0);
+        });
+        break;
+      case MapKind::ao:
+      case MapKind::thickness: {
+        Image& error = kind == MapKind::ao ? out.ao_error : out.thickness_error;
+        each([&](std::size_t i, std::size_t g) {
+          const double* v = m.at(i, slot);
+          const double rays = v[1];
+          pixels[g] = float(rays > 0.0 ? v[0] / rays : kind == MapKind::ao ? kMissAo : kMissThickness);
+          error.pixels[g] = float(chain_standard_error(v + 2));
+        });
+        break;
+      }
+      case MapKind::object_id:
+      case MapKind::material_id: {
+        // The index (as the float it was kept as) rounded half away from zero (std::lround) without
+        // a library call: a float's d + 0.5 is exact in double, so d + 0.5 < size says lround(d) <
+        // size; -1 (a miss), NaN and indices out of range are black.
+        const std::vector<glm::vec3>& colors = kind == MapKind::object_id ? in.object_colors : in.material_colors;
+        const double size = double(colors.size());
+        each([&](std::size_t i, std::size_t g) {
+          const double d = double(float(*m.at(i, slot)));
+          const glm::vec3 c = d > -0.5 && d + 0.5 < size ? colors[std::size_t(d + 0.5)] : glm::vec3(0.0f);
+          for (int ch = 0; ch < 3; ++ch) pixels[channels * g + std::size_t(ch)] = c[ch];
+        });
+        break;
+      }
+      default: break;
+    }
+  }
+  if (!out.ao_rays.pixels.empty()) each([&](std::size_t i, std::size_t g) { out.ao_rays.pixels[g] = float(m.at(i, s_ao)[1]); });
+  if (!out.thickness_rays.pixels.empty())
+    each([&](std::size_t i, std::size_t g) { out.thickness_rays.pixels[g] = float(m.at(i, s_thickness)[1]); });
 }
 
 }  // namespace nmbake

@@ -44,6 +44,11 @@ struct MapInputs {
   // With match groups: per low-poly triangle its group and per BVH triangle its group (RayGroups);
   // secondary rays then see only their group (unless MapOptions::ao_occluders_all).
   const RayGroups* groups = nullptr;
+  // The encodings known before the trace, which TexelMaps::write applies itself: position, the
+  // high-poly's bounding box (re-centred scene coordinates) to [0, 1]; the ID maps, per index its
+  // colour (map_set.h id_colors).
+  glm::dvec3 position_lo{0.0}, position_hi{0.0};
+  std::vector<glm::vec3> object_colors, material_colors;
 };
 
 // The raw values the trace writes for each extra map, per texel of the whole map (covered texels
@@ -51,8 +56,12 @@ struct MapInputs {
 //   object-normal, bent-normal: unit vector (x, y, z), the output space's (tangent or object);
 //   ao: unoccluded share; thickness: mean of min(distance, D) / D;
 //   height: mean signed distance (scene units); curvature: mean curvature (1 / scene units);
-//   position: mean hit (re-centred scene coordinates); vertex-color: mean RGB;
-//   object-id, material-id: the index taken (as a float), -1 for a texel whose samples all miss.
+//   vertex-color: mean RGB;
+// and already encoded, as finish_maps leaves them:
+//   position: mean hit (re-centred scene coordinates) over MapInputs::position_lo..hi, each axis
+//     clamped to [0, 1] (0.5 on a flat axis);
+//   object-id, material-id: the colour of the index taken (MapInputs::*_colors), black for a texel
+//     whose samples all miss or an index without a colour.
 // A texel whose samples all miss gets the map's miss value (texel_maps.cpp, kMiss*).
 struct MapTargets {
   std::vector<Image> raw;  // per MapOptions::maps entry; empty for normal
