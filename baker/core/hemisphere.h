@@ -143,28 +143,38 @@ inline std::uint32_t sobol_second(std::uint32_t index) {
   return x;
 }
 
+// An axis's seed with the hash of the interval of depth 0 (the whole [0, 1)), which every value
+// of the axis reads: made once for many values (owen_scramble's first hash, skipped).
+struct OwenSeed {
+  std::uint64_t seed = 0, top = 0;
+};
+inline OwenSeed owen_seed(std::uint64_t seed) { return {seed, mix64(seed ^ 0x9e3779b97f4a7c15ull)}; }
+
+// The six flips of a block of depths: bit t (from the top) is the bit of h at the heap index of
+// the interval at depth t the six bits `below` lead to (2^t plus their top t bits).
+inline std::uint32_t owen_flips(std::uint64_t h, std::uint32_t below) {
+  std::uint32_t flips = 0;
+  for (int t = 0; t < 6; ++t) flips = flips << 1 | std::uint32_t((h >> ((1u << t) | (below >> (6 - t)))) & 1u);
+  return flips;
+}
+
 // The nested uniform scramble of a 32-bit fixed-point value in [0, 1), to a double in [0, 1). Each
 // interval of the subdivision (to kOwenDepth) swaps its halves or not by one bit of a hash: one
 // 64-bit hash per interval at depths 0 and 6 gives the 63 bits of the intervals of the six depths
-// from it (1 + 2 + ... + 32), so a value costs three hashes (the third for the bits below), not 13.
-inline double owen_scramble(std::uint32_t x, std::uint64_t seed) {
+// from it (1 + 2 + ... + 32), so a value costs three hashes (the third for the bits below), not 13, or two with the
+// depth-0 hash made once (OwenSeed).
+inline double owen_scramble(std::uint32_t x, const OwenSeed& s) {
   static_assert(kOwenDepth == 12, "two blocks of six depths");
-  std::uint32_t out = x;
-  for (int d = 0; d < kOwenDepth; d += 6) {
-    // The interval of depth d holding x: its top d bits, tagged by a leading 1 (a heap index).
-    const std::uint64_t node = (std::uint64_t(1) << d) | (d ? std::uint64_t(x >> (32 - d)) : 0u);
-    const std::uint64_t h = mix64(seed ^ (node * 0x9e3779b97f4a7c15ull));
-    // The next six bits of x pick the intervals at depths d .. d + 5 below it (bit 2^t + their top
-    // t bits of h); no branches: the swaps are coin flips, which a branch predictor would miss.
-    const std::uint32_t below = (x << d) >> 26;
-    std::uint32_t flips = 0;
-    for (int t = 0; t < 6; ++t) flips = flips << 1 | std::uint32_t((h >> ((1u << t) | (below >> (6 - t)))) & 1u);
-    out ^= flips << (26 - d);
-  }
+  // Depths 0 .. 5: the interval of depth 0 is the same for every x (OwenSeed::top). Depths 6 ..
+  // 11: the interval of depth 6 holding x, its top 6 bits tagged by a leading 1 (a heap index).
+  std::uint32_t out = x ^ (owen_flips(s.top, x >> 26) << 26);
+  const std::uint64_t node = (std::uint64_t(1) << 6) | std::uint64_t(x >> 26);
+  out ^= owen_flips(mix64(s.seed ^ (node * 0x9e3779b97f4a7c15ull)), (x << 6) >> 26) << 20;
   const std::uint64_t low =
-      mix64(seed ^ (std::uint64_t(x) * 0xd1b54a32d192ed03ull) ^ 0x5851f42d4c957f2dull) >> (64 - (53 - kOwenDepth));
+      mix64(s.seed ^ (std::uint64_t(x) * 0xd1b54a32d192ed03ull) ^ 0x5851f42d4c957f2dull) >> (64 - (53 - kOwenDepth));
   return double((std::uint64_t(out >> (32 - kOwenDepth)) << (53 - kOwenDepth)) | low) * 0x1.0p-53;
 }
+inline double owen_scramble(std::uint32_t x, std::uint64_t seed) { return owen_scramble(x, owen_seed(seed)); }
 
 // Point `index` of the first two dimensions of Sobol's sequence (the (0, 2)-sequence in base 2:
 // van der Corput's radical inverse, and the dimension whose generator is Pascal's triangle mod 2),
@@ -181,8 +191,11 @@ inline void scramble_seeds(std::uint64_t seed, std::uint64_t& seed_x, std::uint6
   seed_x = mix64(seed ^ 0x243f6a8885a308d3ull);
   seed_y = mix64(seed ^ 0x13198a2e03707344ull);
 }
-inline glm::dvec2 scrambled_sobol2(std::uint32_t index, std::uint64_t seed_x, std::uint64_t seed_y) {
+inline glm::dvec2 scrambled_sobol2(std::uint32_t index, const OwenSeed& seed_x, const OwenSeed& seed_y) {
   return glm::dvec2(owen_scramble(sobol_radical_inverse(index), seed_x), owen_scramble(sobol_second(index), seed_y));
+}
+inline glm::dvec2 scrambled_sobol2(std::uint32_t index, std::uint64_t seed_x, std::uint64_t seed_y) {
+  return scrambled_sobol2(index, owen_seed(seed_x), owen_seed(seed_y));
 }
 inline glm::dvec2 scrambled_sobol2(std::uint32_t index, std::uint64_t seed) {
   std::uint64_t sx, sy;

@@ -27,6 +27,7 @@ constexpr std::size_t kAhead = 8;        // samples ahead whose hit data is fetc
 // low by chance (measured on the accuracy bench: the noise 1.3 to 1.45 times the reported standard
 // error with 4 chains, 1.1 to 1.2 with 8).
 constexpr int kFixedChains = 4, kAutoChains = 8, kMaxChains = 8;
+static_assert(kFixedChains == 4 && kAutoChains == 8, "queue_rays deals a texel's rays to its chains by mask and shift");
 // --ao-rays auto: the first round's rays per texel (4 per chain), and the rate at which a texel's
 // stratified error falls with its rays n (about n^-0.7 on the accuracy bench's sculpts, 64 to 1024
 // rays): a later round adds the rays that would bring the texel's error to E at that rate, at
@@ -155,8 +156,8 @@ struct TexelMaps::Impl {
   std::vector<SampleStream> stream[2];
   const std::uint16_t* sample_texel = nullptr;  // the pass's samples' tile texels
   // Per tile texel and kind: its chains' seeds (kMaxChains pairs: the two axes') and the rays it
-  // has numbered; the chains a texel's rays are dealt to (kFixedChains or kAutoChains).
-  std::vector<std::uint64_t> texel_seed[2];
+  // has numbered; the chains a texel's rays are dealt to (kFixedChains or kAutoChains, powers of 2).
+  std::vector<OwenSeed> texel_seed[2];
   std::vector<std::uint32_t> texel_next[2];
   int chains = kFixedChains;
   // --ao-rays auto, per tile texel: its hit samples, rays, chains' sums (kMaxChains pairs, as
@@ -207,28 +208,39 @@ struct TexelMaps::Impl {
     const bool thick = k == 1;
     RayQueue& q = queue[k];
     const glm::dvec3 axis = thick ? -hit_normal[r] : hit_normal[r];
-    const glm::dvec3 org = hit_point[r] + (thick ? -in.epsilon : in.epsilon) * hit_face[r];
+    const glm::vec3 org(hit_point[r] + (thick ? -in.epsilon : in.epsilon) * hit_face[r]);
+    const float tfar = float(thick ? in.thickness_distance : in.ao_distance);
     glm::dvec3 bt, bb, bn;  // the basis about the axis, once for the sample's rays
     orthonormal_basis(axis, bt, bb, bn);
     const std::size_t i = sample_texel[r];
     std::uint32_t& next = texel_next[k][i];
-    for (std::size_t j = 0; j < count; ++j, ++next) {
-      const std::uint32_t chain = next % chains;
-      const std::uint64_t* seed = &texel_seed[k][(i * kMaxChains + chain) * 2];
-      const glm::dvec2 u =
-          in.maps->ao_independent_rays ? stream[k][r].next2() : scrambled_sobol2(next / chains, seed[0], seed[1]);
-      const glm::dvec3 d = cosine_direction(bt, bb, bn, u.x, u.y);
-      raycast::Ray ray;
-      ray.origin = glm::vec3(org);
-      ray.direction = glm::vec3(d);
-      ray.tnear = 0.0f;
-      ray.tfar = float(thick ? in.thickness_distance : in.ao_distance);
-      q.rays.set(q.n, ray);
-      q.sample[q.n] = std::uint32_t(r);
-      q.chain[q.n] = std::uint8_t(chain);
-      ++chain_rays[k][r * kMaxChains + chain];
-      if (!q.group.empty()) q.group[q.n] = ray_group[r];
-      if (++q.n == kRayBatch) flush(k);
+    const std::uint32_t chain_mask = std::uint32_t(chains - 1);
+    const int chain_shift = chains == 8 ? 3 : 2;
+    const OwenSeed* seeds = &texel_seed[k][i * kMaxChains * 2];
+    std::uint32_t* sample_chain_rays = &chain_rays[k][r * kMaxChains];
+    // In runs of up to kGenerate rays: their points first, then their directions, each loop short
+    // and free of calls, so that the processor overlaps the rays' long chains of arithmetic.
+    constexpr std::size_t kGenerate = 64;
+    glm::dvec2 u[kGenerate];
+    for (std::size_t done = 0; done < count;) {
+      const std::size_t m = std::min(kGenerate, count - done);
+      for (std::size_t j = 0; j < m; ++j) {
+        const std::uint32_t n = next + std::uint32_t(j), chain = n & chain_mask;
+        u[j] = in.maps->ao_independent_rays ? stream[k][r].next2()
+                                            : scrambled_sobol2(n >> chain_shift, seeds[2 * chain], seeds[2 * chain + 1]);
+      }
+      for (std::size_t j = 0; j < m; ++j) {
+        const std::uint32_t chain = (next + std::uint32_t(j)) & chain_mask;
+        const glm::vec3 d(cosine_direction(bt, bb, bn, u[j].x, u[j].y));
+        q.rays.set(q.n, raycast::Ray{org, 0.0f, d, tfar});
+        q.sample[q.n] = std::uint32_t(r);
+        q.chain[q.n] = std::uint8_t(chain);
+        ++sample_chain_rays[chain];
+        if (!q.group.empty()) q.group[q.n] = ray_group[r];
+        if (++q.n == kRayBatch) flush(k);
+      }
+      next += std::uint32_t(m);
+      done += m;
     }
     rays_cast[k][r] += std::uint32_t(count);
   }
@@ -447,8 +459,10 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
       if (m.texel_next[kind][i] == 0) {
         const std::uint64_t key = sample_key(texel, (std::uint64_t(level) << 32) | 0xffffffffu, map_key);
         for (int c = 0; c < m.chains; ++c) {
-          std::uint64_t* seed = &m.texel_seed[kind][(i * kMaxChains + std::size_t(c)) * 2];
-          scramble_seeds(key + std::uint64_t(c) * 0x9e3779b97f4a7c15ull, seed[0], seed[1]);
+          std::uint64_t sx, sy;
+          scramble_seeds(key + std::uint64_t(c) * 0x9e3779b97f4a7c15ull, sx, sy);
+          m.texel_seed[kind][(i * kMaxChains + std::size_t(c)) * 2] = owen_seed(sx);
+          m.texel_seed[kind][(i * kMaxChains + std::size_t(c)) * 2 + 1] = owen_seed(sy);
         }
       }
       m.queue_rays(kind, r, per_sample);
