@@ -477,57 +477,61 @@ void Scene::intersect(const RayBatch& rays, const HitBatch& hits, std::size_t co
   }
 }
 
+namespace {
+
+// Ray i of `rays` as entry k of a stream block (its id k: its index for the group filter).
+void set_stream_ray(RTCRay& r, const RayBatch& rays, std::size_t i, std::size_t k) {
+  r.org_x = rays.org_x[i], r.org_y = rays.org_y[i], r.org_z = rays.org_z[i], r.tnear = rays.tnear[i];
+  r.dir_x = rays.dir_x[i], r.dir_y = rays.dir_y[i], r.dir_z = rays.dir_z[i], r.time = 0.0f;
+  r.tfar = rays.tfar[i], r.mask = 0xffffffffu, r.id = unsigned(k), r.flags = 0;
+}
+
+// The secondary rays (after building their BVH, the first time) in blocks of `block`: trace(base,
+// n, context) for rays base .. base + n - 1, the context's group filter on their groups.
+template <typename Trace>
+void in_blocks(const Scene& scene, const RayBatch& rays, std::size_t count, std::size_t block, const SecondaryRayOptions& options,
+               Trace&& trace) {
+  if (count == 0) return;
+  scene.prepare_secondary_rays();
+  GroupContext gc(options.group);
+  gc.context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+  for (std::size_t base = 0; base < count; base += block) {
+    gc.ray_group = rays.group ? rays.group + base : nullptr;
+    trace(base, std::min(block, count - base), gc.context);
+  }
+}
+
+}  // namespace
+
 void Scene::occluded(const RayBatch& rays, std::uint8_t* occluded, std::size_t count, const SecondaryRayOptions& options) const {
   // On the secondary rays' scene, as incoherent streams of RTCRay structs (rtcOccluded1M) in
   // blocks: Embree sorts a block's rays by the octant of their direction and traces each octant's
   // rays together, which on AO's rays beat every other entry point (bench_occlusion --variants,
   // suz_L4 x4, one core: on the fast scene 1.06 times rtcOccludedNp's rays per second and 2 times
   // rtcOccluded1's; packets of 8 or 16, coherent or not, octant-sorted or not, were slower still).
-  if (count == 0) return;
-  prepare_secondary_rays();
   constexpr std::size_t kBlock = 1024;
   alignas(64) RTCRay block[kBlock];
-  GroupContext gc(options.group);
-  gc.context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
   constexpr float minus_inf = -std::numeric_limits<float>::infinity();
-  for (std::size_t base = 0; base < count; base += kBlock) {
-    const std::size_t n = std::min(kBlock, count - base);
-    for (std::size_t k = 0; k < n; ++k) {
-      RTCRay& r = block[k];
-      const std::size_t i = base + k;
-      r.org_x = rays.org_x[i], r.org_y = rays.org_y[i], r.org_z = rays.org_z[i], r.tnear = rays.tnear[i];
-      r.dir_x = rays.dir_x[i], r.dir_y = rays.dir_y[i], r.dir_z = rays.dir_z[i], r.time = 0.0f;
-      r.tfar = rays.tfar[i], r.mask = 0xffffffffu, r.id = unsigned(k), r.flags = 0;  // id: the ray's index for the group filter
-    }
-    gc.ray_group = rays.group ? rays.group + base : nullptr;
-    rtcOccluded1M(impl_->secondary, &gc.context, block, unsigned(n), sizeof(RTCRay));
+  in_blocks(*this, rays, count, kBlock, options, [&](std::size_t base, std::size_t n, RTCIntersectContext& context) {
+    for (std::size_t k = 0; k < n; ++k) set_stream_ray(block[k], rays, base + k, k);
+    rtcOccluded1M(impl_->secondary, &context, block, unsigned(n), sizeof(RTCRay));
     // Embree sets tfar to -inf when occluded; a ray it skips (tnear > tfar) keeps its own.
     for (std::size_t k = 0; k < n; ++k) occluded[base + k] = block[k].tfar == minus_inf && rays.tfar[base + k] != minus_inf;
-  }
+  });
 }
 
 void Scene::first_hits(const RayBatch& rays, const HitBatch& hits, std::size_t count, const SecondaryRayOptions& options) const {
   // As occluded: the secondary rays' scene, incoherent streams of RTCRayHit structs in blocks.
-  if (count == 0) return;
-  prepare_secondary_rays();
   constexpr std::size_t kBlock = 512;
   alignas(64) RTCRayHit block[kBlock];
-  GroupContext gc(options.group);
-  gc.context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
-  for (std::size_t base = 0; base < count; base += kBlock) {
-    const std::size_t n = std::min(kBlock, count - base);
+  in_blocks(*this, rays, count, kBlock, options, [&](std::size_t base, std::size_t n, RTCIntersectContext& context) {
     for (std::size_t k = 0; k < n; ++k) {
-      RTCRay& r = block[k].ray;
-      const std::size_t i = base + k;
-      r.org_x = rays.org_x[i], r.org_y = rays.org_y[i], r.org_z = rays.org_z[i], r.tnear = rays.tnear[i];
-      r.dir_x = rays.dir_x[i], r.dir_y = rays.dir_y[i], r.dir_z = rays.dir_z[i], r.time = 0.0f;
-      r.tfar = rays.tfar[i], r.mask = 0xffffffffu, r.id = unsigned(k), r.flags = 0;
+      set_stream_ray(block[k].ray, rays, base + k, k);
       block[k].hit.geomID = RTC_INVALID_GEOMETRY_ID;
       block[k].hit.primID = RTC_INVALID_GEOMETRY_ID;
       block[k].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     }
-    gc.ray_group = rays.group ? rays.group + base : nullptr;
-    rtcIntersect1M(impl_->secondary, &gc.context, block, unsigned(n), sizeof(RTCRayHit));
+    rtcIntersect1M(impl_->secondary, &context, block, unsigned(n), sizeof(RTCRayHit));
     for (std::size_t k = 0; k < n; ++k) {
       const RTCRayHit& rh = block[k];
       const std::size_t i = base + k;
@@ -538,7 +542,7 @@ void Scene::first_hits(const RayBatch& rays, const HitBatch& hits, std::size_t c
       hits.v[i] = rh.hit.v;
       if (hits.flags) hits.flags[i] = 0;
     }
-  }
+  });
 }
 
 }  // namespace nmbake::raycast
