@@ -18,20 +18,16 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
-#include "compare.h"
 #include "core/image.h"
 #include "gl_context.h"
 #include "io/image_io.h"
 #include "io/mesh_io.h"
-#include "scene.h"
 #include "scene_maker.h"
-#include "texture_set.h"
 #include "tool_run.h"
 #include "test_support.h"
 #include "build_paths.h"
@@ -210,31 +206,23 @@ TEST(NmviewSelfCheck, TorusLowBakedFromItself) {
 
 // The interior figures of `map` on LOW/HIGH with the map and without, as `nmview LOW MAP HIGH
 // --compare --size 800x400 [--no-map]` prints them (psnr, rmse, within2 of its last line), measured
-// in this process by the viewer's own code (scene.h, compare.h): the scene loaded once for both, and
-// without the angle passes, which these figures do not need. NmviewDecoding and the verdict tests
-// run the binary's --compare.
+// in this process (tool_run.h compare_interior: the scene loaded once for both). NmviewDecoding and
+// the verdict tests run the binary's --compare.
 struct MapOnOff {
   Summary on, off;
 };
 
 MapOnOff compare_map_on_off(const std::string& low, const std::string& map, const std::string& high) {
-  unsetenv("DISPLAY");
-  unsetenv("WAYLAND_DISPLAY");
-  setenv("LIBGL_ALWAYS_SOFTWARE", "1", 1);
+  nmview::test::make_headless();
   const nmview::HeadlessContext context;
-  std::ostringstream log;
-  const nmview::Scene scene = nmview::load_scene(low, nmview::find_texture_set(map), high, log);
-  nmview::Renderer renderer(scene.low, scene.high, scene.map, scene.radius, scene.decoding);
+  const std::vector<nmview::ErrorSums> sums = nmview::test::compare_interior(low, map, high, 400, 400, {true, false});
   MapOnOff figures;
   for (const bool map_on : {true, false}) {
-    nmview::Toggles measure;
-    measure.map = map_on;
-    const nmview::CompareResult result =
-        nmview::run_compare(renderer, 400, 400, nmview::Light{}, measure, nmview::CompareScope::shading);
+    const nmview::ErrorSums& e = sums[map_on ? 0 : 1];
     Summary& s = map_on ? figures.on : figures.off;
-    s.psnr = result.total.interior.psnr();
-    s.rmse = result.total.interior.rmse();
-    s.within2 = result.total.interior.within2();
+    s.psnr = e.psnr();
+    s.rmse = e.rmse();
+    s.within2 = e.within2();
   }
   return figures;
 }

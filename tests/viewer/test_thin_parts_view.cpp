@@ -4,17 +4,15 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
-#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
 
-#include "compare.h"
 #include "gl_context.h"
 #include "io/mesh_io.h"
-#include "scene.h"
 #include "test_support.h"
 #include "thin_parts.h"
+#include "tool_run.h"
 
 namespace {
 
@@ -27,25 +25,17 @@ constexpr double kSweep[] = {0.01, 0.015, 0.02, 0.03, 0.05};
 constexpr double kMarginDb = 0.2;
 
 // The interior PSNR of `map` as `nmview LOW MAP HIGH --compare --size 300x300` measures it (its
-// last line's psnr=), run in this process: the scene loaded and compared by the viewer's own code
-// (scene.h, compare.h) in the test's one headless context, without a process start per map, and
-// without the angle passes, which the PSNR does not need.
+// last line's psnr=), run in this process (tool_run.h compare_interior) in the test's one headless
+// context, without a process start per map.
 double compare_psnr(const std::string& dir, const std::string& name, const std::string& map) {
-  std::ostringstream log;
-  const nmview::Scene scene = nmview::load_scene(dir + "/" + name + "_low.obj", nmview::find_texture_set(dir + "/" + map),
-                                                 dir + "/" + name + "_high.obj", log);
-  nmview::Renderer renderer(scene.low, scene.high, scene.map, scene.radius, scene.decoding);
-  nmview::Toggles measure;
-  measure.map = true;
-  const nmview::CompareResult result =
-      nmview::run_compare(renderer, 150, 300, nmview::Light{}, measure, nmview::CompareScope::shading);
-  return result.total.interior.psnr();
+  return nmview::test::compare_interior(dir + "/" + name + "_low.obj", dir + "/" + map, dir + "/" + name + "_high.obj", 150, 300,
+                                        {true})
+      .at(0)
+      .psnr();
 }
 
 TEST(ThinPartsView, AutomaticCageRendersNoWorseThanTheBestFixedDistance) {
-  unsetenv("DISPLAY");
-  unsetenv("WAYLAND_DISPLAY");
-  setenv("LIBGL_ALWAYS_SOFTWARE", "1", 1);
+  nmview::test::make_headless();
   const nmview::HeadlessContext context;
   const std::string dir = nmbake::test::scratch_dir();
   for (const nmbake::procedural::ThinPartsSpec& spec : nmbake::procedural::thin_parts_family()) {
