@@ -303,12 +303,14 @@ struct TexelMaps::Impl {
       raycast::SecondaryRayOptions so;
       so.group = groups;
       in.scene->scene->occluded(batch, q.occluded.data(), q.n, so);
-      for (std::size_t i = 0; i < q.n; ++i) {
-        if (q.occluded[i]) continue;
-        const std::size_t r = q.sample[i];
-        chain_sum[0][r * kMaxChains + q.chain[i]] += 1.0;
-        bent_sum[r] += glm::dvec3(q.rays.direction(0)[i], q.rays.direction(1)[i], q.rays.direction(2)[i]);
-      }
+      // Without a branch on the verdict, which a processor cannot predict (adding 0 leaves a sum's
+      // bits as they are); the open directions only for a bent-normal map.
+      for (std::size_t i = 0; i < q.n; ++i)
+        chain_sum[0][std::size_t(q.sample[i]) * kMaxChains + q.chain[i]] += q.occluded[i] ? 0.0 : 1.0;
+      if (has(s_bent))
+        for (std::size_t i = 0; i < q.n; ++i)
+          if (!q.occluded[i])
+            bent_sum[q.sample[i]] += glm::dvec3(q.rays.direction(0)[i], q.rays.direction(1)[i], q.rays.direction(2)[i]);
     } else {
       raycast::SecondaryRayOptions so;
       so.group = groups;
