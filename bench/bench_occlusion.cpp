@@ -304,7 +304,8 @@ double run_lane(const Lane& lane, const Rays& r, std::uint8_t* out, int threads,
 
 // Thickness's rays (inverted normals, from just under the surface): the first hit's distance by
 // rtcIntersect1 per ray (default scene), by Scene::intersect without a rule, under a rule that
-// keeps back faces (skip_backfaces = false) and under that rule with groups (all 0). Distances
+// keeps back faces (skip_backfaces = false) and under that rule with groups (all 0), and by
+// Scene::first_hits (the bake's), without and with groups. Distances
 // compared to the bare loop's within 1e-5 (relative): the default scene rounds differently from
 // the robust one.
 void thickness(const Mesh& high, const Args& args, RTCScene bare, const raycast::Scene& scene, std::size_t chunk) {
@@ -349,6 +350,18 @@ void thickness(const Mesh& high, const Args& args, RTCScene bare, const raycast:
   rows.push_back({"Scene::intersect, no rule", with(nullptr, false), 1e30, {}});
   rows.push_back({"Scene::intersect, HitRule{skip_backfaces = false}", with(&keep, false), 1e30, {}});
   rows.push_back({"Scene::intersect, that rule with groups (all 0)", with(&grouped, true), 1e30, {}});
+  // What the bake casts (texel_maps.cpp): first_hits in the secondary rays' BVH.
+  auto fast = [&](bool groups) -> Cast {
+    return [&, groups](std::size_t first, std::size_t n) {
+      raycast::RayBatch b = r.batch(first);
+      if (groups) b.group = ray_group.data() + first;
+      raycast::SecondaryRayOptions o;
+      o.group = groups ? tri_group.data() : nullptr;
+      scene.first_hits(b, {tri.data() + first, t.data() + first, u.data() + first, v.data() + first}, n, o);
+    };
+  };
+  rows.push_back({"Scene::first_hits (the bake's)", fast(false), 1e30, {}});
+  rows.push_back({"Scene::first_hits, groups (all 0)", fast(true), 1e30, {}});
   for (int round = 0; round < args.rounds; ++round)
     for (Row& row : rows) {
       std::atomic<std::size_t> next{0};
