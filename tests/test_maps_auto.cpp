@@ -7,8 +7,11 @@
 
 #include <array>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "pipeline/bake.h"
+#include "pipeline/texel_maps.h"
 #include "maps_test_helpers.h"
 #include "test_support.h"
 
@@ -174,3 +177,26 @@ TEST(MapsBentNormal, OnOpenGroundIsTheNormal) {
 
 }  // namespace
 }  // namespace nmbake
+
+// The memory check counts auto's per-texel ray counts: one float per texel for AO's rays (ao or
+// bent-normal) and one for thickness's, the images allocate_map_targets makes.
+TEST(MapsAoAuto, MemoryEstimateCountsTheRaysPerTexel) {
+  BakeOptions o;
+  o.width = 64;
+  o.height = 32;
+  const std::uint64_t texels = 64 * 32;
+  const std::pair<std::vector<MapKind>, std::uint64_t> cases[] = {{{MapKind::normal, MapKind::ao}, 1},
+                                                                  {{MapKind::normal, MapKind::bent_normal}, 1},
+                                                                  {{MapKind::normal, MapKind::ao, MapKind::thickness}, 2},
+                                                                  {{MapKind::normal, MapKind::thickness}, 1},
+                                                                  {{MapKind::normal, MapKind::height}, 0}};
+  for (const auto& [maps, ray_images] : cases) {
+    o.maps.maps = maps;
+    o.maps.ao_rays_auto = false;
+    const std::uint64_t fixed = estimate_bake_bytes(o);
+    o.maps.ao_rays_auto = true;
+    const MapTargets targets = allocate_map_targets(o.maps, o.width, o.height);
+    EXPECT_EQ(targets.ao_rays.pixels.size() + targets.thickness_rays.pixels.size(), ray_images * texels) << maps.size();
+    EXPECT_EQ(estimate_bake_bytes(o) - fixed, 4 * ray_images * texels) << maps.size();
+  }
+}
