@@ -210,6 +210,29 @@ TEST(Hemisphere, SinCosQuarterIsWithinAnUlpAndTheDiskMatchesTheLibrarys) {
   EXPECT_EQ(concentric_disk(0.5, 0.5), glm::dvec2(0.0));
 }
 
+// The four-at-a-time directions have the one-at-a-time bits: random points, the disk's centre, the
+// diagonals where the quarters meet (|a| = |b|), the square's edges, and a count that leaves a tail.
+TEST(Hemisphere, CosineDirectionsManyAtOnceHaveTheBitsOfOneAtATime) {
+  SampleStream r(99);
+  std::vector<double> u1, u2;
+  for (int i = 0; i < 4000; ++i) u1.push_back(r.next()), u2.push_back(r.next());
+  for (const double e : {0.0, 0.25, 0.5, 0.75, 0.999999}) {
+    for (const double f : {0.0, 0.25, 0.5, 0.75, 0.999999}) u1.push_back(e), u2.push_back(f);
+  }
+  u1.push_back(0.5), u2.push_back(0.5);
+  for (const glm::dvec3 axis : {glm::dvec3(0, 0, 1), glm::dvec3(0.3, -0.4, 0.8), glm::dvec3(0, 0, -1), glm::dvec3(-1, 2, 0.01)}) {
+    glm::dvec3 t, b, n;
+    orthonormal_basis(axis, t, b, n);
+    const std::size_t count = u1.size();
+    std::vector<float> x(count), y(count), z(count);
+    cosine_directions(t, b, n, u1.data(), u2.data(), count, x.data(), y.data(), z.data());
+    for (std::size_t i = 0; i < count; ++i) {
+      const glm::vec3 d(cosine_direction(t, b, n, u1[i], u2[i]));
+      ASSERT_EQ(glm::vec3(x[i], y[i], z[i]), d) << i << " (" << u1[i] << ", " << u2[i] << ")";
+    }
+  }
+}
+
 TEST(SampleStream, EqualKeysGiveEqualStreams) {
   SampleStream a(sample_key(1234, 5, 2)), b(sample_key(1234, 5, 2)), c(sample_key(1234, 6, 2));
   int equal_to_other = 0;

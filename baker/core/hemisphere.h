@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 
 #include <glm/glm.hpp>
@@ -96,6 +97,11 @@ inline glm::dvec3 cosine_direction(const glm::dvec3& t, const glm::dvec3& b, con
   const double z = std::sqrt(h > 0.0 ? h : 0.0);
   return d.x * t + d.y * b + z * n;
 }
+
+// cosine_direction(t, b, n, u1[i], u2[i]) rounded to float, for i < count, into x[i], y[i], z[i]:
+// the same bits, four at a time (hemisphere.cpp; an AVX2 clone where the processor has it).
+void cosine_directions(const glm::dvec3& t, const glm::dvec3& b, const glm::dvec3& n, const double* u1, const double* u2,
+                       std::size_t count, float* x, float* y, float* z);
 
 // The cosine-weighted direction over the hemisphere around n for (u1, u2) uniform in [0, 1)^2:
 // unit length (to rounding), dot(direction, n) >= 0 up to rounding (about 0 only on the disk's

@@ -221,18 +221,21 @@ struct TexelMaps::Impl {
     // In runs of up to kGenerate rays: their points first, then their directions, each loop short
     // and free of calls, so that the processor overlaps the rays' long chains of arithmetic.
     constexpr std::size_t kGenerate = 64;
-    glm::dvec2 u[kGenerate];
+    double u1[kGenerate], u2[kGenerate];
+    float dx[kGenerate], dy[kGenerate], dz[kGenerate];
     for (std::size_t done = 0; done < count;) {
       const std::size_t m = std::min(kGenerate, count - done);
       for (std::size_t j = 0; j < m; ++j) {
         const std::uint32_t n = next + std::uint32_t(j), chain = n & chain_mask;
-        u[j] = in.maps->ao_independent_rays ? stream[k][r].next2()
-                                            : scrambled_sobol2(n >> chain_shift, seeds[2 * chain], seeds[2 * chain + 1]);
+        const glm::dvec2 u = in.maps->ao_independent_rays
+                                 ? stream[k][r].next2()
+                                 : scrambled_sobol2(n >> chain_shift, seeds[2 * chain], seeds[2 * chain + 1]);
+        u1[j] = u.x, u2[j] = u.y;
       }
+      cosine_directions(bt, bb, bn, u1, u2, m, dx, dy, dz);
       for (std::size_t j = 0; j < m; ++j) {
         const std::uint32_t chain = (next + std::uint32_t(j)) & chain_mask;
-        const glm::vec3 d(cosine_direction(bt, bb, bn, u[j].x, u[j].y));
-        q.rays.set(q.n, raycast::Ray{org, 0.0f, d, tfar});
+        q.rays.set(q.n, raycast::Ray{org, 0.0f, glm::vec3(dx[j], dy[j], dz[j]), tfar});
         q.sample[q.n] = std::uint32_t(r);
         q.chain[q.n] = std::uint8_t(chain);
         ++sample_chain_rays[chain];
