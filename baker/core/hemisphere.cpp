@@ -10,44 +10,14 @@ using lanes::kLanes;
 using lanes::M;
 using lanes::V;
 
-// sin_cos_quarter, four angles at once: the same operations in the same order, lane by lane.
-[[gnu::always_inline]] inline void sin_cos_quarter4(const V& t, V& s, V& c) {
-  constexpr double kSin[] = {1.0,
-                             -1.0 / 6.0,
-                             1.0 / 120.0,
-                             -1.0 / 5040.0,
-                             1.0 / 362880.0,
-                             -1.0 / 39916800.0,
-                             1.0 / 6227020800.0,
-                             -1.0 / 1307674368000.0,
-                             1.0 / 355687428096000.0};
-  constexpr double kCos[] = {1.0,
-                             -1.0 / 2.0,
-                             1.0 / 24.0,
-                             -1.0 / 720.0,
-                             1.0 / 40320.0,
-                             -1.0 / 3628800.0,
-                             1.0 / 479001600.0,
-                             -1.0 / 87178291200.0,
-                             1.0 / 20922789888000.0,
-                             -1.0 / 6402373705728000.0};
-  const V t2 = t * t;
-  V ps = V{} + kSin[8], pc = V{} + kCos[9];
-  for (int k = 7; k >= 0; --k) ps = ps * t2 + kSin[k];
-  for (int k = 8; k >= 0; --k) pc = pc * t2 + kCos[k];
-  s = t * ps;
-  c = pc;
-}
-
 // out = m ? a : b per lane (by reference: a 32-byte vector by value changes the calling convention).
 [[gnu::always_inline]] inline void select(V& out, const M& m, const V& a, const V& b) { out = m ? a : b; }
 
 }  // namespace
 
 __attribute__((target_clones("avx2", "default"))) void cosine_directions(const glm::dvec3& t, const glm::dvec3& b,
-                                                                          const glm::dvec3& n, const double* u1,
-                                                                          const double* u2, std::size_t count, float* x,
-                                                                          float* y, float* z) {
+                                                                         const glm::dvec3& n, const double* u1, const double* u2,
+                                                                         std::size_t count, float* x, float* y, float* z) {
   constexpr double quarter_pi = 0.78539816339744830962;
   std::size_t i = 0;
   for (; i + kLanes <= count; i += kLanes) {
@@ -65,7 +35,8 @@ __attribute__((target_clones("avx2", "default"))) void cosine_directions(const g
     select(o, wide, bb, a);
     select(one_or_r, centre, V{} + 1.0, r);
     select(ratio, centre, V{}, o / one_or_r);
-    sin_cos_quarter4(quarter_pi * ratio, s, c);
+    const V angle = quarter_pi * ratio;
+    sin_cos_quarter(angle, s, c);
     select(cs, wide, c, s);
     select(sc, wide, s, c);
     select(dx, centre, V{}, r * cs);

@@ -41,7 +41,10 @@ inline void orthonormal_basis(const glm::dvec3& n_in, glm::dvec3& t, glm::dvec3&
 // in the last place of the true values (checked against the library on 10^7 angles), the same on
 // every machine, and inlined, where the library's sincos is a call in the middle of every ray's
 // arithmetic.
-inline void sin_cos_quarter(double t, double& s, double& c) {
+// For a double, or for a vector of doubles lane by lane (hemisphere.cpp: the same operations in the
+// same order, so the same bits).
+template <typename T>
+[[gnu::always_inline]] inline void sin_cos_quarter(const T& t, T& s, T& c) {
   // Horner in t^2 over the series' coefficients (-1)^k / (2k + 1)! and (-1)^k / (2k)!.
   constexpr double kSin[] = {1.0,
                              -1.0 / 6.0,
@@ -62,8 +65,8 @@ inline void sin_cos_quarter(double t, double& s, double& c) {
                              -1.0 / 87178291200.0,
                              1.0 / 20922789888000.0,
                              -1.0 / 6402373705728000.0};
-  const double t2 = t * t;
-  double ps = kSin[8], pc = kCos[9];
+  const T t2 = t * t;
+  T ps = T{} + kSin[8], pc = T{} + kCos[9];  // T{} + x: x itself, in every lane of a vector
   for (int k = 7; k >= 0; --k) ps = ps * t2 + kSin[k];
   for (int k = 8; k >= 0; --k) pc = pc * t2 + kCos[k];
   s = t * ps;
