@@ -201,7 +201,7 @@ class Scene {
   // a failure throws and the next call tries again); occluded calls it itself, so a caller calls it
   // only to build it at a time of its choosing (the bake: in its BVH stage).
   void prepare_secondary_rays() const;
-  //
+
   // Occlusion (ambient occlusion, bent normals), traced as incoherent streams, the fastest way
   // given thousands of rays a call (a tile's worth; bench_occlusion): occluded[i] = 1 when some
   // triangle of ray i's group, of either facing, crosses the ray at a t with tnear < t < tfar,
@@ -210,7 +210,6 @@ class Scene {
   // tnear or tfar, may go either way. A ray with tnear > tfar is not occluded. Of RayBatch only the eight
   // ray arrays and `group` are read (`coherent`, `order`, `outward` and the preferred part are
   // not). `occluded`: `count` bytes. Thread-safe.
-  //
   void occluded(const RayBatch& rays, std::uint8_t* occluded, std::size_t count, const SecondaryRayOptions& options = {}) const;
   // Thickness: per ray the first triangle of its group, of either facing, that crosses it at a t
   // with tnear < t < tfar (the same ties), as intersect(RayBatch, ...) without a rule gives it, in

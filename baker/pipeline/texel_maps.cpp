@@ -519,14 +519,14 @@ void TexelMaps::shade(const Samples& smp, int tile_x0, int tile_y0, int side, in
   // texel, in sample order (a counting sort, once for both maps), and a texel of one sample takes
   // its index.
   const bool single = m.ids && std::all_of(m.seen.begin(), m.seen.end(), [](std::uint32_t c) { return c <= 1; });
-  if (single)
+  if (single) {
     for (int which = 0; which < 2; ++which) {
       const Slot slot = which == 0 ? s_object_id : s_material_id;
       if (!m.has(slot)) continue;
       const std::vector<std::int64_t>& id = which == 0 ? m.object_id : m.material_id;
       for (std::size_t r = 0; r < n; ++r) *m.at(smp.texel[r], slot) = id[r] >= 0 ? double(id[r]) : -1.0;
     }
-  if (m.ids && !single) {
+  } else if (m.ids) {
     std::vector<std::uint32_t>&start = m.start, &order = m.order, &fill = m.fill;
     start.assign(m.texels + 1, 0);
     order.resize(n);
