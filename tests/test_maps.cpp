@@ -247,13 +247,20 @@ TEST(MapsIds, TwoMaterialsGiveTwoFlatColours) {
   ASSERT_EQ(m.colors.size(), 2u);
   const glm::vec3 a = m.colors[0].second, b = m.colors[1].second;
   EXPECT_NE(a, b);
-  std::size_t na = 0, nb = 0;
+  // Held as palette indices (1 channel: 1 + the material's index), written as their colours.
+  ASSERT_EQ(m.image.channels, 1);
+  const Image rgb = expand_palette(m.image, id_palette(m));
+  std::size_t na = 0, nb = 0, ia = 0, ib = 0;
   for (std::size_t i = 0; i < r.coverage.size(); ++i) {
-    const glm::vec3 c(m.image.pixels[3 * i], m.image.pixels[3 * i + 1], m.image.pixels[3 * i + 2]);
+    const glm::vec3 c(rgb.pixels[3 * i], rgb.pixels[3 * i + 1], rgb.pixels[3 * i + 2]);
     na += c == a;
     nb += c == b;
+    ia += m.image.pixels[i] == 1.0f;
+    ib += m.image.pixels[i] == 2.0f;
   }
   EXPECT_EQ(na + nb, r.coverage.size());
+  EXPECT_EQ(ia, na);
+  EXPECT_EQ(ib, nb);
   EXPECT_GT(na, 300u);
   EXPECT_GT(nb, 300u);
   EXPECT_EQ(id_color("paint"), id_color("paint"));  // from the name alone

@@ -110,3 +110,44 @@ TEST(PngIndexed, OnlyWhenAskedFor) {
   nmbake::write_image(path, img, o);
   EXPECT_EQ(png_depth_and_type(nmbake::test::read_file(path)).second, 3);
 }
+
+// An image of palette indices (WriteOptions::palette, how the ID maps are held) is written as the
+// RGB image expand_palette makes of it: the same samples as that image written with `indexed` (in
+// a PNG the same bytes), in PNG, TIFF and EXR, with dither, and past 256 colours. Indices 0, out of range, fractional
+// near a step, and NaN are black or their colour as expand_palette says; two indices of one colour
+// and a palette colour equal to black share an entry.
+TEST(PngIndexed, PaletteIndicesWriteAsTheirColours) {
+  const std::string dir = nmbake::test::scratch_dir();
+  for (int colours : {1, 3, 40, 255, 300}) {
+    std::vector<glm::vec3> palette;
+    for (int k = 0; k < colours; ++k)
+      palette.push_back(glm::vec3(float(k % 7) * 36.0f, float((k / 7) % 7) * 36.0f, float(k * 13 % 256)) / 255.0f);
+    if (colours > 2) palette[2] = palette[1];  // two names, one colour
+    if (colours > 3) palette[3] = glm::vec3(0.0f);
+    Image index(83, 47, 1);
+    for (int y = 0; y < index.height; ++y)
+      for (int x = 0; x < index.width; ++x) {
+        const int v = ((x / 4) * 29 + (y / 3) * 11) % (colours + 3);  // colours + 1, + 2: out of range
+        *index.at(x, y) = float(v) + (x % 5 == 1 ? -0.25f : x % 5 == 2 ? 0.25f : 0.0f);
+      }
+    *index.at(5, 5) = std::nanf("");
+    *index.at(6, 5) = -1.0f;
+    const Image rgb = nmbake::expand_palette(index, palette);
+    for (const char* ext : {".png", ".tif", ".exr"})
+      for (bool dither : {false, true}) {
+        if (dither && std::string(ext) != ".png") continue;
+        nmbake::WriteOptions o(std::string(ext) == ".png" ? 8 : 0);
+        o.dither = dither;
+        o.indexed = true;
+        nmbake::write_image(dir + "/want" + ext, rgb, o);
+        o.palette = palette;
+        nmbake::write_image(dir + "/got" + ext, index, o);
+        const std::string what = std::to_string(colours) + " colours, " + ext + (dither ? ", dither" : "");
+        if (std::string(ext) == ".png")  // no time stamp unless SOURCE_DATE_EPOCH gives one: the bytes
+          EXPECT_TRUE(nmbake::test::read_file(dir + "/got" + ext) == nmbake::test::read_file(dir + "/want" + ext)) << what;
+        const Image got = nmbake::read_image(dir + "/got" + ext), want = nmbake::read_image(dir + "/want" + ext);
+        EXPECT_EQ(got.channels, 3) << what;
+        EXPECT_TRUE(got.pixels == want.pixels) << what;
+      }
+  }
+}

@@ -221,8 +221,9 @@ void write_outputs(const JobEnv& env, OutputSet& outputs, const Args& a, const B
       if (m.image.pixels.empty()) continue;  // skipped (a warning says why)
       WriteOptions mo = wo;
       mo.metadata = extra_metadata(o, m);
-      mo.dither = wo.dither && !map_is_flat(m.kind);  // an ID's colour is exact
-      mo.indexed = map_is_flat(m.kind);               // and few: a PNG palette
+      mo.dither = wo.dither && !map_is_flat(m.kind);        // an ID's colour is exact
+      mo.indexed = map_is_flat(m.kind);                     // and few: a PNG palette
+      if (map_is_flat(m.kind)) mo.palette = id_palette(m);  // the image holds their indices
       add(map_name(m.kind), f.tile, f.extra[i], m.image, std::move(mo), true);
     }
     for (const auto& [name, path, image] : {std::tuple{"miss-mask", &f.miss_mask, &f.result->miss_mask},

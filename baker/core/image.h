@@ -10,6 +10,8 @@
 #include <utility>
 #include <vector>
 
+#include <glm/vec3.hpp>
+
 #if defined(__linux__)
 #include <sys/mman.h>
 #endif
@@ -82,5 +84,20 @@ struct Image {
 #endif
   }
 };
+
+// An image of palette indices (1 channel: 0 black, k the colour palette[k - 1]; any other value,
+// NaN included, black) as the RGB image it stands for: how the ID maps are held until written
+// (BakedMap::image, WriteOptions::palette).
+inline Image expand_palette(const Image& index, const std::vector<glm::vec3>& palette) {
+  Image out(index.width, index.height, 3, Image::Unset{});
+  const std::size_t n = std::size_t(index.width) * std::size_t(index.height);
+  const double size = double(palette.size());
+  for (std::size_t i = 0; i < n; ++i) {
+    const double v = double(index.pixels[i]);
+    const glm::vec3 c = v >= 0.5 && v < size + 0.5 ? palette[std::size_t(v + 0.5) - 1] : glm::vec3(0.0f);
+    for (int k = 0; k < 3; ++k) out.pixels[3 * i + std::size_t(k)] = c[k];
+  }
+  return out;
+}
 
 }  // namespace nmbake

@@ -34,6 +34,8 @@ int map_channels(MapKind kind) {
   }
 }
 
+int map_image_channels(MapKind kind) { return map_is_flat(kind) ? 1 : map_channels(kind); }
+
 bool map_is_flat(MapKind kind) { return kind == MapKind::object_id || kind == MapKind::material_id; }
 
 bool map_casts_rays(MapKind kind) { return kind == MapKind::ao || kind == MapKind::bent_normal || kind == MapKind::thickness; }

@@ -31,8 +31,11 @@ const char* map_name(MapKind kind);
 bool parse_map_name(const std::string& name, MapKind& kind);
 // Every name, comma-separated, in MapKind order (for messages and --help).
 std::string map_name_list();
-// Channels of the map's image: 1 for ao, height, thickness, curvature; 3 for the others.
+// Channels of the map's file: 1 for ao, height, thickness, curvature; 3 for the others.
 int map_channels(MapKind kind);
+// Channels of the map's image in memory (BakedMap::image): as map_channels, except the ID maps
+// (map_is_flat), held as 1 channel of palette indices (expand_palette) until they are written.
+int map_image_channels(MapKind kind);
 // Maps whose texel takes one sample's value (the most frequent among its hit samples), never a
 // mean: the ID maps.
 bool map_is_flat(MapKind kind);

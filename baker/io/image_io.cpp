@@ -144,6 +144,11 @@ OIIO::ImageSpec output_spec(const Image& image, OIIO::TypeDesc stored, const std
 void write_image(const std::string& path, const Image& image, const WriteOptions& options) {
   const std::string ext = image_io_detail::lower_extension(path);
   if (ext == ".png") return write_png_image(path, image, options);
+  if (!options.palette.empty()) {
+    WriteOptions rgb = options;
+    rgb.palette.clear();
+    return write_image(path, expand_palette(image, options.palette), rgb);
+  }
   const int bits = image_write::check_write(path, image, options);
   const fs::path target(path);
   std::error_code ec;

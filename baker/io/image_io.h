@@ -38,6 +38,10 @@ struct WriteOptions {
   // 3, png_write.h), the same samples to a reader in a fraction of the bytes. For maps of flat
   // colours (the ID maps); other maps stay RGB, as the tools that read normal maps expect them.
   bool indexed = false;
+  // Not empty: `image` is 1 channel of indices into this palette (core/image.h expand_palette: 0
+  // black, k palette[k - 1]) and the file is the RGB image they stand for. A PNG of 8 bits without
+  // dither stores them indexed (as `indexed` would the RGB image) while they fit in 256 colours.
+  std::vector<glm::vec3> palette;
   // Threads an encoder may use (the quantization to 8 or 16 bits, PNG's bands, png_write.h): 0 =
   // all cores. The bytes written do not depend on it.
   int threads = 0;

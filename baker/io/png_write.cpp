@@ -314,6 +314,45 @@ bool index_colors(const Image& image, IndexedColors& out) {
   return true;
 }
 
+// The same from an image of palette indices (WriteOptions::palette): each index's colour found
+// once, in texel order, and a colour that two indices share (or that black repeats) one entry, so
+// the palette and the indices are those index_colors finds in the RGB image they stand for (the
+// same bytes). False past 256 colours.
+bool index_palette(const Image& image, const std::vector<glm::vec3>& palette, IndexedColors& out) {
+  const std::size_t n = std::size_t(image.width) * std::size_t(image.height);
+  out.index.resize(n);
+  out.palette.clear();
+  std::vector<std::int16_t> slot(palette.size() + 1, -1);  // per index (0: black), its entry
+  const float* px = image.pixels.data();
+  const double size = double(palette.size());
+  std::uint8_t last = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i > 0 && px[i] == px[i - 1]) {
+      out.index[i] = last;
+      continue;
+    }
+    const double v = double(px[i]);
+    const std::size_t k = v >= 0.5 && v < size + 0.5 ? std::size_t(v + 0.5) : 0;  // as expand_palette
+    if (slot[k] < 0) {
+      const glm::vec3 c = k ? palette[k - 1] : glm::vec3(0.0f);
+      std::uint8_t rgb[3];
+      image_write::quantize8_run(&c[0], 0, 3, false, rgb);
+      std::size_t e = 0;
+      const std::size_t entries = out.palette.size() / 3;
+      while (e < entries && std::memcmp(&out.palette[3 * e], rgb, 3) != 0) ++e;
+      if (e == entries) {
+        if (entries == 256) return false;
+        out.palette.insert(out.palette.end(), rgb, rgb + 3);
+      }
+      slot[k] = std::int16_t(e);
+    }
+    last = out.index[i] = std::uint8_t(slot[k]);
+  }
+  const std::size_t entries = out.palette.size() / 3;
+  out.depth = entries <= 2 ? 1 : entries <= 4 ? 2 : entries <= 16 ? 4 : 8;
+  return true;
+}
+
 // `width` indices of `depth` bits packed into bytes, the first in the high bits (PNG's order), the
 // last byte's unused bits 0.
 void pack_indices(const std::uint8_t* index, int width, int depth, unsigned char* out) {
@@ -359,7 +398,18 @@ void write_png_image(const std::string& path, const Image& image, const WriteOpt
   if (!valid_sizes(image.width, image.height, image.channels, bits, &error)) image_write::fail_write(path, error);
   std::vector<unsigned char> bytes;
   IndexedColors indexed;
-  if (options.indexed && bits == 8 && image.channels == 3 && !options.dither && index_colors(image, indexed)) {
+  bool use_index;
+  if (!options.palette.empty()) {  // an image of indices: indexed while it can be, else its RGB image
+    use_index = bits == 8 && image.channels == 1 && !options.dither && index_palette(image, options.palette, indexed);
+    if (!use_index) {
+      WriteOptions rgb = options;
+      rgb.palette.clear();
+      return write_png_image(path, expand_palette(image, options.palette), rgb);
+    }
+  } else {
+    use_index = options.indexed && bits == 8 && image.channels == 3 && !options.dither && index_colors(image, indexed);
+  }
+  if (use_index) {
     Layout layout;
     layout.color_type = 3;
     layout.depth = indexed.depth;

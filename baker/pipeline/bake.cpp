@@ -137,7 +137,7 @@ std::uint64_t estimate_bake_bytes(const BakeOptions& o) {
       12 + 1 + (o.padding > 0 ? 4 : 0) + (o.miss_mask ? 4 : 0) + (o.suspect_mask ? 4 : 0) + (o.samples > 1 ? 1 : 0);
   for (MapKind k : o.maps.maps)  // each extra map's floats (and ao's, thickness's error)
     if (k != MapKind::normal)
-      per_texel += 4u * std::uint64_t(map_channels(k)) + (k == MapKind::ao || k == MapKind::thickness ? 4 : 0);
+      per_texel += 4u * std::uint64_t(map_image_channels(k)) + (k == MapKind::ao || k == MapKind::thickness ? 4 : 0);
   if (o.maps.ao_rays_auto) {  // --ao-rays auto: each texel's rays (allocate_map_targets' ao_rays, thickness_rays)
     if (o.maps.wants(MapKind::ao) || o.maps.wants(MapKind::bent_normal)) per_texel += 4;
     if (o.maps.wants(MapKind::thickness)) per_texel += 4;

@@ -243,7 +243,9 @@ struct TraceInputs;  // bake_stages.h: the prepared scene, its BVH and the rays'
 // One map of the texture set other than the normal map (BakeOptions::maps), ready to write.
 struct BakedMap {
   MapKind kind = MapKind::ao;
-  Image image;  // map_channels(kind) channels, values in [0, 1] as written, padded like the normal map
+  // map_image_channels(kind) channels, values in [0, 1] as written, padded like the normal map;
+  // the ID maps 1 channel of palette indices, their colours `colors` (expand_palette).
+  Image image;
   // Written into the file: "nmbake:map" (the map's name) and its ranges ("nmbake:height_range",
   // "nmbake:position_box", "nmbake:curvature_scale", "nmbake:ao_distance", "nmbake:thickness_distance").
   std::vector<std::pair<std::string, std::string>> metadata;
@@ -252,7 +254,8 @@ struct BakedMap {
   double range_min = 0.0, range_max = 0.0;
   glm::dvec3 box_min{0.0}, box_max{0.0};
   double distance = 0.0;  // ao, bent-normal: the AO distance; thickness: its distance (scene units)
-  std::vector<std::pair<std::string, glm::vec3>> colors;  // ID maps: per name its colour (0-1, 8-bit steps)
+  // ID maps: per name its colour (0-1, 8-bit steps), in index order: image's palette (id_palette).
+  std::vector<std::pair<std::string, glm::vec3>> colors;
   // ao, thickness: the standard error of the covered texels' values, mean and 95th percentile;
   // -1 for the other maps.
   double error_mean = -1.0, error_p95 = -1.0;
@@ -263,6 +266,13 @@ struct BakedMap {
   // Not written, and why (vertex-color of a high-poly without colours): `image` is then empty.
   std::string skipped;
 };
+
+// An ID map's palette: its colours in index order, as expand_palette and WriteOptions::palette read it.
+inline std::vector<glm::vec3> id_palette(const BakedMap& m) {
+  std::vector<glm::vec3> out;
+  for (const auto& named : m.colors) out.push_back(named.second);
+  return out;
+}
 
 struct BakeResult {
   Image map;                           // RGB, encoded c = n * 0.5 + 0.5

@@ -123,7 +123,8 @@ double chain_standard_error(const double* pairs, bool resolution = false) {
 
 MapTargets allocate_map_targets(const MapOptions& maps, int width, int height) {
   MapTargets out;
-  for (MapKind k : maps.maps) out.raw.push_back(k == MapKind::normal ? Image() : Image(width, height, map_channels(k), 0.0f));
+  for (MapKind k : maps.maps)
+    out.raw.push_back(k == MapKind::normal ? Image() : Image(width, height, map_image_channels(k), 0.0f));
   if (maps.wants(MapKind::ao)) out.ao_error = Image(width, height, 1, 0.0f);
   if (maps.wants(MapKind::thickness)) out.thickness_error = Image(width, height, 1, 0.0f);
   if (maps.ao_rays_auto && (maps.wants(MapKind::ao) || maps.wants(MapKind::bent_normal)))
@@ -573,7 +574,6 @@ void TexelMaps::write(MapTargets& out, int x0, int y0, int w, int h, int side, i
     if (slot == kSlots) continue;
     Image& img = out.raw[k];
     float* const pixels = img.pixels.data();
-    const std::size_t channels = std::size_t(img.channels);
     switch (kind) {
       case MapKind::object_normal:
       case MapKind::bent_normal:
@@ -628,13 +628,12 @@ void TexelMaps::write(MapTargets& out, int x0, int y0, int w, int h, int side, i
       case MapKind::material_id: {
         // The index (as the float it was kept as) rounded half away from zero (std::lround) without
         // a library call: a float's d + 0.5 is exact in double, so d + 0.5 < size says lround(d) <
-        // size; -1 (a miss), NaN and indices out of range are black.
+        // size; -1 (a miss), NaN and indices out of range are 0 (black).
         const std::vector<glm::vec3>& colors = kind == MapKind::object_id ? in.object_colors : in.material_colors;
         const double size = double(colors.size());
         each([&](std::size_t i, std::size_t g) {
           const double d = double(float(*m.at(i, slot)));
-          const glm::vec3 c = d > -0.5 && d + 0.5 < size ? colors[std::size_t(d + 0.5)] : glm::vec3(0.0f);
-          for (int ch = 0; ch < 3; ++ch) pixels[channels * g + std::size_t(ch)] = c[ch];
+          pixels[g] = d > -0.5 && d + 0.5 < size ? float(std::size_t(d + 0.5) + 1) : 0.0f;
         });
         break;
       }

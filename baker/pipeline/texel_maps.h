@@ -60,11 +60,11 @@ struct MapInputs {
 // and already encoded, as finish_maps leaves them:
 //   position: mean hit (re-centred scene coordinates) over MapInputs::position_lo..hi, each axis
 //     clamped to [0, 1] (0.5 on a flat axis);
-//   object-id, material-id: the colour of the index taken (MapInputs::*_colors), black for a texel
-//     whose samples all miss or an index without a colour.
+//   object-id, material-id: 1 + the index taken, as expand_palette reads it with MapInputs::*_colors
+//     as the palette (0, black, for a texel whose samples all miss or an index without a colour).
 // A texel whose samples all miss gets the map's miss value (texel_maps.cpp, kMiss*).
 struct MapTargets {
-  std::vector<Image> raw;  // per MapOptions::maps entry; empty for normal
+  std::vector<Image> raw;  // per MapOptions::maps entry (map_image_channels); empty for normal
   // Per texel, the standard error of the ao / thickness value (the spread of the means of its
   // rays' independent chains over sqrt of their number, texel_maps.cpp); empty unless the map is
   // asked for.
@@ -75,7 +75,7 @@ struct MapTargets {
   Image ao_rays, thickness_rays;
 };
 
-// The images of `maps` (raw, 1 or 3 channels) and the error images, sized as the map.
+// The images of `maps` (raw, map_image_channels) and the error images, sized as the map.
 MapTargets allocate_map_targets(const MapOptions& maps, int width, int height);
 
 // One trace thread's part: per tile texel, sums of each extra map's sample values.

@@ -95,9 +95,11 @@ struct DecodedImage {
 };
 
 DecodedImage decode_as_written(const JobImage& j) {
-  DecodedImage d{j.name, j.tile, j.image->width, j.image->height, j.image->channels, {}, false};
+  const Image expanded = j.options->palette.empty() ? Image() : expand_palette(*j.image, j.options->palette);
+  const Image& image = j.options->palette.empty() ? *j.image : expanded;  // an ID map: its colours
+  DecodedImage d{j.name, j.tile, image.width, image.height, image.channels, {}, false};
   const int bits = j.options->bits ? j.options->bits : default_bits_for(j.path);
-  const Image::Pixels& p = j.image->pixels;
+  const Image::Pixels& p = image.pixels;
   const bool exr = image_io_detail::lower_extension(j.path) == ".exr";
   d.values.resize(p.size());
   if (bits == 8) {
