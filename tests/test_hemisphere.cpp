@@ -396,3 +396,27 @@ TEST(ScrambledSobol, SameBitsAsTheFirstImplementation) {
     EXPECT_EQ(scrambled_sobol2(k.index, owen_seed(sx), owen_seed(sy)), glm::dvec2(k.x, k.y)) << k.index;
   }
 }
+
+// scrambled_sobol2_many, four points of several sets at once, gives each point the bits of
+// scrambled_sobol2: indices small and large (every bit of the second dimension's loop, lanes that
+// end it at different lengths), 0 and 2^32 - 1, chains in any order, counts that leave a tail.
+TEST(ScrambledSobol, ManyAtOnceHaveTheBitsOfOneAtATime) {
+  SampleStream r(7);
+  std::vector<OwenSeed> seeds;
+  for (int c = 0; c < 16; ++c) seeds.push_back(owen_seed(std::uint64_t(r.next() * 0x1.0p53) * 2654435761ull));
+  std::vector<std::uint32_t> index;
+  std::vector<std::uint8_t> chain;
+  for (std::uint32_t i = 0; i < 3000; ++i) {
+    index.push_back(i % 5 == 0 ? std::uint32_t(r.next() * 4294967296.0) : i % 3 == 0 ? i * 977u : i / 4);
+    chain.push_back(std::uint8_t(i % 7 == 0 ? (i / 7) % 8 : i % 8));
+  }
+  for (std::uint32_t edge : {0u, 1u, 0x80000000u, 0xffffffffu, 4095u, 4096u}) index.push_back(edge), chain.push_back(3);
+  for (std::size_t count : {index.size(), std::size_t(3), std::size_t(1), std::size_t(0)}) {
+    std::vector<double> u1(count), u2(count);
+    scrambled_sobol2_many(index.data(), chain.data(), seeds.data(), count, u1.data(), u2.data());
+    for (std::size_t i = 0; i < count; ++i) {
+      const glm::dvec2 want = scrambled_sobol2(index[i], seeds[2 * chain[i]], seeds[2 * chain[i] + 1]);
+      ASSERT_EQ(glm::dvec2(u1[i], u2[i]), want) << "point " << i << " index " << index[i] << " chain " << int(chain[i]);
+    }
+  }
+}

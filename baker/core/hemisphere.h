@@ -239,6 +239,11 @@ inline void scramble_seeds(std::uint64_t seed, std::uint64_t& seed_x, std::uint6
 inline glm::dvec2 scrambled_sobol2(std::uint32_t index, const OwenSeed& seed_x, const OwenSeed& seed_y) {
   return glm::dvec2(owen_scramble(sobol_radical_inverse(index), seed_x), owen_scramble(sobol_second(index), seed_y));
 }
+// scrambled_sobol2(index[i], seeds[2 * chain[i]], seeds[2 * chain[i] + 1]) for i < count, into
+// u1[i], u2[i]: points of several sets at once (a texel's chains), the same bits, four at a time
+// (hemisphere.cpp; an AVX2 clone where the processor has it).
+void scrambled_sobol2_many(const std::uint32_t* index, const std::uint8_t* chain, const OwenSeed* seeds, std::size_t count,
+                           double* u1, double* u2);
 inline glm::dvec2 scrambled_sobol2(std::uint32_t index, std::uint64_t seed_x, std::uint64_t seed_y) {
   return scrambled_sobol2(index, owen_seed(seed_x), owen_seed(seed_y));
 }

@@ -224,14 +224,22 @@ struct TexelMaps::Impl {
     constexpr std::size_t kGenerate = 64;
     double u1[kGenerate], u2[kGenerate];
     float dx[kGenerate], dy[kGenerate], dz[kGenerate];
+    std::uint32_t point[kGenerate];
+    std::uint8_t point_chain[kGenerate];
     for (std::size_t done = 0; done < count;) {
       const std::size_t m = std::min(kGenerate, count - done);
-      for (std::size_t j = 0; j < m; ++j) {
-        const std::uint32_t n = next + std::uint32_t(j), chain = n & chain_mask;
-        const glm::dvec2 u = in.maps->ao_independent_rays
-                                 ? stream[k][r].next2()
-                                 : scrambled_sobol2(n >> chain_shift, seeds[2 * chain], seeds[2 * chain + 1]);
-        u1[j] = u.x, u2[j] = u.y;
+      if (in.maps->ao_independent_rays) {
+        for (std::size_t j = 0; j < m; ++j) {
+          const glm::dvec2 u = stream[k][r].next2();
+          u1[j] = u.x, u2[j] = u.y;
+        }
+      } else {
+        for (std::size_t j = 0; j < m; ++j) {
+          const std::uint32_t n = next + std::uint32_t(j);
+          point[j] = n >> chain_shift;
+          point_chain[j] = std::uint8_t(n & chain_mask);
+        }
+        scrambled_sobol2_many(point, point_chain, seeds, m, u1, u2);
       }
       cosine_directions(bt, bb, bn, u1, u2, m, dx, dy, dz);
       for (std::size_t j = 0; j < m; ++j) {
