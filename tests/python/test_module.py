@@ -135,6 +135,21 @@ def test_arrays_are_what_the_files_decode_to(both):
         assert np.allclose(nmbake.read_image(folder / f"py_{name}.png"), array, rtol=0, atol=1e-6), name
 
 
+def test_id_map_arrays_are_their_colours(tmp_path):
+    # The ID maps are held as palette indices inside the bake; the module hands back the RGB
+    # colours the file stores (the report's colour per name), as for every other map.
+    out = str(tmp_path / "id_<MAP>.png")
+    result = nmbake.bake(LOW, HIGH, size=SIZE, maps=["normal", "object-id", "material-id"], output=out)
+    for name in ("object-id", "material-id"):
+        array = result.maps[name]
+        assert array.shape == (SIZE, SIZE, 3) and array.dtype == np.float32, name
+        assert np.allclose(nmbake.read_image(tmp_path / f"id_{name}.png"), array, rtol=0, atol=1e-6), name
+        entry = next(m for m in result.report["maps"] if m["map"] == name)
+        colours = {tuple(c) for c in entry["colors"].values()} | {(0, 0, 0)}
+        used = {tuple(int(v) for v in px) for px in np.round(array.reshape(-1, 3) * 255.0)}
+        assert used <= colours and len(used - {(0, 0, 0)}) >= 1, (name, used, colours)
+
+
 def test_report_dict_is_the_report_file(both):
     import json
     folder, result = both
