@@ -143,8 +143,9 @@ TEST(PngIndexed, PaletteIndicesWriteAsTheirColours) {
         o.palette = palette;
         nmbake::write_image(dir + "/got" + ext, index, o);
         const std::string what = std::to_string(colours) + " colours, " + ext + (dither ? ", dither" : "");
-        if (std::string(ext) == ".png")  // no time stamp unless SOURCE_DATE_EPOCH gives one: the bytes
+        if (std::string(ext) == ".png") {  // no time stamp unless SOURCE_DATE_EPOCH gives one: the bytes
           EXPECT_TRUE(nmbake::test::read_file(dir + "/got" + ext) == nmbake::test::read_file(dir + "/want" + ext)) << what;
+        }
         const Image got = nmbake::read_image(dir + "/got" + ext), want = nmbake::read_image(dir + "/want" + ext);
         EXPECT_EQ(got.channels, 3) << what;
         EXPECT_TRUE(got.pixels == want.pixels) << what;

@@ -267,10 +267,12 @@ struct BakedMap {
   std::string skipped;
 };
 
-// An ID map's palette: its colours in index order, as expand_palette and WriteOptions::palette read it.
+// An ID map's palette: its colours in index order, as expand_palette and WriteOptions::palette read
+// it. Never empty (a map without names has only 0s: one black entry keeps it read as indices).
 inline std::vector<glm::vec3> id_palette(const BakedMap& m) {
   std::vector<glm::vec3> out;
   for (const auto& named : m.colors) out.push_back(named.second);
+  if (out.empty()) out.push_back(glm::vec3(0.0f));
   return out;
 }
 
