@@ -85,17 +85,23 @@ struct Image {
   }
 };
 
-// An image of palette indices (1 channel: 0 black, k the colour palette[k - 1]; any other value,
-// NaN included, black) as the RGB image it stands for: how the ID maps are held until written
-// (BakedMap::image, WriteOptions::palette).
+// The entry a value of an image of palette indices names among `size` colours: k (1 .. size) for
+// the colour palette[k - 1], 0 for black (0, a value out of range, NaN). Values are rounded to the
+// nearest entry.
+inline std::size_t palette_entry(float value, std::size_t size) {
+  const double v = double(value);
+  return v >= 0.5 && v < double(size) + 0.5 ? std::size_t(v + 0.5) : 0;
+}
+
+// An image of palette indices (1 channel, palette_entry) as the RGB image it stands for: how the
+// ID maps are held until written (BakedMap::image, WriteOptions::palette).
 inline Image expand_palette(const Image& index, const std::vector<glm::vec3>& palette) {
   Image out(index.width, index.height, 3, Image::Unset{});
   const std::size_t n = std::size_t(index.width) * std::size_t(index.height);
-  const double size = double(palette.size());
   for (std::size_t i = 0; i < n; ++i) {
-    const double v = double(index.pixels[i]);
-    const glm::vec3 c = v >= 0.5 && v < size + 0.5 ? palette[std::size_t(v + 0.5) - 1] : glm::vec3(0.0f);
-    for (int k = 0; k < 3; ++k) out.pixels[3 * i + std::size_t(k)] = c[k];
+    const std::size_t k = palette_entry(index.pixels[i], palette.size());
+    const glm::vec3 c = k ? palette[k - 1] : glm::vec3(0.0f);
+    for (int ch = 0; ch < 3; ++ch) out.pixels[3 * i + std::size_t(ch)] = c[ch];
   }
   return out;
 }

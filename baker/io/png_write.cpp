@@ -324,15 +324,13 @@ bool index_palette(const Image& image, const std::vector<glm::vec3>& palette, In
   out.palette.clear();
   std::vector<std::int16_t> slot(palette.size() + 1, -1);  // per index (0: black), its entry
   const float* px = image.pixels.data();
-  const double size = double(palette.size());
   std::uint8_t last = 0;
   for (std::size_t i = 0; i < n; ++i) {
     if (i > 0 && px[i] == px[i - 1]) {
       out.index[i] = last;
       continue;
     }
-    const double v = double(px[i]);
-    const std::size_t k = v >= 0.5 && v < size + 0.5 ? std::size_t(v + 0.5) : 0;  // as expand_palette
+    const std::size_t k = palette_entry(px[i], palette.size());
     if (slot[k] < 0) {
       const glm::vec3 c = k ? palette[k - 1] : glm::vec3(0.0f);
       std::uint8_t rgb[3];

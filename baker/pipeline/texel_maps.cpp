@@ -228,25 +228,25 @@ struct TexelMaps::Impl {
     std::uint8_t point_chain[kGenerate];
     for (std::size_t done = 0; done < count;) {
       const std::size_t m = std::min(kGenerate, count - done);
+      for (std::size_t j = 0; j < m; ++j) {
+        const std::uint32_t n = next + std::uint32_t(j);
+        point[j] = n >> chain_shift;
+        point_chain[j] = std::uint8_t(n & chain_mask);
+      }
       if (in.maps->ao_independent_rays) {
         for (std::size_t j = 0; j < m; ++j) {
           const glm::dvec2 u = stream[k][r].next2();
           u1[j] = u.x, u2[j] = u.y;
         }
       } else {
-        for (std::size_t j = 0; j < m; ++j) {
-          const std::uint32_t n = next + std::uint32_t(j);
-          point[j] = n >> chain_shift;
-          point_chain[j] = std::uint8_t(n & chain_mask);
-        }
         scrambled_sobol2_many(point, point_chain, seeds, m, u1, u2);
       }
       cosine_directions(bt, bb, bn, u1, u2, m, dx, dy, dz);
       for (std::size_t j = 0; j < m; ++j) {
-        const std::uint32_t chain = (next + std::uint32_t(j)) & chain_mask;
+        const std::uint8_t chain = point_chain[j];
         q.rays.set(q.n, raycast::Ray{org, 0.0f, glm::vec3(dx[j], dy[j], dz[j]), tfar});
         q.sample[q.n] = std::uint32_t(r);
-        q.chain[q.n] = std::uint8_t(chain);
+        q.chain[q.n] = chain;
         ++sample_chain_rays[chain];
         if (!q.group.empty()) q.group[q.n] = ray_group[r];
         if (++q.n == kRayBatch) flush(k);

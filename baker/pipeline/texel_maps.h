@@ -46,7 +46,7 @@ struct MapInputs {
   const RayGroups* groups = nullptr;
   // The encodings known before the trace, which TexelMaps::write applies itself: position, the
   // high-poly's bounding box (re-centred scene coordinates) to [0, 1]; the ID maps, per index its
-  // colour (map_set.h id_colors).
+  // colour (map_set.h id_colors): their palette, of which write needs the size only.
   glm::dvec3 position_lo{0.0}, position_hi{0.0};
   std::vector<glm::vec3> object_colors, material_colors;
 };
