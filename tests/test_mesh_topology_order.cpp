@@ -3,6 +3,8 @@
 // breadth-first walk (faces linked in the order of their edges' (smaller, larger vertex) keys).
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -11,6 +13,7 @@
 
 #include "core/mesh_topology.h"
 #include "core/normals.h"
+#include "core/parallel.h"
 
 using namespace nmbake;
 
@@ -70,6 +73,53 @@ TEST(MeshTopology, WeldIdsFollowFirstOccurrenceAndSignedZerosMeet) {
       weld_positions({{1, 0, 0}, {0, 0, 0}, {1, -0.0f, 0}, {-0.0f, 0, -0.0f}, {2, 0, 0}, {1, 0, 0}}, &count);
   EXPECT_EQ(ids, (std::vector<std::uint32_t>{0, 1, 0, 1, 2, 0}));
   EXPECT_EQ(count, 3u);
+}
+
+// Enough positions for the parts on several threads (weld_positions deals positions in chunks of
+// 65536): a random cloud where a third repeat an earlier position (some as -0), checked against
+// the rule itself (a map from key to the first index) on 1 to 5 threads.
+TEST(MeshTopology, WeldIdsOnSeveralThreadsAreTheFirstOccurrences) {
+  std::vector<glm::vec3> positions;
+  std::uint64_t x = 0x9e3779b97f4a7c15ull;
+  auto next = [&] { return x ^= x << 13, x ^= x >> 7, x ^= x << 17; };
+  for (std::size_t i = 0; i < 300000; ++i) {
+    if (i > 0 && next() % 3 == 0) {
+      glm::vec3 p = positions[std::size_t(next() % i)];
+      if (p.x == 0.0f) p.x = -p.x;
+      positions.push_back(p);
+    } else {
+      positions.push_back({float(next() % 1000) * 0.5f, float(next() % 7) - 3.0f, 0.0f});
+    }
+  }
+  std::map<std::array<float, 3>, std::uint32_t> first;
+  std::vector<std::uint32_t> want;
+  for (const glm::vec3& p : positions) {
+    const auto [it, added] = first.try_emplace({p.x + 0.0f, p.y + 0.0f, p.z + 0.0f}, std::uint32_t(first.size()));
+    want.push_back(it->second);
+  }
+  for (int threads : {1, 2, 3, 5}) {
+    std::size_t count = 0;
+    EXPECT_TRUE(weld_positions(positions, &count, threads) == want) << threads << " threads";
+    EXPECT_EQ(count, first.size()) << threads << " threads";
+  }
+}
+
+// "All cores" is what an AllCores scope says while it lasts.
+TEST(Parallel, AllCoresScopeBoundsTheDefaultThreads) {
+  const int machine = worker_threads(0);
+  {
+    const AllCores one(1);
+    EXPECT_EQ(worker_threads(0), 1);
+    EXPECT_EQ(worker_threads(3), 3);
+    {
+      const AllCores seven(7);
+      EXPECT_EQ(worker_threads(-1), 7);
+    }
+    EXPECT_EQ(worker_threads(0), 1);
+  }
+  EXPECT_EQ(worker_threads(0), machine);
+  const AllCores none(0);
+  EXPECT_EQ(worker_threads(0), machine);
 }
 
 TEST(MeshTopology, DuplicatesKeepTheEarliestFace) {

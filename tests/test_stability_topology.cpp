@@ -75,6 +75,35 @@ TEST(Stability, HighPolyTopologyIsInspected) {
   }
 }
 
+// A bake that computes the high-poly's normals hands back the checks it found on the way (the
+// command reports them instead of inspecting the mesh again): the same counts as inspect_topology.
+// A high-poly with normals leaves them to the command.
+TEST(Stability, TheBakeComputingNormalsFindsTheSameTopology) {
+  const Mesh low = load_low("flat_grid_low.obj");
+  std::size_t computed = 0;
+  for (const char* file : {"isolated_vertices_high.obj", "inconsistent_winding_high.obj", "duplicates_high.obj",
+                           "nonmanifold_high.obj", "bumps_high.obj"}) {
+    const Mesh high = load(file);
+    const BakeResult r = bake_normal_map(low, high, nullptr, options(32, 0.1f));
+    if (high.has_normals()) {
+      EXPECT_FALSE(r.stats.prepare.high_topology) << file;
+      continue;
+    }
+    ++computed;
+    ASSERT_TRUE(r.stats.prepare.high_topology) << file;
+    const MeshTopology& got = *r.stats.prepare.high_topology;
+    const MeshTopology want = inspect_topology(high);
+    EXPECT_EQ(got.welded_vertices, want.welded_vertices) << file;
+    EXPECT_EQ(got.isolated_vertices, want.isolated_vertices) << file;
+    EXPECT_EQ(got.duplicate_faces, want.duplicate_faces) << file;
+    EXPECT_EQ(got.boundary_edges, want.boundary_edges) << file;
+    EXPECT_EQ(got.non_manifold_edges, want.non_manifold_edges) << file;
+    EXPECT_EQ(got.inconsistent_winding_faces, want.inconsistent_winding_faces) << file;
+    EXPECT_EQ(r.stats.prepare.high_faces_reoriented, want.inconsistent_winding_faces) << file;
+  }
+  EXPECT_EQ(computed, 3u);
+}
+
 TEST(Stability, NonManifoldFinsGiveTheFirstHit) {
   // 0 < x < 0.2: the slanted fin lies above the plane; elsewhere the plane (+Z). The fin's normal
   // points down, into the low-poly: by default the plane beneath it is taken (a hit whose normal

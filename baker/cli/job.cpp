@@ -467,6 +467,7 @@ std::shared_ptr<const LoadedHigh> load_highs(const JobEnv& env, const std::vecto
 }  // namespace
 
 void bake_job(const Args& a, const JobEnv& env) {
+  const AllCores cores(a.threads);  // --threads bounds every stage, the loading included
   BakeOptions o = bake_options(a);
   validate_options(o);  // the library's checks, before a long load
   const int bits = a.bits ? a.bits : default_bits_for(a.output);
@@ -560,9 +561,12 @@ void bake_job(const Args& a, const JobEnv& env) {
     r.trace_inputs.reset();
     if (udim) udim->trace_inputs.reset();
   }
-  // Topology checks are only reported: they run beside the image write, after the bake (and the
-  // estimate) have freed the BVH, so that they take neither the bake's threads nor its peak memory.
-  auto topology = std::async(std::launch::async, [&high, threads = o.threads] { return inspect_topology(high, threads); });
+  // Topology checks are only reported. A bake that computed the high-poly's normals found them on
+  // the way; otherwise they run beside the image write, after the bake (and the estimate) have
+  // freed the BVH, so that they take neither the bake's threads nor its peak memory.
+  std::future<MeshTopology> topology;
+  if (!s.prepare.high_topology)
+    topology = std::async(std::launch::async, [&high, threads = o.threads] { return inspect_topology(high, threads); });
 
   // Every output to its temporary file, then all renamed into place together.
   OutputSet outputs;
@@ -572,7 +576,7 @@ void bake_job(const Args& a, const JobEnv& env) {
   write_outputs(env, outputs, a, o, r, udim ? &*udim : nullptr, low, bits);
   run.seconds_write = seconds_since(t0);
   *env.doing = "checking the high-poly's topology";
-  run.high_topology = topology.get();
+  run.high_topology = s.prepare.high_topology ? *s.prepare.high_topology : topology.get();
   if (env.keep_progress) env.progress.hold();
   else env.progress.finish();
   warnings.add(bake_warnings(s, run.high_topology, a.low, a.high, uv_tiles_note(low, a, o.width, o.height),

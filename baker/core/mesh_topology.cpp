@@ -27,13 +27,15 @@ PosKey key_of(const glm::vec3& p) {
   return k;
 }
 
-// The top bits of a multiplicative mix: a table index of `shift` = 64 - log2(table size).
-std::size_t slot_of(const PosKey& k, unsigned shift) {
+// A multiplicative mix of the key.
+std::uint64_t hash_of(const PosKey& k) {
   std::uint64_t h = ((std::uint64_t(k.bits[0]) << 32) | k.bits[1]) * 0x9E3779B97F4A7C15ull;
   h ^= k.bits[2] * 0xC2B2AE3D27D4EB4Full;
-  h = (h ^ (h >> 29)) * 0xBF58476D1CE4E5B9ull;
-  return std::size_t(h >> shift);
+  return (h ^ (h >> 29)) * 0xBF58476D1CE4E5B9ull;
 }
+
+// Its top bits: a table index of `shift` = 64 - log2(table size).
+std::size_t slot_of(const PosKey& k, unsigned shift) { return std::size_t(hash_of(k) >> shift); }
 
 // Everything the checks and the normals share: welded corners, duplicate faces, and the faces to
 // turn so that every piece has one winding.
@@ -286,7 +288,7 @@ Analysis analyze(const Mesh& m, int threads) {
   Analysis a;
   const std::size_t tris = m.triangle_count();
   std::size_t ids = 0;
-  a.weld = weld_positions(m.positions, &ids);
+  a.weld = weld_positions(m.positions, &ids, threads);
   a.corner.resize(3 * tris);
   parallel_chunks(threads, 3 * tris, std::size_t(1) << 16, [&](std::size_t begin, std::size_t end) {
     for (std::size_t c = begin; c < end; ++c) a.corner[c] = a.weld[m.position_index[c]];
@@ -303,8 +305,11 @@ Analysis analyze(const Mesh& m, int threads) {
 
 }  // namespace
 
-// Open addressing with linear probing over a table at most half full; ids in order of first occurrence.
-std::vector<std::uint32_t> weld_positions(const std::vector<glm::vec3>& positions, std::size_t* count) {
+namespace {
+
+// On one thread: open addressing with linear probing over one table at most half full, the
+// positions in order.
+std::vector<std::uint32_t> weld_serial(const std::vector<glm::vec3>& positions, std::size_t* count) {
   unsigned shift = 64 - 4;
   while ((std::size_t(1) << (64 - shift)) < 2 * positions.size()) --shift;
   const std::size_t mask = (std::size_t(1) << (64 - shift)) - 1;
@@ -332,19 +337,116 @@ std::vector<std::uint32_t> weld_positions(const std::vector<glm::vec3>& position
   return out;
 }
 
+}  // namespace
+
+// Ids in order of first occurrence. On every core: the positions' keys are dealt into kParts parts
+// by their hash (each part in position order), each part finds every position's first occurrence
+// in an open-addressing table of its own (linear probing, at most half full, small enough for the
+// caches), and the first occurrences are numbered in position order. The ids do not depend on the
+// threads.
+std::vector<std::uint32_t> weld_positions(const std::vector<glm::vec3>& positions, std::size_t* count, int threads) {
+  const std::size_t n = positions.size();
+  constexpr std::size_t kChunk = std::size_t(1) << 16;  // positions
+  constexpr std::size_t kParts = 256;
+  const std::size_t chunks = (n + kChunk - 1) / kChunk;
+  // One thread's table of all positions is faster than the parts' three passes (the same ids).
+  if (std::min(worker_threads(threads), int(chunks)) <= 1) return weld_serial(positions, count);
+  const auto chunk_end = [&](std::size_t c) { return std::min(n, (c + 1) * kChunk); };
+  // The low bits of the hash: a part's table indexes by the top ones.
+  const auto part_of = [](const PosKey& k) { return std::size_t(hash_of(k) & (kParts - 1)); };
+  // Per chunk, how many of its positions go to each part; then where they go (part by part, chunk
+  // by chunk within a part, so each part's list is in position order).
+  std::vector<std::uint32_t> at(chunks * kParts, 0);
+  parallel_chunks(threads, chunks, 1, [&](std::size_t c0, std::size_t c1) {
+    for (std::size_t c = c0; c < c1; ++c)
+      for (std::size_t i = c * kChunk; i < chunk_end(c); ++i) ++at[c * kParts + part_of(key_of(positions[i]))];
+  });
+  std::vector<std::size_t> part_start(kParts + 1, 0);
+  std::uint32_t next = 0;
+  for (std::size_t p = 0; p < kParts; ++p) {
+    part_start[p] = next;
+    for (std::size_t c = 0; c < chunks; ++c) {
+      const std::uint32_t k = at[c * kParts + p];
+      at[c * kParts + p] = next;
+      next += k;
+    }
+  }
+  part_start[kParts] = next;
+  std::vector<PosKey> listed(n);  // the keys part by part, each with its position (in `id`)
+  parallel_chunks(threads, chunks, 1, [&](std::size_t c0, std::size_t c1) {
+    for (std::size_t c = c0; c < c1; ++c)
+      for (std::size_t i = c * kChunk; i < chunk_end(c); ++i) {
+        PosKey k = key_of(positions[i]);
+        k.id = std::uint32_t(i);
+        listed[at[c * kParts + part_of(k)]++] = k;
+      }
+  });
+  // Per position, the first with its key (in `out` for now), and which are firsts.
+  std::vector<std::uint32_t> out(n);
+  std::vector<std::uint8_t> is_first(n);
+  parallel_chunks(threads, kParts, 1, [&](std::size_t p0, std::size_t p1) {
+    std::vector<PosKey> table;  // id: 1 + the position, 0 for an empty slot
+    for (std::size_t p = p0; p < p1; ++p) {
+      unsigned shift = 64 - 4;
+      while ((std::size_t(1) << (64 - shift)) < 2 * (part_start[p + 1] - part_start[p])) --shift;
+      const std::size_t mask = (std::size_t(1) << (64 - shift)) - 1;
+      table.assign(mask + 1, PosKey{});
+      for (std::size_t k = part_start[p]; k < part_start[p + 1]; ++k) {
+        const PosKey& key = listed[k];
+        for (std::size_t s = slot_of(key, shift);; s = (s + 1) & mask) {
+          PosKey& e = table[s];
+          if (e.id == 0) {
+            e = key;
+            e.id = key.id + 1;
+          } else if (e.bits[0] != key.bits[0] || e.bits[1] != key.bits[1] || e.bits[2] != key.bits[2]) {
+            continue;
+          }
+          out[key.id] = e.id - 1;
+          is_first[key.id] = e.id - 1 == key.id;
+          break;
+        }
+      }
+    }
+  });
+  // The firsts numbered in position order, then every other position takes its first's number.
+  std::vector<std::uint32_t> firsts_before(chunks + 1, 0);
+  parallel_chunks(threads, chunks, 1, [&](std::size_t c0, std::size_t c1) {
+    for (std::size_t c = c0; c < c1; ++c)
+      for (std::size_t i = c * kChunk; i < chunk_end(c); ++i) firsts_before[c + 1] += is_first[i];
+  });
+  for (std::size_t c = 0; c < chunks; ++c) firsts_before[c + 1] += firsts_before[c];
+  parallel_chunks(threads, chunks, 1, [&](std::size_t c0, std::size_t c1) {
+    for (std::size_t c = c0; c < c1; ++c) {
+      std::uint32_t id = firsts_before[c];
+      for (std::size_t i = c * kChunk; i < chunk_end(c); ++i)
+        if (is_first[i]) out[i] = id++;
+    }
+  });
+  parallel_chunks(threads, n, kChunk, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i)
+      if (!is_first[i]) out[i] = out[out[i]];
+  });
+  if (count) *count = firsts_before[chunks];
+  return out;
+}
+
 MeshTopology inspect_topology(const Mesh& mesh, int threads) { return analyze(mesh, threads).topo; }
 
-void compute_high_corner_normals(const Mesh& m, glm::vec3* out, std::size_t* reoriented, int threads) {
+void compute_high_corner_normals(const Mesh& m, glm::vec3* out, MeshTopology* topology, int threads) {
   const Analysis a = analyze(m, threads);
-  if (reoriented) *reoriented = a.topo.inconsistent_winding_faces;
+  if (topology) *topology = a.topo;
   // Indexed by welded id (< positions).
-  const std::vector<glm::dvec3> sum = angle_weighted_sums(m, &a.corner, m.positions.size(), &a.skip, &a.flip);
-  for (std::size_t c = 0; c < 3 * m.triangle_count(); ++c) out[c] = unit_or_up(sum[a.corner[c]]);
+  const std::vector<glm::dvec3> sum = angle_weighted_sums(m, &a.corner, m.positions.size(), &a.skip, &a.flip, threads);
+  parallel_chunks(threads, 3 * m.triangle_count(), std::size_t(1) << 16, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t c = begin; c < end; ++c) out[c] = unit_or_up(sum[a.corner[c]]);
+  });
 }
 
 std::vector<glm::vec3> compute_high_corner_normals(const Mesh& m, std::size_t* reoriented, int threads) {
   std::vector<glm::vec3> out(3 * m.triangle_count());
-  compute_high_corner_normals(m, out.data(), reoriented, threads);
+  MeshTopology topology;
+  compute_high_corner_normals(m, out.data(), &topology, threads);
+  if (reoriented) *reoriented = topology.inconsistent_winding_faces;
   return out;
 }
 

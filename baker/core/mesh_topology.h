@@ -30,15 +30,18 @@ struct MeshTopology {
 MeshTopology inspect_topology(const Mesh& mesh, int threads = 0);
 
 // Per position, an id shared by all positions with bit-identical coordinates (-0 equals +0).
-// `count` receives the number of distinct ids.
-std::vector<std::uint32_t> weld_positions(const std::vector<glm::vec3>& positions, std::size_t* count = nullptr);
+// `count` receives the number of distinct ids. Ids in order of first occurrence, on any number of
+// threads (<= 0: all cores).
+std::vector<std::uint32_t> weld_positions(const std::vector<glm::vec3>& positions, std::size_t* count = nullptr, int threads = 0);
 
 // Angle-weighted smooth normals for a high-poly without normals, one per corner (3 per triangle):
 // vertices welded by value, duplicate faces counted once, and faces wound against their
 // neighbours turned to the majority winding of their piece first (`reoriented` receives how many).
 // Zero-area faces carry no direction; a vertex with none gets (0,0,1). Never NaN.
 std::vector<glm::vec3> compute_high_corner_normals(const Mesh& mesh, std::size_t* reoriented = nullptr, int threads = 0);
-// The same into `out` (3 per triangle), the caller's storage.
-void compute_high_corner_normals(const Mesh& mesh, glm::vec3* out, std::size_t* reoriented = nullptr, int threads = 0);
+// The same into `out` (3 per triangle), the caller's storage; `topology`, when not null, receives
+// what inspect_topology finds (the same analysis: a bake that computes the normals need not check
+// again).
+void compute_high_corner_normals(const Mesh& mesh, glm::vec3* out, MeshTopology* topology = nullptr, int threads = 0);
 
 }  // namespace nmbake

@@ -1,36 +1,103 @@
 #include "core/normals.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <string>
 #include <unordered_map>
 #include <utility>
 #include <vector>
 
 #include "core/mesh_topology.h"
+#include "core/parallel.h"
 
 namespace nmbake {
 
+namespace {
+
+// A face's shares of its vertices' sums: corner c adds share[c] to vertex[c]'s sum, or nothing when
+// vertex[c] is kNoShare (a face that counts nothing, a corner with no angle).
+constexpr std::uint32_t kNoShare = 0xffffffffu;
+
+struct FaceShares {
+  std::uint32_t vertex[3];
+  glm::dvec3 share[3];
+};
+
+FaceShares face_shares(const Mesh& mesh, std::size_t t, const std::vector<std::uint32_t>* corner_vertex,
+                       const std::vector<std::uint8_t>* skip, const std::vector<std::uint8_t>* flip) {
+  FaceShares f;
+  f.vertex[0] = f.vertex[1] = f.vertex[2] = kNoShare;
+  if (skip && (*skip)[t]) return f;
+  const glm::dvec3 p[3] = {glm::dvec3(mesh.corner_position(t, 0)), glm::dvec3(mesh.corner_position(t, 1)),
+                           glm::dvec3(mesh.corner_position(t, 2))};
+  glm::dvec3 face = glm::cross(p[1] - p[0], p[2] - p[0]);
+  const double len = glm::length(face);
+  if (!(len > 0.0) || !std::isfinite(len)) return f;  // zero-area faces carry no direction
+  face /= len;
+  if (flip && (*flip)[t]) face = -face;
+  for (int c = 0; c < 3; ++c) {
+    const glm::dvec3 a = p[(c + 1) % 3] - p[c], b = p[(c + 2) % 3] - p[c];
+    if (!(glm::length(a) > 0.0) || !(glm::length(b) > 0.0)) continue;
+    // atan2 of |cross| and dot is accurate for angles near 0 and pi, unlike acos.
+    const double angle = std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
+    const std::size_t corner = 3 * t + std::size_t(c);
+    f.vertex[c] = corner_vertex ? (*corner_vertex)[corner] : mesh.position_index[corner];
+    f.share[c] = angle * face;
+  }
+  return f;
+}
+
+}  // namespace
+
+// Each vertex's sum adds its shares in face order, whatever the threads. Faces go in blocks of
+// chunks: the threads work out a block's shares (the angles, most of the work) chunk by chunk,
+// each share into its chunk's list for the thread that owns its vertex (runs of 64 ids dealt
+// round); then each thread adds its lists, chunk after chunk, to its own vertices' sums. So every
+// sum is the one the face-by-face loop makes, to the bit.
 std::vector<glm::dvec3> angle_weighted_sums(const Mesh& mesh, const std::vector<std::uint32_t>* corner_vertex,
                                             std::size_t vertices, const std::vector<std::uint8_t>* skip,
-                                            const std::vector<std::uint8_t>* flip) {
+                                            const std::vector<std::uint8_t>* flip, int threads) {
   std::vector<glm::dvec3> sum(vertices, glm::dvec3(0.0));
-  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
-    if (skip && (*skip)[t]) continue;
-    const glm::dvec3 p[3] = {glm::dvec3(mesh.corner_position(t, 0)), glm::dvec3(mesh.corner_position(t, 1)),
-                             glm::dvec3(mesh.corner_position(t, 2))};
-    glm::dvec3 face = glm::cross(p[1] - p[0], p[2] - p[0]);
-    const double len = glm::length(face);
-    if (!(len > 0.0) || !std::isfinite(len)) continue;  // zero-area faces carry no direction
-    face /= len;
-    if (flip && (*flip)[t]) face = -face;
-    for (int c = 0; c < 3; ++c) {
-      const glm::dvec3 a = p[(c + 1) % 3] - p[c], b = p[(c + 2) % 3] - p[c];
-      if (!(glm::length(a) > 0.0) || !(glm::length(b) > 0.0)) continue;
-      // atan2 of |cross| and dot is accurate for angles near 0 and pi, unlike acos.
-      const double angle = std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
-      const std::size_t corner = 3 * t + std::size_t(c);
-      sum[corner_vertex ? (*corner_vertex)[corner] : mesh.position_index[corner]] += angle * face;
+  const std::size_t tris = mesh.triangle_count();
+  constexpr std::size_t kChunk = 4096;  // faces
+  constexpr std::size_t kChunks = 16;   // per block
+  const int n = std::min(worker_threads(threads), int((tris + kChunk - 1) / kChunk));
+  if (n <= 1) {
+    for (std::size_t t = 0; t < tris; ++t) {
+      const FaceShares f = face_shares(mesh, t, corner_vertex, skip, flip);
+      for (int c = 0; c < 3; ++c)
+        if (f.vertex[c] != kNoShare) sum[f.vertex[c]] += f.share[c];
     }
+    return sum;
+  }
+  struct Share {
+    std::uint32_t vertex;
+    glm::dvec3 share;
+  };
+  const std::size_t owners = std::size_t(n);
+  struct alignas(64) List {  // one cache line each: the threads push to neighbouring lists
+    std::vector<Share> shares;
+  };
+  std::vector<List> lists(kChunks * owners);  // [chunk in block][owner]
+  for (std::size_t b0 = 0; b0 < tris; b0 += kChunk * kChunks) {
+    const std::size_t chunks = std::min(kChunks, (tris - b0 + kChunk - 1) / kChunk);
+    parallel_chunks(n, chunks, 1, [&](std::size_t k0, std::size_t k1) {
+      for (std::size_t k = k0; k < k1; ++k) {
+        List* own = &lists[k * owners];
+        for (std::size_t j = 0; j < owners; ++j) own[j].shares.clear();
+        const std::size_t t1 = std::min(tris, b0 + (k + 1) * kChunk);
+        for (std::size_t t = b0 + k * kChunk; t < t1; ++t) {
+          const FaceShares f = face_shares(mesh, t, corner_vertex, skip, flip);
+          for (int c = 0; c < 3; ++c)
+            if (f.vertex[c] != kNoShare) own[(f.vertex[c] >> 6) % owners].shares.push_back({f.vertex[c], f.share[c]});
+        }
+      }
+    });
+    run_on_threads(n, [&](int id) {
+      for (std::size_t k = 0; k < chunks; ++k)
+        for (const Share& sh : lists[k * owners + std::size_t(id)].shares) sum[sh.vertex] += sh.share;
+    });
   }
   return sum;
 }

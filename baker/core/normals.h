@@ -14,9 +14,10 @@ namespace nmbake {
 // per vertex, the sum over its faces of the corner angle times the unit face normal. Vertices are
 // the corners' `corner_vertex` ids (null: the position index), `vertices` of them; faces marked in
 // `skip` count nothing, faces marked in `flip` count reversed. Zero-area faces carry no direction.
+// Each sum adds its faces in face order: the same bits on any number of threads (<= 0: all cores).
 std::vector<glm::dvec3> angle_weighted_sums(const Mesh& mesh, const std::vector<std::uint32_t>* corner_vertex,
                                             std::size_t vertices, const std::vector<std::uint8_t>* skip = nullptr,
-                                            const std::vector<std::uint8_t>* flip = nullptr);
+                                            const std::vector<std::uint8_t>* flip = nullptr, int threads = 0);
 // A sum made unit, or (0,0,1) when it has no direction. Never NaN.
 glm::vec3 unit_or_up(const glm::dvec3& sum);
 

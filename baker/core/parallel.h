@@ -14,9 +14,32 @@
 
 namespace nmbake {
 
+// What "all cores" (a count <= 0) means in this process: the machine's cores, unless an AllCores
+// scope says otherwise (nmbake --threads N: then every stage keeps within N, the file readers and
+// the helpers that are given no count among them).
+inline std::atomic<int>& all_cores_setting() {
+  static std::atomic<int> count{0};  // <= 0: the machine's
+  return count;
+}
+
+// Within its lifetime, "all cores" means `count` threads (count <= 0: the machine's). Not for
+// concurrent jobs with different counts: the setting is the process's.
+class AllCores {
+ public:
+  explicit AllCores(int count) : before_(all_cores_setting().exchange(count > 0 ? count : 0)) {}
+  ~AllCores() { all_cores_setting().store(before_); }
+  AllCores(const AllCores&) = delete;
+  AllCores& operator=(const AllCores&) = delete;
+
+ private:
+  int before_;
+};
+
 // The worker threads for a requested count: itself when positive, else all cores (at least 1).
 inline int worker_threads(int requested) {
-  return requested > 0 ? requested : std::max(1, int(std::thread::hardware_concurrency()));
+  if (requested > 0) return requested;
+  const int set = all_cores_setting().load(std::memory_order_relaxed);
+  return set > 0 ? set : std::max(1, int(std::thread::hardware_concurrency()));
 }
 
 // Runs fn(id) for ids [0, count) on the caller's thread and up to count - 1 new ones, joined before

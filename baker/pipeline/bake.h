@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,7 @@
 #include "core/image.h"
 #include "core/maps.h"
 #include "core/mesh.h"
+#include "core/mesh_topology.h"
 #include "core/tangent_frames.h"
 
 namespace nmbake {
@@ -147,6 +149,9 @@ struct BakeStats {
     std::size_t uv_outside_entirely_triangles = 0;  // of those, UV bounding box outside [0,1]^2: not baked
     std::size_t high_faces_reoriented = 0;          // computed high-poly normals: faces turned to their piece's winding
     bool high_normals_computed = false;
+    // The high-poly's topology checks (inspect_topology), found on the way when its normals are
+    // computed; empty otherwise.
+    std::optional<MeshTopology> high_topology;
     // Float spacing at the largest (referenced) coordinate of the inputs, relative to the scene
     // diagonal: the precision the meshes themselves carry. Above kCoordinateSpacingWarn the map
     // degrades measurably (data/stability/README.md, case 5).
