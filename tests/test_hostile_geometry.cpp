@@ -3,8 +3,10 @@
 // message naming the file or the option; degenerate floods (duplicate faces, huge polygons,
 // meshes collapsed to a point) bake in time that grows at most as n log n.
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -251,3 +253,36 @@ TEST(HostileGeometry, ClosestPolicyIsHonouredWithACage) {
 
 }  // namespace
 }  // namespace nmbake
+
+// The stacks found on several threads (past 2 x 65536 triangles each thread counts the buckets it
+// owns): the same triangles left out as on one, of a kept list or of all.
+TEST(HostileGeometry, StacksAreFoundAlikeOnAnyNumberOfThreads) {
+  const int n = 280;  // n x n quads: 156800 triangles, then stacks
+  Prepared s;
+  Mesh high;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) s.high_pos.push_back({float(i), float(j), 0.01f * float((i * j) % 7)});
+  auto v = [&](int i, int j) { return std::uint32_t(j * (n + 1) + i); };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      for (std::uint32_t k : {v(i, j), v(i + 1, j), v(i + 1, j + 1), v(i, j), v(i + 1, j + 1), v(i, j + 1)})
+        high.position_index.push_back(k);
+  // Stacks: triangle 5 and 20 copies, 1000 and 9 (both past kDuplicateFlood), 7 and 7 (not).
+  for (auto [t, copies] : {std::pair<std::size_t, int>{5, 20}, {1000, 9}, {7, 7}})
+    for (int c = 0; c < copies; ++c)
+      for (int k = 0; k < 3; ++k) high.position_index.push_back(high.position_index[3 * t + std::size_t(k)]);
+  high.positions = s.high_pos;
+  std::vector<std::uint32_t> all_one, kept_one(high.triangle_count() / 2);
+  for (std::size_t i = 0; i < kept_one.size(); ++i) kept_one[i] = std::uint32_t(2 * i + 1);
+  const std::vector<std::uint32_t> kept_start = kept_one;
+  EXPECT_EQ(drop_duplicate_floods(s, high, 1, all_one), 20u + 9u);
+  const std::size_t kept_dropped = drop_duplicate_floods(s, high, 1, kept_one);
+  EXPECT_GT(kept_dropped, 0u);
+  for (int threads : {2, 3}) {
+    std::vector<std::uint32_t> all, kept = kept_start;
+    EXPECT_EQ(drop_duplicate_floods(s, high, threads, all), 20u + 9u) << threads;
+    EXPECT_TRUE(all == all_one) << threads;
+    EXPECT_EQ(drop_duplicate_floods(s, high, threads, kept), kept_dropped) << threads;
+    EXPECT_TRUE(kept == kept_one) << threads;
+  }
+}

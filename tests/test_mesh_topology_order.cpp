@@ -185,7 +185,8 @@ TEST(MeshTopology, FacesTurnedInANonOrientablePieceFollowTheEdgeOrder) {
 // threads, and with faces turned, repeated and a fin added, the counts and normals are the same on
 // 1, 2 and 3 threads.
 TEST(MeshTopology, CountsAndNormalsDoNotDependOnTheThreads) {
-  const int n = 150;  // n x n quads, (n + 1)^2 = 22801 vertices
+  // Past 65536 positions, so that weld_positions deals them into its parts on several threads.
+  const int n = 260;  // n x n quads, (n + 1)^2 = 68121 vertices
   std::vector<glm::vec3> positions;
   std::vector<std::uint32_t> index;
   for (int j = 0; j <= n; ++j)

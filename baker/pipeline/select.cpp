@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <cstring>
 
@@ -95,12 +96,26 @@ std::size_t drop_duplicate_floods(const Prepared& s, const Mesh& high, int threa
   parallel_chunks(threads, n, 1 << 16, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) hash[i] = key_hash(triangle_key(s, high, triangle(i)));
   });
-  bool suspects = false;
-  for (std::size_t i = 0; i < n; ++i) {
-    std::uint16_t& c = count[hash[i] & (buckets - 1)];
-    if (c < UINT16_MAX) ++c;
-    suspects |= c > kDuplicateFlood;
-  }
+  // Counted on every core: each thread counts the buckets it owns (runs of 4096 dealt round),
+  // reading every hash, so no two threads touch one count.
+  const int owners = std::max(1, std::min(worker_threads(threads), int(n >> 16)));
+  std::atomic<bool> suspects{false};
+  run_on_threads(owners, [&](int id) {
+    bool seen = false;
+    constexpr std::size_t kAhead = 16;  // the counts are larger than the caches: fetch ahead
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t b = hash[i] & (buckets - 1);
+      if (int((b >> 12) % std::size_t(owners)) != id) continue;
+      if (i + kAhead < n) {
+        const std::size_t ahead = hash[i + kAhead] & (buckets - 1);
+        if (int((ahead >> 12) % std::size_t(owners)) == id) __builtin_prefetch(&count[ahead], 1);
+      }
+      std::uint16_t& c = count[b];
+      if (c < UINT16_MAX) ++c;
+      seen |= c > kDuplicateFlood;
+    }
+    if (seen) suspects = true;
+  });
   if (!suspects) return 0;
   // The triangles of crowded buckets, grouped by key (first triangle first); repeats are left out.
   struct Suspect {
