@@ -86,8 +86,8 @@ std::vector<std::string> bake_warnings(const BakeStats& s, const MeshTopology& t
         "warning: %s: its faces look inverted (%.0f%% of the surfaces nearest the low-poly face into it): their fronts "
         "were taken the other way round%s%s",
         high.c_str(), 100.0 * s.distances.backface_probe_share,
-        s.prepare.high_normals_computed ? " and the computed normals turned outwards"
-                                        : "; the file's normals are kept, so the map points into the surface",
+        s.prepare.high_normals_computed() ? " and the computed normals turned outwards"
+                                          : "; the file's normals are kept, so the map points into the surface",
         pair.boxes_mismatch ? " (judged from the few probes that met it: LOW and HIGH do not match, above)" : ""));
   else if (s.distances.high_facing == BakeStats::HighFacing::mixed)
     out.push_back(
@@ -112,7 +112,7 @@ std::vector<std::string> bake_warnings(const BakeStats& s, const MeshTopology& t
   };
   add(t.non_manifold_edges, "non-manifold edges");
   add(t.isolated_vertices, "isolated vertices (ignored)");
-  add(t.inconsistent_winding_faces, s.prepare.high_normals_computed
+  add(t.inconsistent_winding_faces, s.prepare.high_normals_computed()
                                         ? "faces wound against their neighbours (turned before computing normals)"
                                         : "faces wound against their neighbours (the file's normals are used)");
   add(t.duplicate_faces, "duplicate faces (counted once in computed normals)");

@@ -147,11 +147,12 @@ struct BakeStats {
     std::size_t degenerate_uv_triangles = 0, degenerate_3d_triangles = 0, corners_without_tangent = 0;
     std::size_t uv_outside_triangles = 0;           // low-poly triangles with a UV outside [0,1]
     std::size_t uv_outside_entirely_triangles = 0;  // of those, UV bounding box outside [0,1]^2: not baked
-    std::size_t high_faces_reoriented = 0;          // computed high-poly normals: faces turned to their piece's winding
-    bool high_normals_computed = false;
-    // The high-poly's topology checks (inspect_topology), found on the way when its normals are
-    // computed; empty otherwise.
+    // The high-poly's topology checks (inspect_topology), found on the way when its normals were
+    // computed (it had none); empty when the file's normals were used.
     std::optional<MeshTopology> high_topology;
+    bool high_normals_computed() const { return high_topology.has_value(); }
+    // Computed high-poly normals: faces turned to their piece's winding.
+    std::size_t high_faces_reoriented() const { return high_topology ? high_topology->inconsistent_winding_faces : 0; }
     // Float spacing at the largest (referenced) coordinate of the inputs, relative to the scene
     // diagonal: the precision the meshes themselves carry. Above kCoordinateSpacingWarn the map
     // degrades measurably (data/stability/README.md, case 5).

@@ -151,7 +151,7 @@ void measure_reach(const ReachMode& mode, const Mesh& low, const BakeOptions& op
   st.distances.rear = opt.rear;
   const RayGroups groups = ray_groups(s, h, opt);
   const auto [global_front, global_rear] = probe_scene(mode, opt, threads, s, h, groups, st);
-  if (st.distances.high_facing == BakeStats::HighFacing::inverted) turn_inverted_high(s, h, st.prepare.high_normals_computed);
+  if (st.distances.high_facing == BakeStats::HighFacing::inverted) turn_inverted_high(s, h, st.prepare.high_normals_computed());
   if (mode.local_rear) {
     // Per-vertex distances (after the facing decision: the probes judge faces by it).
     const LocalDistances ld =

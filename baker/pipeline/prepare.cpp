@@ -174,11 +174,7 @@ Prepared prepare(const Mesh& low, const Mesh& high, const Mesh* cage, BakeStats&
   } else {
     // Welded by value, duplicate faces once, one winding per piece (mesh_topology.h).
     s.high_corner_normals.resize(3 * high.triangle_count());
-    MeshTopology topology;
-    compute_high_corner_normals(high, s.high_corner_normals.data(), &topology);
-    st.prepare.high_faces_reoriented = topology.inconsistent_winding_faces;
-    st.prepare.high_topology = topology;
-    st.prepare.high_normals_computed = true;
+    compute_high_corner_normals(high, s.high_corner_normals.data(), &st.prepare.high_topology.emplace());
   }
   s.high_facing = triangle_facing(s.high_pos, high.position_index, s.high_corner_normals);
   s.low_tris.resize(low.triangle_count());
