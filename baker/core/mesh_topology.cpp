@@ -307,31 +307,47 @@ Analysis analyze(const Mesh& m, int threads) {
 
 namespace {
 
-// On one thread: open addressing with linear probing over one table at most half full, the
-// positions in order.
+// Open addressing with linear probing over a table at most half full, for `items` keys.
+class KeyTable {
+ public:
+  explicit KeyTable(std::size_t items = 0) { start(items); }
+  void start(std::size_t items) {
+    shift_ = 64 - 4;
+    while ((std::size_t(1) << (64 - shift_)) < 2 * items) --shift_;
+    mask_ = (std::size_t(1) << (64 - shift_)) - 1;
+    slots_.assign(mask_ + 1, PosKey{});
+  }
+  void prefetch(const PosKey& k) const { __builtin_prefetch(&slots_[slot_of(k, shift_)]); }
+  // The entry with k's bits, or the empty one (id 0) where k goes.
+  PosKey& find(const PosKey& k) {
+    for (std::size_t s = slot_of(k, shift_);; s = (s + 1) & mask_) {
+      PosKey& e = slots_[s];
+      if (e.id == 0 || (e.bits[0] == k.bits[0] && e.bits[1] == k.bits[1] && e.bits[2] == k.bits[2])) return e;
+    }
+  }
+
+ private:
+  unsigned shift_ = 0;
+  std::size_t mask_ = 0;
+  std::vector<PosKey> slots_;
+};
+
+// On one thread: one table, the positions in order.
 std::vector<std::uint32_t> weld_serial(const std::vector<glm::vec3>& positions, std::size_t* count) {
-  unsigned shift = 64 - 4;
-  while ((std::size_t(1) << (64 - shift)) < 2 * positions.size()) --shift;
-  const std::size_t mask = (std::size_t(1) << (64 - shift)) - 1;
-  std::vector<PosKey> table(mask + 1, PosKey{});
+  KeyTable table(positions.size());
   std::vector<std::uint32_t> out(positions.size());
   std::uint32_t ids = 0;
   for (std::size_t i = 0; i < positions.size(); ++i) {
     // The table is larger than the caches: its slot for a position some steps ahead is fetched now.
     constexpr std::size_t kAhead = 8;
-    if (i + kAhead < positions.size()) __builtin_prefetch(&table[slot_of(key_of(positions[i + kAhead]), shift)]);
-    PosKey k = key_of(positions[i]);
-    for (std::size_t s = slot_of(k, shift);; s = (s + 1) & mask) {
-      PosKey& e = table[s];
-      if (e.id == 0) {
-        k.id = ++ids;
-        e = k;
-      } else if (e.bits[0] != k.bits[0] || e.bits[1] != k.bits[1] || e.bits[2] != k.bits[2]) {
-        continue;
-      }
-      out[i] = e.id - 1;
-      break;
+    if (i + kAhead < positions.size()) table.prefetch(key_of(positions[i + kAhead]));
+    const PosKey k = key_of(positions[i]);
+    PosKey& e = table.find(k);
+    if (e.id == 0) {
+      e = k;
+      e.id = ++ids;
     }
+    out[i] = e.id - 1;
   }
   if (count) *count = ids;
   return out;
@@ -385,26 +401,18 @@ std::vector<std::uint32_t> weld_positions(const std::vector<glm::vec3>& position
   std::vector<std::uint32_t> out(n);
   std::vector<std::uint8_t> is_first(n);
   parallel_chunks(threads, kParts, 1, [&](std::size_t p0, std::size_t p1) {
-    std::vector<PosKey> table;  // id: 1 + the position, 0 for an empty slot
+    KeyTable table;  // id: 1 + the position
     for (std::size_t p = p0; p < p1; ++p) {
-      unsigned shift = 64 - 4;
-      while ((std::size_t(1) << (64 - shift)) < 2 * (part_start[p + 1] - part_start[p])) --shift;
-      const std::size_t mask = (std::size_t(1) << (64 - shift)) - 1;
-      table.assign(mask + 1, PosKey{});
+      table.start(part_start[p + 1] - part_start[p]);
       for (std::size_t k = part_start[p]; k < part_start[p + 1]; ++k) {
         const PosKey& key = listed[k];
-        for (std::size_t s = slot_of(key, shift);; s = (s + 1) & mask) {
-          PosKey& e = table[s];
-          if (e.id == 0) {
-            e = key;
-            e.id = key.id + 1;
-          } else if (e.bits[0] != key.bits[0] || e.bits[1] != key.bits[1] || e.bits[2] != key.bits[2]) {
-            continue;
-          }
-          out[key.id] = e.id - 1;
-          is_first[key.id] = e.id - 1 == key.id;
-          break;
+        PosKey& e = table.find(key);
+        if (e.id == 0) {
+          e = key;
+          e.id = key.id + 1;
         }
+        out[key.id] = e.id - 1;
+        is_first[key.id] = e.id - 1 == key.id;
       }
     }
   });
