@@ -36,7 +36,8 @@ struct Hit {
 };
 
 // Many rays as a structure of arrays (each array `count` long), the layout Embree's packets use,
-// so a batch goes to Embree 8 rays at a time without rearranging each ray's fields.
+// so a batch goes to Embree a packet (8 or 16 rays: Scene::packet_width) at a time without
+// rearranging each ray's fields.
 struct RayBatch {
   const float *org_x, *org_y, *org_z;
   const float *dir_x, *dir_y, *dir_z;  // need not be unit; t is in units of |direction|
@@ -53,12 +54,13 @@ struct RayBatch {
   // For a HitRule with groups: per ray, its group (HitRule::group).
   const std::uint32_t* group = nullptr;
   // Consecutive rays are near each other and go the same way (neighbouring texels of a bake):
-  // Embree then traces each packet of 8 together (RTC_INTERSECT_CONTEXT_FLAG_COHERENT), which
+  // Embree then traces each packet together (RTC_INTERSECT_CONTEXT_FLAG_COHERENT), which
   // on the bake's rays takes about 0.6 of the time; the hits are the same.
   bool coherent = false;
   // When not null, the order to cast the rays in (a permutation of 0 .. count - 1, Scene::intersect's
-  // count): packets are made of rays order[0..7], order[8..15], ...; each ray's hit still goes to
-  // its own index. (For making packets of near rays without moving the rays.)
+  // count): packets are made of rays order[0..W-1], order[W..2W-1], ... (W: Scene::packet_width);
+  // each ray's hit still goes to its own index. (For making packets of near rays without moving
+  // the rays.)
   const std::uint32_t* order = nullptr;
 };
 // Their hits, the same way: triangle[i] is no_hit for a miss (t, u, v then unspecified).
@@ -175,8 +177,8 @@ class Scene {
 
   // First hit in (tnear, tfar), or no hit. Thread-safe.
   Hit intersect(const Ray& ray) const;
-  // `count` independent rays, traced as 8-wide packets (rays need not be coherent; RayBatch::coherent
-  // when they are). Thread-safe.
+  // `count` independent rays, traced in packets of packet_width() (rays need not be coherent;
+  // RayBatch::coherent when they are). Thread-safe.
   void intersect(const Ray* rays, Hit* hits, std::size_t count, bool coherent = false) const;
   // The same for rays and hits held as arrays, optionally under a HitRule (whose arrays are
   // indexed by the triangles given at construction). Thread-safe.
@@ -219,6 +221,15 @@ class Scene {
   void first_hits(const RayBatch& rays, const HitBatch& hits, std::size_t count, const SecondaryRayOptions& options = {}) const;
 
   std::size_t triangle_count() const;
+
+  // How many rays intersect(RayBatch, ...) hands Embree at once: 16 where Embree traces packets
+  // of 16 natively (an AVX-512 CPU), else 8. The hits do not depend on it under a HitRule, whose
+  // choice among hits does not depend on the order Embree finds them in; without one, of two
+  // triangles at one distance the packet's traversal decides. set_packet_width (8 or 16; not while
+  // another thread traces) is for tests and benchmarks: 16 on a CPU without native packets of 16
+  // is correct but slow (Embree splits them).
+  int packet_width() const;
+  void set_packet_width(int width);
 
   struct Impl;  // Embree's device and scene (raycast.cpp)
 
