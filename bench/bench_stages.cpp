@@ -12,9 +12,9 @@
 namespace nmbake::bench {
 
 std::vector<raycast::Ray> tile_rays(const Prepared& s, const TileBins& bins, const RaySetup& setup,
-                                    const std::vector<glm::dvec2>& offsets, int width, int height, bool by_texel) {
+                                    const std::vector<glm::dvec2>& offsets, int width, int height) {
   // Slot (k * side + y) * side + x holds sample k of the tile's texel (x, y): its triangle (the
-  // lowest index that covers it) and barycentrics.
+  // lowest index that covers it) and barycentrics. The rays come texel by texel.
   struct Slot {
     std::int32_t tri = -1;
     double b[3] = {0, 0, 0};
@@ -43,14 +43,9 @@ std::vector<raycast::Ray> tile_rays(const Prepared& s, const TileBins& bins, con
             if (slot.tri < 0 && covers(tt, sample_point(x, y, offsets[k].x, offsets[k].y), slot.b)) slot.tri = std::int32_t(t);
           }
     }
-    if (by_texel && offsets.size() > 1) {
-      for (std::size_t i = 0; i < texels; ++i)
-        for (std::size_t k = 0; k < offsets.size(); ++k)
-          if (slots[k * texels + i].tri >= 0) emit(slots[k * texels + i]);
-    } else {
-      for (const Slot& slot : slots)
-        if (slot.tri >= 0) emit(slot);
-    }
+    for (std::size_t i = 0; i < texels; ++i)
+      for (std::size_t k = 0; k < offsets.size(); ++k)
+        if (slots[k * texels + i].tri >= 0) emit(slots[k * texels + i]);
   }
   return out;
 }
@@ -62,9 +57,7 @@ BakeRays bake_rays(const Mesh& low, const Mesh& high, const BakeOptions& o) {
   std::string stage;
   prepare_trace(low, high, nullptr, o, worker_threads(o.threads), in, result, stage);
   const TileBins bins = bin_triangles(low, o.width, o.height, trace_tile_side(o));
-  // Under a hit rule (back faces skipped, or match groups) the trace casts texel by texel.
-  const bool rule = result.stats.distances.backfaces_skipped || !o.low_object_group.empty();
-  return {tile_rays(in.s, bins, in.rays, sample_offsets(o.samples), o.width, o.height, rule), result.stats};
+  return {tile_rays(in.s, bins, in.rays, sample_offsets(o.samples), o.width, o.height), result.stats};
 }
 
 BakeStats trace_by_texel(const Mesh& low, const Mesh& high, const BakeOptions& o) {
@@ -80,7 +73,7 @@ BakeStats trace_by_texel(const Mesh& low, const Mesh& high, const BakeOptions& o
   const auto t0 = std::chrono::steady_clock::now();
   const double cpu0 = process_cpu_seconds();
   const TileBins bins = bin_triangles(low, o.width, o.height, trace_tile_side(o));
-  trace_and_shade(in.s, in.scene, bins, in.rays, o, threads, {result.map, result.coverage, result.miss_mask, disagree}, st, true);
+  trace_and_shade(in.s, in.scene, bins, in.rays, o, threads, {result.map, result.coverage, result.miss_mask, disagree}, st);
   st.trace.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   st.trace.cpu_seconds = process_cpu_seconds() - cpu0;
   return st;

@@ -14,10 +14,9 @@
 namespace nmbake::bench {
 
 // The rays the trace stage casts over `bins` (the same values, bit for bit, in its order): tile by
-// tile; within a tile sample by sample in rows of texels, or, with `by_texel` and several offsets,
-// texel by texel in sample order (trace.cpp's cast_order).
+// tile; within a tile texel by texel in rows, each texel's samples in sample order.
 std::vector<raycast::Ray> tile_rays(const Prepared& s, const TileBins& bins, const RaySetup& setup,
-                                    const std::vector<glm::dvec2>& offsets, int width, int height, bool by_texel);
+                                    const std::vector<glm::dvec2>& offsets, int width, int height);
 
 // The rays bake_normal_map casts with these options (not adaptive; no cage file), in coordinates
 // re-centred on stats.centre, and the stats of the stages before the trace (distances, culling,
@@ -28,9 +27,9 @@ struct BakeRays {
 };
 BakeRays bake_rays(const Mesh& low, const Mesh& high, const BakeOptions& options);
 
-// bake_normal_map's stages up to the trace, then its trace with every texel's samples cast texel
-// by texel whatever the hit rule (so a bake with keep_backfaces casts the packets the bake under
-// the rule casts). The stats, seconds_trace and cpu_seconds_trace timed as the bake times them.
+// bake_normal_map's stages up to the trace, then its trace (texel by texel, with or without the
+// hit rule, as the bake casts). The stats, seconds_trace and cpu_seconds_trace timed as the bake
+// times them.
 BakeStats trace_by_texel(const Mesh& low, const Mesh& high, const BakeOptions& options);
 
 }  // namespace nmbake::bench

@@ -80,26 +80,41 @@ struct RuleContext {
     float key, t, u, v;
     std::uint32_t prim;
   } kept[2][kMaxPacket];
+  // Whether the filter passed a back face or kept a hit since the lanes were last reset: without,
+  // backface_t and kept are as reset, and finish has nothing to do (most packets of a bake).
+  bool marked = false;
 
   explicit RuleContext(const HitRule* r) : rule(r) {
     rtcInitIntersectContext(&context);
     context.filter = r ? &filter : nullptr;
-  }
-  void reset_lanes(int lanes) {
     constexpr float inf = std::numeric_limits<float>::infinity();
-    for (int k = 0; k < lanes; ++k) {
-      backface_t[k] = inf;
-      accepted_t[k] = inf;
-      accepted_prim[k] = no_hit;
+    for (int k = 0; k < kMaxPacket; ++k) {
       prefer_lo[k] = 0.0f;
       prefer_hi[k] = inf;
       group[k] = 0;
+      backface_t[k] = inf;
       for (auto& kk : kept) kk[k] = {inf, 0.0f, 0.0f, 0.0f, no_hit};
     }
   }
+  // The per-lane state of the filter, for the next packet (of `lanes` rays); the rays' own fields
+  // (outward, prefer_lo/hi, group) are the caller's.
+  void reset_lanes(int lanes) {
+    constexpr float inf = std::numeric_limits<float>::infinity();
+    for (int k = 0; k < lanes; ++k) {
+      accepted_t[k] = inf;
+      accepted_prim[k] = no_hit;
+    }
+    if (!marked) return;
+    for (int k = 0; k < lanes; ++k) {
+      backface_t[k] = inf;
+      for (auto& kk : kept) kk[k] = {inf, 0.0f, 0.0f, 0.0f, no_hit};
+    }
+    marked = false;
+  }
   // Keeps the hit when its key is smaller (equal keys: the lower triangle index, whatever order
   // Embree found them in).
-  static void keep(Kept& k, float key, float t, float u, float v, std::uint32_t prim) {
+  void keep(Kept& k, float key, float t, float u, float v, std::uint32_t prim) {
+    marked = true;
     if (key < k.key || (key == k.key && prim < k.prim)) k = {key, t, u, v, prim};
   }
 
@@ -128,6 +143,7 @@ struct RuleContext {
       const float front = code < 0 ? -glm::dot(ng, out) : glm::dot(ng, out);
       if (front < 0.0f && rule.skip_backfaces) {
         rc.backface_t[lane] = std::min(rc.backface_t[lane], t);
+        rc.marked = true;
         args->valid[i] = 0;
         continue;
       }
@@ -141,13 +157,13 @@ struct RuleContext {
         const glm::vec3* c = rule.corner_normals + 3 * std::size_t(prim);
         const glm::vec3 nh = (1.0f - u - v) * c[0] + u * c[1] + v * c[2];
         if (!(glm::dot(nh, out) > 0.0f)) {
-          keep(rc.kept[1][lane], t, t, u, v, prim);
+          rc.keep(rc.kept[1][lane], t, t, u, v, prim);
           args->valid[i] = 0;
           continue;
         }
       }
       if (t < rc.prefer_lo[lane] || t > rc.prefer_hi[lane]) {
-        keep(rc.kept[0][lane], t < rc.prefer_lo[lane] ? rc.prefer_lo[lane] - t : t - rc.prefer_hi[lane], t, u, v, prim);
+        rc.keep(rc.kept[0][lane], t < rc.prefer_lo[lane] ? rc.prefer_lo[lane] - t : t - rc.prefer_hi[lane], t, u, v, prim);
         args->valid[i] = 0;
         continue;
       }
@@ -164,6 +180,7 @@ struct RuleContext {
   // Embree's hit, else the fallback; its flags.
   std::uint8_t finish(int k, std::uint32_t& prim, float& t, float& u, float& v) const {
     std::uint8_t flags = 0;
+    if (!marked) return flags;
     for (int j = 0; j < 2 && prim == no_hit; ++j)
       if (kept[j][k].prim != no_hit) {
         prim = kept[j][k].prim;
@@ -388,7 +405,7 @@ Hit Scene::intersect(const Ray& ray) const {
 Hit Scene::intersect(const Ray& ray, const HitRule& rule, bool outward, std::uint8_t* flags, float prefer_lo, float prefer_hi,
                      std::uint32_t group) const {
   RuleContext rc(&rule);
-  rc.reset_lanes(1);
+  rc.reset_lanes(1);  // accepted_t, accepted_prim
   rc.group[0] = group;
   rc.outward[0] = outward;
   rc.prefer_lo[0] = prefer_lo;
@@ -462,13 +479,13 @@ void intersect_packets(RTCScene scene, const RayBatch& rays, const HitBatch& hit
     }
     if (rule) {
       rc.reset_lanes(K);
-      for (std::size_t k = 0; k < K; ++k) {
-        const std::size_t i = ray[k];
-        rc.outward[k] = rays.outward ? rays.outward[i] : 0;
-        if (rays.prefer_lo) rc.prefer_lo[k] = rays.prefer_lo[i];
-        if (rays.prefer_hi) rc.prefer_hi[k] = rays.prefer_hi[i];
-        if (rays.group) rc.group[k] = rays.group[i];
-      }
+      // The rays' own fields; those the batch leaves out keep the constructor's.
+      if (rays.outward)
+        for (std::size_t k = 0; k < K; ++k) rc.outward[k] = rays.outward[ray[k]];
+      if (rays.prefer_lo) fill(rc.prefer_lo, rays.prefer_lo);
+      if (rays.prefer_hi) fill(rc.prefer_hi, rays.prefer_hi);
+      if (rays.group)
+        for (std::size_t k = 0; k < K; ++k) rc.group[k] = rays.group[ray[k]];
     }
     rc.context.flags =
         rays.coherent && one_octant<K>(rh) ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
@@ -476,11 +493,15 @@ void intersect_packets(RTCScene scene, const RayBatch& rays, const HitBatch& hit
     else rtcIntersect8(valid, scene, &rc.context, &rh);
     for (std::size_t k = 0; k < K; ++k)
       rh.hit.primID[k] = rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID ? rh.hit.primID[k] : no_hit;
-    if (rule) {
+    if (rule && rc.marked) {
       for (std::size_t k = 0; k < n; ++k) {
         const std::uint8_t f = rc.finish(int(k), rh.hit.primID[k], rh.ray.tfar[k], rh.hit.u[k], rh.hit.v[k]);
         if (hits.flags) hits.flags[ray[k]] = f;
       }
+    } else if (rule && hits.flags) {
+      if (in_place) std::memset(hits.flags + base, 0, K);
+      else
+        for (std::size_t k = 0; k < n; ++k) hits.flags[ray[k]] = 0;
     }
     if (in_place) {
       std::memcpy(hits.triangle + base, rh.hit.primID, K * sizeof(std::uint32_t));

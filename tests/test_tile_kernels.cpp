@@ -237,6 +237,80 @@ TEST(TileKernels, CageRaysAreCageRayBitForBit) {
   EXPECT_GT(on_low, 50u);   // cage points on the low-poly were reached and flagged
 }
 
+TEST(TileKernels, CoverRectSamplesIsCoverRectPerOffset) {
+  // cover_rect_samples lays a texel's samples side by side; each slot must hold exactly what
+  // cover_rect gives for that one offset (coverage, barycentrics, rays, fallback flags, cage
+  // fields), including a second triangle over the first (slots kept, the rest counted). 1 to 17
+  // samples: short last groups of four; the bake's grids and Hammersley points; corners on texel
+  // centres (ties and edge insets), with and without a cage.
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f), out(0.0f, 0.2f);
+  std::size_t compared = 0, fallbacks = 0;
+  for (int i = 0; i < 120; ++i) {
+    const int count = 1 + i % 17;
+    const std::vector<glm::dvec2> offsets = sample_offsets(count);
+    std::vector<double> ox, oy;
+    for (const glm::dvec2& o : offsets) ox.push_back(o.x), oy.push_back(o.y);
+    glm::vec2 uv[2][3];
+    for (auto& tri : uv)
+      for (glm::vec2& c : tri) c = {u(rng), u(rng)};
+    if (i % 3 == 0)
+      for (auto& tri : uv)
+        for (glm::vec2& c : tri) c = (glm::floor(c * 24.0f) + 0.5f) / 24.0f;
+    const TexelTriangle tt[2] = {setup_texel_triangle(uv[0][0], uv[0][1], uv[0][2], 24, 24),
+                                 setup_texel_triangle(uv[1][0], uv[1][1], uv[1][2], 24, 24)};
+    const LowTriangle lt[2] = {random_ray_triangle(rng), random_ray_triangle(rng)};
+    CageTriangle ct[2];
+    for (int t = 0; t < 2; ++t)
+      for (int c = 0; c < 3; ++c) {
+        ct[t].corner[c] = i % 10 == 5 ? lt[t].p[c] : lt[t].p[c] + double(out(rng)) * lt[t].ray_n[c];
+        ct[t].rear[c] = double(out(rng));
+        ct[t].search[c] = i % 4 == 0 ? 0.0 : 2.0 * double(out(rng));
+      }
+    const bool cage = i % 2 == 1;
+    const KernelRays rays = cage ? KernelRays{lt, 0.0f, ct, 3.0} : KernelRays{lt, 0.02f};
+    // The whole 24 x 24 map as one rectangle; rows padded, as in a tile.
+    constexpr int kSide = 24;
+    const std::size_t stride = kSide + 2, n = stride * kSide * std::size_t(count);
+    Slots together(n, cage);
+    std::vector<Slots> apart(std::size_t(count), Slots(stride * kSide, cage));
+    for (int t = 0; t < 2; ++t) {
+      if (!tt[t].valid() || tt[t].xmax < tt[t].xmin || tt[t].ymax < tt[t].ymin) continue;
+      const int x0 = tt[t].xmin, x1 = tt[t].xmax, y0 = tt[t].ymin, y1 = tt[t].ymax;
+      std::size_t taken = 0;
+      for (int k = 0; k < count; ++k)
+        taken += cover_rect(tt[t], t, x0, x1, y0, y1, ox[std::size_t(k)], oy[std::size_t(k)], rays, apart[std::size_t(k)].view,
+                            std::size_t(y0) * stride + std::size_t(x0), stride);
+      EXPECT_EQ(
+          cover_rect_samples(tt[t], t, x0, x1, y0, y1, ox.data(), oy.data(), count, rays, together.view,
+                             (std::size_t(y0) * stride + std::size_t(x0)) * std::size_t(count), stride * std::size_t(count)),
+          taken)
+          << i;
+    }
+    for (std::size_t s = 0; s < stride * kSide; ++s)
+      for (std::size_t k = 0; k < std::size_t(count); ++k) {
+        const Slots& a = apart[k];
+        const std::size_t j = s * std::size_t(count) + k, m = stride * kSide;
+        ASSERT_EQ(together.tri[j], a.tri[s]) << i << ": slot " << s << " sample " << k;
+        if (a.tri[s] < 0) continue;
+        ++compared;
+        for (int c = 0; c < 3; ++c) EXPECT_TRUE(same_bits(together.b[std::size_t(c) * n + j], a.b[std::size_t(c) * m + s])) << i;
+        EXPECT_EQ(together.fallback[j], a.fallback[s]) << i;
+        fallbacks += a.fallback[s];
+        if (a.fallback[s]) continue;  // the caller makes that ray
+        for (int c = 0; c < 6; ++c)
+          EXPECT_TRUE(same_bits(together.ray[std::size_t(c) * n + j], a.ray[std::size_t(c) * m + s])) << i;
+        if (cage) {
+          EXPECT_TRUE(same_bits(together.tfar[j], a.tfar[s])) << i;
+          EXPECT_TRUE(same_bits(together.base[j], a.base[s])) << i;
+          EXPECT_TRUE(same_bits(together.prefer_lo[j], a.prefer_lo[s])) << i;
+        }
+      }
+  }
+  EXPECT_GT(compared, 50000u);
+  EXPECT_GT(fallbacks, 100u);  // edge insets and cage points on the low-poly were reached
+}
+
 TEST(TileKernels, WriteTexelRowIsTheTexelFormula) {
   std::mt19937 rng(17);
   std::uniform_real_distribution<double> u(-2.0, 2.0);
@@ -307,13 +381,13 @@ TEST(TileKernels, CompactAndAccumulateKeepSampleOrder) {
                              cage ? tfar.data() : nullptr,
                              cage ? base.data() : nullptr,
                              cage ? prefer_lo.data() : nullptr};
-    const std::size_t count = compact_samples(slots.view, n, kTexels, true, out);
+    const std::size_t count = compact_samples(slots.view, n, std::size_t(samples), true, out);
     std::size_t r = 0;
     for (std::size_t i = 0; i < n; ++i) {
       if (slots.tri[i] < 0) continue;
       ASSERT_LT(r, count);
       EXPECT_EQ(tri[r], slots.tri[i]) << i;
-      EXPECT_EQ(texel[r], i % kTexels) << i;
+      EXPECT_EQ(texel[r], i / std::size_t(samples)) << i;
       EXPECT_EQ(fallback[r], slots.fallback[i]) << i;
       for (int c = 0; c < 3; ++c) EXPECT_TRUE(same_bits(b[std::size_t(c) * n + r], slots.b[std::size_t(c) * n + i])) << i;
       for (int c = 0; c < 6; ++c) EXPECT_TRUE(same_bits(ray[std::size_t(c) * n + r], slots.ray[std::size_t(c) * n + i])) << i;
@@ -340,7 +414,7 @@ TEST(TileKernels, CompactAndAccumulateKeepSampleOrder) {
                                   same.view.tfar,
                                   same.view.base,
                                   same.view.prefer_lo};
-    ASSERT_EQ(compact_samples(same.view, n, kTexels, true, in_place), count);
+    ASSERT_EQ(compact_samples(same.view, n, std::size_t(samples), true, in_place), count);
     for (std::size_t k = 0; k < count; ++k) {
       EXPECT_EQ(same.tri[k], tri[k]) << k;
       EXPECT_EQ(same_texel[k], texel[k]) << k;

@@ -54,9 +54,10 @@ inline bool inset_from_edges(double bary[3]) {
 // the first products (one per edge, shared by a row of samples). A sample is covered by edge k when
 // strictly inside, or on the edge with this triangle on the edge's positive side: of two triangles
 // sharing an edge exactly one covers it. `in` is and-ed with the result (a bool, or a lane mask);
-// w receives the unnormalized barycentric weights.
-template <typename T, typename Mask>
-[[gnu::always_inline]] inline void edge_weights(Mask& in, T w[3], const TexelTriangle& tri, const double row[3], const T& qx,
+// w receives the unnormalized barycentric weights. (`row` may also be per lane: samples of one
+// texel at different heights.)
+template <typename T, typename Mask, typename Row>
+[[gnu::always_inline]] inline void edge_weights(Mask& in, T w[3], const TexelTriangle& tri, const Row row[3], const T& qx,
                                                 const T& zero) {
   for (int k = 0; k < 3; ++k) {
     const T e = row[k] - tri.edge_d[k].y * (qx - tri.edge_a[k].x);

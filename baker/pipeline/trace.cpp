@@ -59,7 +59,6 @@ struct Shared {
   bool per_object = false;  // several objects: hits counted per object
   const raycast::HitRule* hit_rule = nullptr;
   bool prefer = false;              // the rule looks at the rays' preferred parts (back faces skipped)
-  bool by_texel = false;            // cast texel by texel even without a rule (trace_and_shade's by_texel)
   RayGroups groups;                 // with --match: per low-poly triangle and BVH triangle
   const MapInputs* maps = nullptr;  // the extra maps (TraceTargets::maps), or null: none
   std::vector<ThreadStats> stats;
@@ -71,12 +70,14 @@ struct Shared {
 };
 
 // One thread's buffers and its walk over the tiles it takes. Sample slots of a tile: sample k of
-// tile texel (x, y) is slot (k * side + y) * side + x, so a texel row is contiguous for the
-// coverage kernel. The covered samples are compacted in slot order, which puts each texel's samples
-// in sample order: that fixes how its values are summed. Rays and hits are arrays, the layout
-// Embree's packets take; sample r casts rays r * rays_per_sample onwards. The coverage fills slots
-// in these same arrays (with the default policy's one ray per sample, slot i's ray is ray i), and
-// the compaction closes the gaps in place: a fully covered stretch of slots stays where it is.
+// tile texel (x, y) is slot (y * side + x) * samples + k, a texel's samples side by side
+// (cover_rect_samples). The covered samples are compacted in slot order, which puts each texel's
+// samples together in sample order: that fixes how its values are summed, and a packet of rays is
+// a texel's samples (or, with one sample, a row of texels), which Embree traces faster than rays
+// spread over texels. Rays and hits are arrays, the layout Embree's packets take; sample r casts
+// rays r * rays_per_sample onwards. The coverage fills slots in these same arrays (with the default
+// policy's one ray per sample, slot i's ray is ray i), and the compaction closes the gaps in place:
+// a fully covered stretch of slots stays where it is.
 class TileTracer {
  public:
   TileTracer(Shared& sh, int id)
@@ -219,7 +220,6 @@ class TileTracer {
     const std::size_t sample_count = cover_tile(tile, rect, offsets, only);
     const std::size_t ray_count = sample_count * std::size_t(sh_.rays_per_sample);
     make_rays(sample_count);
-    batch_.order = cast_order(offsets, sample_count);
     if (sh_.groups.active()) set_groups(sample_count);
     if (ray_count) {
       sh_.scene.scene->intersect(batch_, hits_, ray_count, sh_.hit_rule);
@@ -284,13 +284,13 @@ class TileTracer {
                          const std::uint8_t* only) {
     const TileBins& bins = sh_.bins;
     const int tx0 = rect.x0, ty0 = rect.y0, tw = rect.w, th = rect.h;
-    // Sample k of texel (x, y) is slot (k * rows + y - y_first) * side + x: the first pass lays out
-    // every row of the tile, a refining pass only its rows y_first .. y_first + rows - 1 that hold
-    // marked texels (the same samples in the same order, in fewer slots to clear and compact).
+    // Sample k of texel (x, y) is slot ((y - y_first) * side + x) * samples + k: the first pass lays
+    // out every row of the tile, a refining pass only its rows y_first .. y_first + rows - 1 that
+    // hold marked texels (the same samples in the same order, in fewer slots to clear and compact).
     int y_first = 0, rows = side_;
     if (only && !marked_rows(only, tw, th, y_first, rows)) return last_sample_count_ = 0;
-    const std::size_t band = std::size_t(rows) * std::size_t(side_);  // slots per sample offset
-    const std::size_t slot_count = band * offsets.size();
+    const std::size_t per = offsets.size(), band = std::size_t(rows) * std::size_t(side_);  // band: texels laid out
+    const std::size_t slot_count = band * per;
     std::fill(sample_tri_.begin(), sample_tri_.begin() + std::ptrdiff_t(slot_count), -1);
     const bool cage = kernel_rays_ && sh_.setup.cage;
     const SampleSlots slots{sample_tri_.data(),
@@ -306,14 +306,17 @@ class TileTracer {
     // A refining pass covers, row by row, only the span of the row's marked texels (span_): a
     // slot's result does not depend on the rectangle it is covered in, and the others are dropped
     // below.
+    offset_x_.resize(per);
+    offset_y_.resize(per);
+    for (std::size_t k = 0; k < per; ++k) offset_x_[k] = offsets[k].x, offset_y_[k] = offsets[k].y;
     const auto cover = [&](const TexelTriangle& tt, std::uint32_t t, int x0, int x1, int y0, int y1) {
-      for (std::size_t k = 0; k < offsets.size(); ++k) {
-        const std::size_t first =
-            (k * std::size_t(rows) + std::size_t(y0 - ty0 - y_first)) * std::size_t(side_) + std::size_t(x0 - tx0);
-        const std::size_t taken = cover_rect(tt, std::int32_t(t), x0, x1, y0, y1, offsets[k].x, offsets[k].y, kernel_rays, slots,
-                                             first, std::size_t(side_));
-        if (!only) ts_.overlaps += taken;  // a refining pass covers again what the first counted
-      }
+      const std::size_t first = (std::size_t(y0 - ty0 - y_first) * std::size_t(side_) + std::size_t(x0 - tx0)) * per;
+      const std::size_t taken = per == 1
+                                    ? cover_rect(tt, std::int32_t(t), x0, x1, y0, y1, offset_x_[0], offset_y_[0], kernel_rays,
+                                                 slots, first, std::size_t(side_))
+                                    : cover_rect_samples(tt, std::int32_t(t), x0, x1, y0, y1, offset_x_.data(), offset_y_.data(),
+                                                         int(per), kernel_rays, slots, first, std::size_t(side_) * per);
+      if (!only) ts_.overlaps += taken;  // a refining pass covers again what the first counted
     };
     for (std::uint32_t bi = bins.start[tile]; bi < bins.start[tile + 1]; ++bi) {
       const std::uint32_t t = bins.tris[bi];
@@ -331,13 +334,13 @@ class TileTracer {
       }
     }
     if (only)  // the unmarked texels within the rows' spans
-      for (std::size_t k = 0; k < offsets.size(); ++k)
-        for (int r = 0; r < rows; ++r) {
-          const int y = y_first + r;
-          const std::size_t row = (k * std::size_t(rows) + std::size_t(r)) * std::size_t(side_);
-          for (int x = span_[std::size_t(y)].first; x <= span_[std::size_t(y)].second; ++x)
-            if (!only[std::size_t(y) * std::size_t(side_) + std::size_t(x)]) sample_tri_[row + std::size_t(x)] = -1;
-        }
+      for (int r = 0; r < rows; ++r) {
+        const int y = y_first + r;
+        const std::size_t row = std::size_t(r) * std::size_t(side_);
+        for (int x = span_[std::size_t(y)].first; x <= span_[std::size_t(y)].second; ++x)
+          if (!only[std::size_t(y) * std::size_t(side_) + std::size_t(x)])
+            std::fill_n(sample_tri_.begin() + std::ptrdiff_t((row + std::size_t(x)) * per), per, -1);
+      }
     const CoveredSamples covered{sample_tri_.data(),
                                  {sb_[0], sb_[1], sb_[2]},
                                  sample_texel_.data(),
@@ -347,34 +350,10 @@ class TileTracer {
                                  slots.tfar,
                                  slots.base,
                                  slots.prefer_lo};
-    last_sample_count_ = compact_samples(slots, slot_count, band, kernel_rays_, covered);
+    last_sample_count_ = compact_samples(slots, slot_count, per, kernel_rays_, covered);
     if (y_first > 0)  // texel indices within the band, made the tile's
       for (std::size_t r = 0; r < last_sample_count_; ++r) sample_texel_[r] = std::uint16_t(sample_texel_[r] + y_first * side_);
     return last_sample_count_;
-  }
-
-  // The order the rays are cast in (raycast::RayBatch::order), or null for their own: with several
-  // samples per texel under a hit rule, texel by texel, each texel's in sample
-  // order. The compaction orders the samples sample by sample, rows of texels, so a packet of 8 rays
-  // spanned 8 texels (8 far-apart marked ones in a refining pass of --samples auto); a texel's
-  // samples lie within its footprint, and Embree traces such packets faster. Hits land at each
-  // ray's own index: everything after the cast reads the samples in their order, as before.
-  const std::uint32_t* cast_order(const std::vector<glm::dvec2>& offsets, std::size_t count) {
-    // Only under a hit rule, whose hit does not depend on which rays share a packet. Without one, of
-    // two triangles at one distance Embree keeps the one its traversal meets last, and a packet's
-    // traversal order depends on all its rays (a bake with --keep-backfaces moved a texel). The
-    // bench's timing without the rule asks for it anyway (trace_and_shade's by_texel).
-    if ((!sh_.hit_rule && !sh_.by_texel) || offsets.size() < 2 || count < 2) return nullptr;
-    texel_start_.assign(tile_texels_ + 1, 0);
-    for (std::size_t r = 0; r < count; ++r) ++texel_start_[std::size_t(sample_texel_[r]) + 1];
-    for (std::size_t i = 1; i <= tile_texels_; ++i) texel_start_[i] += texel_start_[i - 1];
-    const std::uint32_t per = std::uint32_t(sh_.rays_per_sample);
-    order_.resize(count * per);
-    for (std::size_t r = 0; r < count; ++r) {
-      const std::size_t at = std::size_t(texel_start_[sample_texel_[r]]++) * per;
-      for (std::uint32_t j = 0; j < per; ++j) order_[at + j] = std::uint32_t(r) * per + j;
-    }
-    return order_.data();
   }
 
   // Per row of the tile, the first and last texel `only` marks (first > last: none), in span_; the
@@ -570,10 +549,10 @@ class TileTracer {
   std::size_t last_sample_count_ = 0;      // covered samples of the last cover_tile
   std::vector<double> first_acc_;          // adaptive: the sums so far while a refining pass runs
   std::vector<std::uint32_t> first_miss_;
-  std::vector<std::uint32_t> texel_start_, order_;  // cast_order
-  std::unique_ptr<TexelMaps> maps_;                 // the extra maps, or null
-  std::vector<double> sample_dist_;                 // with maps_: per covered sample, count_hits' signed distance
-  int pass_level_ = 0;                              // the pass under way: 0 the first, then the refining levels
+  std::vector<double> offset_x_, offset_y_;  // cover_tile: the pass's sample offsets
+  std::unique_ptr<TexelMaps> maps_;          // the extra maps, or null
+  std::vector<double> sample_dist_;          // with maps_: per covered sample, count_hits' signed distance
+  int pass_level_ = 0;                       // the pass under way: 0 the first, then the refining levels
 };
 
 // The trace's hit rule (trace_rule), its match groups and whether it looks at preferred parts;
@@ -610,11 +589,10 @@ std::vector<glm::dvec3> trace_texels(const Prepared& s, const HighScene& scene, 
 }
 
 void trace_and_shade(const Prepared& s, const HighScene& scene, const TileBins& bins, const RaySetup& rays,
-                     const BakeOptions& opt, int threads, const TraceTargets& out, BakeStats& st, bool by_texel) {
+                     const BakeOptions& opt, int threads, const TraceTargets& out, BakeStats& st) {
   Shared sh(s, scene, bins, rays, opt, out, threads);
   raycast::HitRule rule;
   set_rule(sh, st, rule);
-  sh.by_texel = by_texel;
   if (out.map_inputs) {
     out.map_inputs->groups = &sh.groups;
     sh.maps = out.map_inputs;

@@ -34,10 +34,8 @@ struct TraceTargets {
 // false. Fills in `st.trace`: rays, hits, misses, samples_covered, overlapping_samples, backface_skips,
 // hits_facing_away, hit_distance_*, texels_total, texels_covered, coverage.
 // Calls options.progress from the calling thread; throws Cancelled when it returns false.
-// `by_texel`: several samples per texel cast texel by texel even without the hit rule, as under it
-// (cast_order in trace.cpp; a map may then differ in ties between triangles at one distance).
 void trace_and_shade(const Prepared& s, const HighScene& scene, const TileBins& bins, const RaySetup& rays,
-                     const BakeOptions& opt, int threads, const TraceTargets& out, BakeStats& st, bool by_texel = false);
+                     const BakeOptions& opt, int threads, const TraceTargets& out, BakeStats& st);
 
 // The texels `texels` (indices y * width + x, each once) of `bins` traced as trace_and_shade traces
 // them, by the same tracer, with the samples of opt.samples (sample_offsets; opt.adaptive false);

@@ -105,12 +105,13 @@ template <bool same_triangle>
 
 }  // namespace
 
-// Two versions, chosen once at load time by the CPU: AVX2 (4 lanes per instruction) and the
-// baseline (2 lanes per SSE2 instruction). Neither uses FMA, so both give the scalar code's bits.
-__attribute__((target_clones("avx2", "default"))) void encode_hits_per_pixel(const LowTriangle* low,
-                                                                             const glm::vec3* high_corner_normals,
-                                                                             const ShadeSamples& samples, std::size_t count,
-                                                                             double* const value[3], std::uint8_t* degenerate) {
+// Three versions, chosen once at load time by the CPU: AVX-512 (x86-64-v4: the same 4 lanes, with
+// twice the registers to hold them), AVX2 (4 lanes per instruction) and the baseline (2 lanes per
+// SSE2 instruction). None uses FMA (-ffp-contract=off for this library: x86-64-v4 has it), so all
+// give the scalar code's bits.
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) void encode_hits_per_pixel(
+    const LowTriangle* low, const glm::vec3* high_corner_normals, const ShadeSamples& samples, std::size_t count,
+    double* const value[3], std::uint8_t* degenerate) {
   for (std::size_t i = 0; i < count; i += kLanes) {
     const std::int32_t* lt = samples.low_tri;
     if (i + kLanes <= count && lt[i] == lt[i + 1] && lt[i] == lt[i + 2] && lt[i] == lt[i + 3])

@@ -60,6 +60,109 @@ struct CageLanes {
   r.prefer_lo = s > len ? s - len : zero;
 }
 
+// The texels x0 <= x <= x1 of one row whose sample at x offset ox can be covered, xa .. xb: each
+// edge's value is linear in x, with one sign on one side of where it crosses 0 and the other on
+// the other. The bounds have a margin far above the rounding of that crossing (relative to the
+// terms it sums) and of the edge values near it; the coverage test decides every texel in them.
+// row_term: each edge's first product at the row's sample height. Returns false when none can be.
+[[gnu::always_inline]] inline bool row_bounds(const TexelTriangle& tt, const double row_term[3], const double inv_dy[3],
+                                              double ox, int x0, int x1, int& xa, int& xb) {
+  xa = x0, xb = x1;
+  for (int k = 0; k < 3; ++k) {
+    const double dy = tt.edge_d[k].y;
+    if (dy == 0.0) continue;  // the edge's value does not change along the row
+    const double along = row_term[k] * inv_dy[k];
+    const double cross = tt.edge_a[k].x + along - ox;
+    if (!(cross >= -DBL_MAX && cross <= DBL_MAX)) continue;  // not finite: no bound
+    const double slack = 1e-6 * (1.0 + std::fabs(tt.edge_a[k].x) + std::fabs(along) + std::fabs(ox));
+    if ((tt.edge_side[k] > 0.0) == (dy > 0.0)) {  // covered only up to the crossing
+      const double hi = std::floor(cross + slack);
+      if (hi < double(xa)) return false;
+      if (hi < double(xb)) xb = int(hi);
+    } else {  // covered only from the crossing on
+      const double lo = std::ceil(cross - slack);
+      if (lo > double(xb)) return false;
+      if (lo > double(xa)) xa = int(lo);
+    }
+  }
+  return true;
+}
+
+// Four lanes of samples of triangle t (those `m` marks covered, barycentrics b before any inset)
+// into slots slot0 .. slot0 + 3, with their rays when rays.low: each slot that already holds a
+// triangle is left as it is and counted. Returns that count.
+[[gnu::always_inline]] inline std::size_t store_lanes(unsigned m, const V (&b)[3], std::int32_t t, const KernelRays& rays,
+                                                      const SampleSlots& slots, std::size_t slot0) {
+  const V zero = {0.0, 0.0, 0.0, 0.0};
+  CageLanes cr{{zero, zero, zero}, {zero, zero, zero}, zero, zero, zero};
+  V3& org = cr.org;
+  V3& dir = cr.dir;
+  unsigned good = 0;
+  if (rays.cage) {
+    cage_ray_lanes(rays.low[t], rays.cage[t], rays.diagonal, b, cr, good);
+  } else if (rays.low) {
+    default_ray_lanes(rays.low[t], double(rays.front), b, org, dir, good);
+  }
+  const F of[3] = {__builtin_convertvector(org.x, F), __builtin_convertvector(org.y, F), __builtin_convertvector(org.z, F)};
+  const F df[3] = {__builtin_convertvector(dir.x, F), __builtin_convertvector(dir.y, F), __builtin_convertvector(dir.z, F)};
+  const F far = __builtin_convertvector(cr.far, F), lo = __builtin_convertvector(cr.prefer_lo, F);
+  if (m == 0xfu) {
+    // The common case, four lanes at once: all four samples covered, their slots free, none
+    // near enough to an edge to be moved in (inset_from_edges leaves them as they are).
+    I held;
+    std::memcpy(&held, &slots.tri[slot0], sizeof held);
+    const M far_from_edges = (b[0] >= kEdgeInset) & (b[1] >= kEdgeInset) & (b[2] >= kEdgeInset);
+    if (bits(held < 0) == 0xfu && bits(far_from_edges) == 0xfu) {
+      const I tris = {t, t, t, t};
+      std::memcpy(&slots.tri[slot0], &tris, sizeof tris);
+      for (int c = 0; c < 3; ++c) std::memcpy(&slots.b[c][slot0], &b[c], sizeof(V));
+      if (!rays.low) return 0;
+      for (int c = 0; c < 3; ++c) {
+        std::memcpy(&slots.org[c][slot0], &of[c], sizeof(F));
+        std::memcpy(&slots.dir[c][slot0], &df[c], sizeof(F));
+      }
+      if (rays.cage) {
+        std::memcpy(&slots.tfar[slot0], &far, sizeof(F));
+        std::memcpy(&slots.base[slot0], &cr.base, sizeof(V));
+        std::memcpy(&slots.prefer_lo[slot0], &lo, sizeof(F));
+      }
+      store_flags(&slots.ray_fallback[slot0], ~good);
+      return 0;
+    }
+  }
+  std::size_t taken = 0;
+  for (int k = 0; k < kLanes; ++k) {
+    if (!(m >> k & 1u)) continue;
+    const std::size_t slot = slot0 + std::size_t(k);
+    if (slots.tri[slot] >= 0) {
+      ++taken;
+      continue;
+    }
+    double bk[3] = {b[0][k], b[1][k], b[2][k]};
+    const bool moved = inset_from_edges(bk);
+    slots.tri[slot] = t;
+    for (int c = 0; c < 3; ++c) slots.b[c][slot] = bk[c];
+    if (!rays.low) continue;
+    // A sample moved in from an edge has other barycentrics than the ray was made with.
+    slots.ray_fallback[slot] = moved || !(good >> k & 1u);
+    for (int c = 0; c < 3; ++c) {
+      slots.org[c][slot] = of[c][k];
+      slots.dir[c][slot] = df[c][k];
+    }
+    if (rays.cage) {
+      slots.tfar[slot] = far[k];
+      slots.base[slot] = cr.base[k];
+      slots.prefer_lo[slot] = lo[k];
+    }
+  }
+  return taken;
+}
+
+// 1 / d.y of each edge, for row_bounds (which need not be exact).
+[[gnu::always_inline]] inline void inverse_dy(const TexelTriangle& tt, double inv_dy[3]) {
+  for (int k = 0; k < 3; ++k) inv_dy[k] = tt.edge_d[k].y != 0.0 ? 1.0 / tt.edge_d[k].y : 0.0;
+}
+
 }  // namespace
 
 // Two versions, chosen once at load time by the CPU: AVX2 and the SSE2 baseline. Neither uses FMA,
@@ -70,38 +173,16 @@ __attribute__((target_clones("avx2", "default"))) std::size_t cover_rect(const T
                                                                          std::size_t first, std::size_t row_stride) {
   std::size_t taken = 0;
   const V zero = {0.0, 0.0, 0.0, 0.0};
-  double inv_dy[3];  // for the rows' bounds, which need not be exact
-  for (int k = 0; k < 3; ++k) inv_dy[k] = tt.edge_d[k].y != 0.0 ? 1.0 / tt.edge_d[k].y : 0.0;
+  double inv_dy[3];
+  inverse_dy(tt, inv_dy);
   for (int y = y0; y <= y1; ++y) {
     const double qy = y + oy;
     // Edge k's value at q is d.x * (q.y - a.y) - d.y * (q.x - a.x); the first product is the row's.
     double row_term[3];
     for (int k = 0; k < 3; ++k) row_term[k] = tt.edge_d[k].x * (qy - tt.edge_a[k].y);
     const std::size_t row = first + std::size_t(y - y0) * row_stride;
-    // The row's texels that can be covered, xa .. xb: each edge's value is linear in x, with one
-    // sign on one side of where it crosses 0 and the other on the other. The bounds have a margin
-    // far above the rounding of that crossing (relative to the terms it sums) and of the edge
-    // values near it; the test below decides every texel in them.
-    int xa = x0, xb = x1;
-    bool empty = false;
-    for (int k = 0; k < 3 && !empty; ++k) {
-      const double dy = tt.edge_d[k].y;
-      if (dy == 0.0) continue;  // the edge's value does not change along the row
-      const double along = row_term[k] * inv_dy[k];
-      const double cross = tt.edge_a[k].x + along - ox;
-      if (!(cross >= -DBL_MAX && cross <= DBL_MAX)) continue;  // not finite: no bound
-      const double slack = 1e-6 * (1.0 + std::fabs(tt.edge_a[k].x) + std::fabs(along) + std::fabs(ox));
-      if ((tt.edge_side[k] > 0.0) == (dy > 0.0)) {  // covered only up to the crossing
-        const double hi = std::floor(cross + slack);
-        if (hi < double(xa)) empty = true;
-        else if (hi < double(xb)) xb = int(hi);
-      } else {  // covered only from the crossing on
-        const double lo = std::ceil(cross - slack);
-        if (lo > double(xb)) empty = true;
-        else if (lo > double(xa)) xa = int(lo);
-      }
-    }
-    if (empty) continue;
+    int xa, xb;
+    if (!row_bounds(tt, row_term, inv_dy, ox, x0, x1, xa, xb)) continue;
     for (int x = xa; x <= xb; x += kLanes) {
       const V qx = V{double(x), double(x + 1), double(x + 2), double(x + 3)} + ox;
       M in = {x <= xb ? -1 : 0, x + 1 <= xb ? -1 : 0, x + 2 <= xb ? -1 : 0, x + 3 <= xb ? -1 : 0};
@@ -112,66 +193,57 @@ __attribute__((target_clones("avx2", "default"))) std::size_t cover_rect(const T
       const unsigned m = bits(in);
       if (!m) continue;
       normalize_weights(b, w, sum);
-      CageLanes cr{{zero, zero, zero}, {zero, zero, zero}, zero, zero, zero};
-      V3& org = cr.org;
-      V3& dir = cr.dir;
-      unsigned good = 0;
-      if (rays.cage) {
-        cage_ray_lanes(rays.low[t], rays.cage[t], rays.diagonal, b, cr, good);
-      } else if (rays.low) {
-        default_ray_lanes(rays.low[t], double(rays.front), b, org, dir, good);
-      }
-      const F of[3] = {__builtin_convertvector(org.x, F), __builtin_convertvector(org.y, F), __builtin_convertvector(org.z, F)};
-      const F df[3] = {__builtin_convertvector(dir.x, F), __builtin_convertvector(dir.y, F), __builtin_convertvector(dir.z, F)};
-      const F far = __builtin_convertvector(cr.far, F), lo = __builtin_convertvector(cr.prefer_lo, F);
-      const std::size_t slot0 = row + std::size_t(x - x0);
-      if (m == 0xfu) {
-        // The common case, four lanes at once: all four samples covered, their slots free, none
-        // near enough to an edge to be moved in (inset_from_edges leaves them as they are).
-        I held;
-        std::memcpy(&held, &slots.tri[slot0], sizeof held);
-        const M far_from_edges = (b[0] >= kEdgeInset) & (b[1] >= kEdgeInset) & (b[2] >= kEdgeInset);
-        if (bits(held < 0) == 0xfu && bits(far_from_edges) == 0xfu) {
-          const I tris = {t, t, t, t};
-          std::memcpy(&slots.tri[slot0], &tris, sizeof tris);
-          for (int c = 0; c < 3; ++c) std::memcpy(&slots.b[c][slot0], &b[c], sizeof(V));
-          if (!rays.low) continue;
-          for (int c = 0; c < 3; ++c) {
-            std::memcpy(&slots.org[c][slot0], &of[c], sizeof(F));
-            std::memcpy(&slots.dir[c][slot0], &df[c], sizeof(F));
-          }
-          if (rays.cage) {
-            std::memcpy(&slots.tfar[slot0], &far, sizeof(F));
-            std::memcpy(&slots.base[slot0], &cr.base, sizeof(V));
-            std::memcpy(&slots.prefer_lo[slot0], &lo, sizeof(F));
-          }
-          store_flags(&slots.ray_fallback[slot0], ~good);
-          continue;
-        }
-      }
-      for (int k = 0; k < kLanes; ++k) {
-        if (!(m >> k & 1u)) continue;
-        const std::size_t slot = slot0 + std::size_t(k);
-        if (slots.tri[slot] >= 0) {
-          ++taken;
-          continue;
-        }
-        double bk[3] = {b[0][k], b[1][k], b[2][k]};
-        const bool moved = inset_from_edges(bk);
-        slots.tri[slot] = t;
-        for (int c = 0; c < 3; ++c) slots.b[c][slot] = bk[c];
-        if (!rays.low) continue;
-        // A sample moved in from an edge has other barycentrics than the ray was made with.
-        slots.ray_fallback[slot] = moved || !(good >> k & 1u);
-        for (int c = 0; c < 3; ++c) {
-          slots.org[c][slot] = of[c][k];
-          slots.dir[c][slot] = df[c][k];
-        }
-        if (rays.cage) {
-          slots.tfar[slot] = far[k];
-          slots.base[slot] = cr.base[k];
-          slots.prefer_lo[slot] = lo[k];
-        }
+      taken += store_lanes(m, b, t, rays, slots, row + std::size_t(x - x0));
+    }
+  }
+  return taken;
+}
+
+// As cover_rect, with an AVX-512 version too (x86-64-v4: the same 4 lanes with twice the registers;
+// no FMA, as -ffp-contract=off keeps it out of this library).
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) std::size_t cover_rect_samples(
+    const TexelTriangle& tt, std::int32_t t, int x0, int x1, int y0, int y1, const double* ox, const double* oy, int count,
+    const KernelRays& rays, const SampleSlots& slots, std::size_t first, std::size_t row_stride) {
+  std::size_t taken = 0;
+  const V zero = {0.0, 0.0, 0.0, 0.0};
+  double inv_dy[3];
+  inverse_dy(tt, inv_dy);
+  const int groups = (count + kLanes - 1) / kLanes;  // of four samples; the last may be short
+  for (int y = y0; y <= y1; ++y) {
+    // The row's texels where some sample can be covered: the union of each sample's bounds.
+    int xa = x1 + 1, xb = x0 - 1;
+    for (int k = 0; k < count; ++k) {
+      const double qy = y + oy[k];
+      double row_term[3];
+      for (int e = 0; e < 3; ++e) row_term[e] = tt.edge_d[e].x * (qy - tt.edge_a[e].y);
+      int a, b;
+      if (!row_bounds(tt, row_term, inv_dy, ox[k], x0, x1, a, b)) continue;
+      xa = std::min(xa, a);
+      xb = std::max(xb, b);
+    }
+    if (xa > xb) continue;
+    const std::size_t row = first + std::size_t(y - y0) * row_stride;
+    for (int g = 0; g < groups; ++g) {
+      // Lanes: samples 4g .. 4g + 3 of each texel (a short group repeats its last sample, masked out).
+      int k[kLanes];
+      for (int j = 0; j < kLanes; ++j) k[j] = std::min(kLanes * g + j, count - 1);
+      const M valid = {kLanes * g < count ? -1 : 0, kLanes * g + 1 < count ? -1 : 0, kLanes * g + 2 < count ? -1 : 0,
+                       kLanes * g + 3 < count ? -1 : 0};
+      const V oxv = {ox[k[0]], ox[k[1]], ox[k[2]], ox[k[3]]};
+      const V qy = V{double(y), double(y), double(y), double(y)} + V{oy[k[0]], oy[k[1]], oy[k[2]], oy[k[3]]};
+      V row_term[3];
+      for (int e = 0; e < 3; ++e) row_term[e] = tt.edge_d[e].x * (qy - tt.edge_a[e].y);
+      for (int x = xa; x <= xb; ++x) {
+        const V qx = V{double(x), double(x), double(x), double(x)} + oxv;
+        M in = valid;
+        // covers() (core/rasterize.h), four samples at a time.
+        V w[3], sum, b[3];
+        edge_weights(in, w, tt, row_term, qx, zero);
+        weight_sum(in, sum, w, zero);
+        const unsigned m = bits(in);
+        if (!m) continue;
+        normalize_weights(b, w, sum);
+        taken += store_lanes(m, b, t, rays, slots, row + std::size_t(x - x0) * std::size_t(count) + std::size_t(kLanes * g));
       }
     }
   }
@@ -179,15 +251,15 @@ __attribute__((target_clones("avx2", "default"))) std::size_t cover_rect(const T
 }
 
 __attribute__((target_clones("avx2", "default"))) std::size_t compact_samples(const SampleSlots& slots, std::size_t slot_count,
-                                                                              std::size_t texels, bool rays,
+                                                                              std::size_t per_texel, bool rays,
                                                                               const CoveredSamples& out) {
   std::size_t n = 0;
   const bool cage = rays && slots.tfar;
-  // Entry i to entry n <= i, one value at a time (in place, n may equal i).
-  const auto copy_one = [&](std::size_t i) {
+  // Entry i (of texel `texel`) to entry n <= i, one value at a time (in place, n may equal i).
+  const auto copy_one = [&](std::size_t i, std::size_t texel) {
     out.tri[n] = slots.tri[i];
     for (int c = 0; c < 3; ++c) out.b[c][n] = slots.b[c][i];
-    out.texel[n] = std::uint16_t(i % texels);
+    out.texel[n] = std::uint16_t(texel);
     if (rays) {
       for (int c = 0; c < 3; ++c) {
         out.org[c][n] = slots.org[c][i];
@@ -202,44 +274,46 @@ __attribute__((target_clones("avx2", "default"))) std::size_t compact_samples(co
     }
     ++n;
   };
+  std::size_t texel = 0, k = 0;  // slot i's texel, and its sample in the texel
+  const auto step = [&] {
+    if (++k == per_texel) k = 0, ++texel;
+  };
   std::size_t i = 0;
-  if (texels % kLanes == 0) {
-    // Four slots at a time (they are four consecutive texels); one by one where some are empty.
-    for (std::size_t texel = 0; i + kLanes <= slot_count; i += kLanes, texel = texel + kLanes == texels ? 0 : texel + kLanes) {
-      std::int32_t tri[kLanes];
-      std::memcpy(tri, &slots.tri[i], sizeof tri);
-      if ((tri[0] & tri[1] & tri[2] & tri[3]) < 0) continue;  // all empty
-      if ((tri[0] | tri[1] | tri[2] | tri[3]) < 0) {          // some empty
-        for (std::size_t k = 0; k < kLanes; ++k)
-          if (tri[k] >= 0) copy_one(i + k);
-        continue;
-      }
-      const std::uint16_t tex[kLanes] = {std::uint16_t(texel), std::uint16_t(texel + 1), std::uint16_t(texel + 2),
-                                         std::uint16_t(texel + 3)};
-      std::memcpy(&out.texel[n], tex, sizeof tex);
-      // Moved unless in place with no gap yet (then already where they belong); memmove, as in
-      // place the four entries from i can overlap the four from n.
-      if (out.tri + n != slots.tri + i) {
-        std::memcpy(&out.tri[n], tri, sizeof tri);
-        for (int c = 0; c < 3; ++c) std::memmove(&out.b[c][n], &slots.b[c][i], kLanes * sizeof(double));
-        if (rays) {
-          for (int c = 0; c < 3; ++c) {
-            std::memmove(&out.org[c][n], &slots.org[c][i], kLanes * sizeof(float));
-            std::memmove(&out.dir[c][n], &slots.dir[c][i], kLanes * sizeof(float));
-          }
-          std::memmove(&out.ray_fallback[n], &slots.ray_fallback[i], kLanes);
-          if (cage) {
-            std::memmove(&out.tfar[n], &slots.tfar[i], kLanes * sizeof(float));
-            std::memmove(&out.base[n], &slots.base[i], kLanes * sizeof(double));
-            std::memmove(&out.prefer_lo[n], &slots.prefer_lo[i], kLanes * sizeof(float));
-          }
+  // Four slots at a time; one by one where some are empty.
+  for (; i + kLanes <= slot_count; i += kLanes) {
+    std::int32_t tri[kLanes];
+    std::memcpy(tri, &slots.tri[i], sizeof tri);
+    std::uint16_t tex[kLanes];
+    for (std::size_t j = 0; j < kLanes; ++j) tex[j] = std::uint16_t(texel), step();
+    if ((tri[0] & tri[1] & tri[2] & tri[3]) < 0) continue;  // all empty
+    if ((tri[0] | tri[1] | tri[2] | tri[3]) < 0) {          // some empty
+      for (std::size_t j = 0; j < kLanes; ++j)
+        if (tri[j] >= 0) copy_one(i + j, tex[j]);
+      continue;
+    }
+    std::memcpy(&out.texel[n], tex, sizeof tex);
+    // Moved unless in place with no gap yet (then already where they belong); memmove, as in
+    // place the four entries from i can overlap the four from n.
+    if (out.tri + n != slots.tri + i) {
+      std::memcpy(&out.tri[n], tri, sizeof tri);
+      for (int c = 0; c < 3; ++c) std::memmove(&out.b[c][n], &slots.b[c][i], kLanes * sizeof(double));
+      if (rays) {
+        for (int c = 0; c < 3; ++c) {
+          std::memmove(&out.org[c][n], &slots.org[c][i], kLanes * sizeof(float));
+          std::memmove(&out.dir[c][n], &slots.dir[c][i], kLanes * sizeof(float));
+        }
+        std::memmove(&out.ray_fallback[n], &slots.ray_fallback[i], kLanes);
+        if (cage) {
+          std::memmove(&out.tfar[n], &slots.tfar[i], kLanes * sizeof(float));
+          std::memmove(&out.base[n], &slots.base[i], kLanes * sizeof(double));
+          std::memmove(&out.prefer_lo[n], &slots.prefer_lo[i], kLanes * sizeof(float));
         }
       }
-      n += kLanes;
     }
+    n += kLanes;
   }
-  for (; i < slot_count; ++i)
-    if (slots.tri[i] >= 0) copy_one(i);
+  for (; i < slot_count; ++i, step())
+    if (slots.tri[i] >= 0) copy_one(i, texel);
   return n;
 }
 
@@ -252,12 +326,25 @@ __attribute__((target_clones("avx2", "default"))) void accumulate_samples(const 
     sums.count[t] += 1.0;
   };
   std::size_t i = 0;
-  for (; i + kLanes <= count; i += kLanes) {
-    // Four samples of four consecutive texels (the common case) are four different texels: their
-    // additions are independent, four at a time.
+  while (i + kLanes <= count) {
     const std::size_t t = texel[i];
+    if (texel[i + 1] == t) {
+      // A texel's samples one after another (several samples a texel): summed in registers, in
+      // order, and stored once.
+      double s[3] = {sums.sum[0][t], sums.sum[1][t], sums.sum[2][t]}, n = sums.count[t];
+      for (; i < count && texel[i] == t; ++i) {
+        for (int c = 0; c < 3; ++c) s[c] += value[c][i];
+        n += 1.0;
+      }
+      for (int c = 0; c < 3; ++c) sums.sum[c][t] = s[c];
+      sums.count[t] = n;
+      continue;
+    }
+    // Four samples of four consecutive texels (one sample a texel) are four different texels:
+    // their additions are independent, four at a time.
     if (!(texel[i + 1] == t + 1 && texel[i + 2] == t + 2 && texel[i + 3] == t + 3)) {
       for (std::size_t k = 0; k < kLanes; ++k) add_one(i + k);
+      i += kLanes;
       continue;
     }
     for (int c = 0; c < 3; ++c) {
@@ -271,6 +358,7 @@ __attribute__((target_clones("avx2", "default"))) void accumulate_samples(const 
     std::memcpy(&n, &sums.count[t], sizeof n);
     n += 1.0;
     std::memcpy(&sums.count[t], &n, sizeof n);
+    i += kLanes;
   }
   for (; i < count; ++i) add_one(i);
 }

@@ -53,6 +53,14 @@ struct KernelRays {
 std::size_t cover_rect(const TexelTriangle& tt, std::int32_t t, int x0, int x1, int y0, int y1, double ox, double oy,
                        const KernelRays& rays, const SampleSlots& slots, std::size_t first, std::size_t row_stride);
 
+// cover_rect for `count` samples per texel at once, sample k at offset (ox[k], oy[k]): slot
+// first + (y - y0) * row_stride + (x - x0) * count + k, so a texel's samples lie side by side in
+// sample order. Each slot gets the bits cover_rect gives it for that one offset (four samples of a
+// texel per vector operation instead of four texels).
+std::size_t cover_rect_samples(const TexelTriangle& tt, std::int32_t t, int x0, int x1, int y0, int y1, const double* ox,
+                               const double* oy, int count, const KernelRays& rays, const SampleSlots& slots, std::size_t first,
+                               std::size_t row_stride);
+
 // A tile's covered samples, in order, as arrays: triangle, barycentrics, texel of the tile and,
 // with rays, the ray's origin and direction and whether the caller must make the ray itself.
 struct CoveredSamples {
@@ -68,12 +76,12 @@ struct CoveredSamples {
 };
 
 // Copies each slot i < slot_count that holds a triangle, in increasing i, to the next entry of
-// `out`: triangle, barycentrics, texel i % texels and, with `rays`, the ray and its fallback flag
-// (and tfar, base and prefer_lo where the slots have them).
-// Returns how many. Slot k * texels + t is sample k of texel t, so each texel's samples come in
-// sample order. texels must be at most 65536. `out` may be the slots' own arrays (except texel):
-// the compaction then works in place.
-std::size_t compact_samples(const SampleSlots& slots, std::size_t slot_count, std::size_t texels, bool rays,
+// `out`: triangle, barycentrics, texel i / per_texel and, with `rays`, the ray and its fallback
+// flag (and tfar, base and prefer_lo where the slots have them). Returns how many. Slot
+// t * per_texel + k is sample k of texel t (cover_rect_samples' layout; cover_rect's with one), so
+// each texel's samples come together, in sample order. Texels must number at most 65536. `out`
+// may be the slots' own arrays (except texel): the compaction then works in place.
+std::size_t compact_samples(const SampleSlots& slots, std::size_t slot_count, std::size_t per_texel, bool rays,
                             const CoveredSamples& out);
 
 // A tile's texels as arrays: per texel, the sums of its samples' values and how many it has.
