@@ -149,11 +149,12 @@ std::vector<QualityRow> run_tracing(BenchRun& run) {
       "seconds (all threads), less disturbed by other load than wall time. The bare loops trace a BVH of the build quality\n"
       "the bake picks (bvh_quality_for in pipeline/bvh.h: low below 16 rays per triangle, else high; column \"BVH\").\n"
       "Targets (wall, trace / best bare): issue 2 <= 1.3x for 1 and 4 samples, issue 6 <= 1.15x for 1 and 16 samples.\n"
-      "Bare loops: one rtcIntersect1 per ray; 8-wide packets (rtcIntersect8) filled from Ray structs; 8-wide packets from\n"
-      "arrays already in Embree's packet layout (filled before the clock starts; the bake writes its rays this way). The\n"
-      "bake uses 8-wide packets; raycast.h has no 16-wide packets or rtcIntersect1M streams, so those are not measured.\n"
-      "The bake and both packet loops tell Embree the packets are coherent (RTC_INTERSECT_CONTEXT_FLAG_COHERENT: eight\n"
-      "neighbouring texels of a row); the single-ray loop cannot.\n"
+      "Bare loops: one rtcIntersect1 per ray; packets filled from Ray structs; packets from arrays already in Embree's\n"
+      "packet layout (filled before the clock starts; the bake writes its rays this way). Packets (the \"8-packet\"\n"
+      "columns, and the bake's) are of raycast::Scene::packet_width rays: 16 where Embree traces them natively (an\n"
+      "AVX-512 CPU), else 8; raycast.h has no rtcIntersect1M streams for primary rays, so those are not measured.\n"
+      "The bake and both packet loops tell Embree the packets are coherent (RTC_INTERSECT_CONTEXT_FLAG_COHERENT: a\n"
+      "texel's samples, or with one sample neighbouring texels of a row); the single-ray loop cannot.\n"
       "\"Own s\": the fastest bake's trace less the best bare loop on its rays: the bake's own rasterizing, ray making,\n"
       "shading and writing, as wall seconds. \"No rule\": the same bake with --keep-backfaces, the same rays cast\n"
       "in the same packets without the hit rule (no Embree filter; hits on back faces are taken): the rule's share of\n"
@@ -161,6 +162,11 @@ std::vector<QualityRow> run_tracing(BenchRun& run) {
       "Rounds: %d at 1 and 4 samples, %d at 16; each timed column is the best of them. \"Per round\": each round's trace\n"
       "over that round's best bare loop, median [lowest .. highest]: how far the host's load moved the ratio in this run.\n\n",
       args.trace_rounds, args.rounds);
+  {
+    const float corners[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    const std::uint32_t tri[3] = {0, 1, 2};
+    std::printf("Packets of %d rays on this CPU.\n\n", raycast::Scene(corners, 3, tri, 1).packet_width());
+  }
   std::printf(
       "| scene | samples | high tris | BVH | load s | bvh s | trace s (CPU) | pad s | rays | Mrays/s | bare 1-ray s (CPU) | "
       "bare 8-packet s (CPU) | bare 8-packet from arrays s (CPU) | trace / best bare, wall (CPU) | per round, median [range] | "

@@ -10,6 +10,7 @@
 
 #include "core/rasterize.h"
 #include "pipeline/rays.h"
+#include "trace/shade_batch.h"
 #include "test_support.h"
 #include "trace/tile_kernels.h"
 
@@ -241,13 +242,15 @@ TEST(TileKernels, CoverRectSamplesIsCoverRectPerOffset) {
   // cover_rect_samples lays a texel's samples side by side; each slot must hold exactly what
   // cover_rect gives for that one offset (coverage, barycentrics, rays, fallback flags, cage
   // fields), including a second triangle over the first (slots kept, the rest counted). 1 to 17
-  // samples: short last groups of four; the bake's grids and Hammersley points; corners on texel
-  // centres (ties and edge insets), with and without a cage.
+  // samples: short last groups of four or eight; the bake's grids and Hammersley points; corners on
+  // texel centres (ties and edge insets), with and without a cage; four lanes and eight.
   std::mt19937 rng(31);
   std::uniform_real_distribution<float> u(0.0f, 1.0f), out(0.0f, 0.2f);
   std::size_t compared = 0, fallbacks = 0;
-  for (int i = 0; i < 120; ++i) {
+  for (int i = 0; i < 240; ++i) {
     const int count = 1 + i % 17;
+    const int lanes = i % 4 < 2 ? 4 : 8;  // both versions (8 where the CPU runs it)
+    if (lanes == 8 && !kernel_lanes_available(8)) continue;
     const std::vector<glm::dvec2> offsets = sample_offsets(count);
     std::vector<double> ox, oy;
     for (const glm::dvec2& o : offsets) ox.push_back(o.x), oy.push_back(o.y);
@@ -281,10 +284,10 @@ TEST(TileKernels, CoverRectSamplesIsCoverRectPerOffset) {
       for (int k = 0; k < count; ++k)
         taken += cover_rect(tt[t], t, x0, x1, y0, y1, ox[std::size_t(k)], oy[std::size_t(k)], rays, apart[std::size_t(k)].view,
                             std::size_t(y0) * stride + std::size_t(x0), stride);
-      EXPECT_EQ(
-          cover_rect_samples(tt[t], t, x0, x1, y0, y1, ox.data(), oy.data(), count, rays, together.view,
-                             (std::size_t(y0) * stride + std::size_t(x0)) * std::size_t(count), stride * std::size_t(count)),
-          taken)
+      EXPECT_EQ(cover_rect_samples(tt[t], t, x0, x1, y0, y1, ox.data(), oy.data(), count, rays, together.view,
+                                   (std::size_t(y0) * stride + std::size_t(x0)) * std::size_t(count), stride * std::size_t(count),
+                                   lanes),
+                taken)
           << i;
     }
     for (std::size_t s = 0; s < stride * kSide; ++s)

@@ -1,4 +1,5 @@
-// Four doubles per vector, for the bake's per-sample arithmetic (shade_batch.cpp, tile_kernels.cpp).
+// Four doubles per vector (and eight, below), for the bake's per-sample arithmetic (shade_batch.cpp,
+// tile_kernels.cpp).
 //
 // Plain IEEE operations lane by lane: no reassociation and no fused multiply-add (the project
 // builds with ISO C++, where GCC does not contract), so each lane rounds exactly as the scalar code
@@ -58,11 +59,72 @@ template <typename Fn>
   std::memcpy(to, flags, sizeof flags);
 }
 
+// Eight doubles per vector, for the kernels' AVX-512 versions only (x86-64-v4: one instruction per
+// operation): the same helpers, overloaded on the wider types. Use them only in functions compiled
+// for that target.
+typedef double V8 __attribute__((vector_size(64)));
+typedef std::int64_t M8 __attribute__((vector_size(64)));
+typedef float F8 __attribute__((vector_size(32)));
+typedef std::int32_t I8 __attribute__((vector_size(32)));
+
+template <typename Fn>
+[[gnu::always_inline]] inline void gather(V8& r, Fn f) {
+  r = V8{f(0), f(1), f(2), f(3), f(4), f(5), f(6), f(7)};
+}
+[[gnu::always_inline]] inline void vsqrt(V8& r, const V8& a) {
+  for (int k = 0; k < 8; ++k) r[k] = std::sqrt(a[k]);
+}
+[[gnu::always_inline]] inline unsigned bits(const I8& m) {
+  unsigned r = 0;
+  for (int k = 0; k < 8; ++k) r |= unsigned(m[k] != 0) << k;
+  return r;
+}
+[[gnu::always_inline]] inline unsigned bits(const M8& m) {
+  unsigned r = 0;
+  for (int k = 0; k < 8; ++k) r |= unsigned(m[k] != 0) << k;
+  return r;
+}
+
+// The vector types of one width, for kernels written once over it.
+struct Lanes4 {
+  using V = lanes::V;
+  using M = lanes::M;
+  using F = lanes::F;
+  using I = lanes::I;
+  static constexpr int n = 4;
+};
+struct Lanes8 {
+  using V = V8;
+  using M = M8;
+  using F = F8;
+  using I = I8;
+  static constexpr int n = 8;
+};
+
+// to[k] = bit k of `bits` (0 or 1) for the L lanes.
+template <int L>
+[[gnu::always_inline]] inline void store_lane_flags(std::uint8_t* to, unsigned bits) {
+  std::uint8_t flags[L];
+  for (int k = 0; k < L; ++k) flags[k] = std::uint8_t(bits >> k & 1u);
+  std::memcpy(to, flags, sizeof flags);
+}
+
+// Whether this CPU runs the kernels' AVX-512 (x86-64-v4) versions: AVX-512 F, VL, BW and DQ.
+inline bool has_x86_64_v4() {
+  static const bool yes = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+                          __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq");
+  return yes;
+}
+
 }  // namespace nmbake::lanes
 
 namespace nmbake::codec {
 template <>
 struct Ops<lanes::V> {
   [[gnu::always_inline]] static void root(lanes::V& r, const lanes::V& a) { lanes::vsqrt(r, a); }
+};
+template <>
+struct Ops<lanes::V8> {
+  [[gnu::always_inline]] static void root(lanes::V8& r, const lanes::V8& a) { lanes::vsqrt(r, a); }
 };
 }  // namespace nmbake::codec

@@ -14,21 +14,26 @@ using namespace lanes;
 
 namespace {
 
-// Four samples from `i` on (a short last block repeats its last sample). `same_triangle`: all four
-// on one low-poly triangle, whose data is then loaded once and broadcast instead of gathered.
-template <bool same_triangle>
+// L::n samples from `i` on (a short last block repeats its last sample). `same_triangle`: all on
+// one low-poly triangle, whose data is then loaded once and broadcast instead of gathered.
+template <typename L, bool same_triangle>
 [[gnu::always_inline]] inline void encode_block(const LowTriangle* low, const glm::vec3* high_corner_normals,
                                                 const ShadeSamples& in, std::size_t i, std::size_t count, double* const value[3],
                                                 std::uint8_t* degenerate) {
-  const V zero = {0.0, 0.0, 0.0, 0.0};
-  const bool full = i + kLanes <= count;
-  std::size_t at[kLanes];
-  for (int k = 0; k < kLanes; ++k) at[k] = std::min(i + std::size_t(k), count - 1);
-  const LowTriangle* lp[kLanes];
-  const glm::vec3* hp[kLanes];
+  using V = typename L::V;
+  using M = typename L::M;
+  using F = typename L::F;
+  using V3 = codec::Vec3<V>;
+  constexpr int kN = L::n;
+  const V zero = {};
+  const bool full = i + kN <= count;
+  std::size_t at[kN];
+  for (int k = 0; k < kN; ++k) at[k] = std::min(i + std::size_t(k), count - 1);
+  const LowTriangle* lp[kN];
+  const glm::vec3* hp[kN];
   unsigned miss = 0;
-#pragma GCC unroll 4
-  for (int k = 0; k < kLanes; ++k) {
+#pragma GCC unroll 8
+  for (int k = 0; k < kN; ++k) {
     lp[k] = &low[in.low_tri[same_triangle ? i : at[k]]];
     const std::uint32_t ht = in.high_tri[at[k]];
     miss |= unsigned(ht == raycast::no_hit) << k;
@@ -63,7 +68,7 @@ template <bool same_triangle>
     gather(v, [&](int k) { return double(in.v[at[k]]); });
   }
   const V hw[3] = {1.0 - u - v, u, v};
-  // The codec (core/codec.h), four samples at a time: the per-pixel frame, the hit normal
+  // The codec (core/codec.h), L::n samples at a time: the per-pixel frame, the hit normal
   // interpolated with the hit's barycentrics (it goes in at its own length: the encoding
   // normalizes its result), the encoding.
   codec::Frame<V> f;
@@ -75,7 +80,7 @@ template <bool same_triangle>
   codec::Encoding<V> e;
   codec::encode_in_frame(e, f, h);
   // inv, negated where det is not positive (encode_tangent_normal's -inv): its sign bit flipped.
-  const M sign_bit = {INT64_MIN, INT64_MIN, INT64_MIN, INT64_MIN};
+  const M sign_bit = M{} + INT64_MIN;
   M inv_bits;
   std::memcpy(&inv_bits, &e.inv, sizeof e.inv);
   inv_bits ^= ~(e.det > zero) & sign_bit;
@@ -87,12 +92,12 @@ template <bool same_triangle>
   M good;
   codec::trusted(good, e);
   good &= hh > kShortHitNormal2;
-  const unsigned bad = (~bits(good) | miss) & 0xfu;
+  const unsigned bad = (~bits(good) | miss) & ((1u << kN) - 1u);
   if (full) {
     std::memcpy(&value[0][i], &r.x, sizeof(V));
     std::memcpy(&value[1][i], &r.y, sizeof(V));
     std::memcpy(&value[2][i], &r.z, sizeof(V));
-    store_flags(&degenerate[i], bad);
+    store_lane_flags<kN>(&degenerate[i], bad);
   } else {
     for (std::size_t k = 0; i + k < count; ++k) {
       value[0][i + k] = r.x[k];
@@ -103,21 +108,46 @@ template <bool same_triangle>
   }
 }
 
-}  // namespace
-
-// Three versions, chosen once at load time by the CPU: AVX-512 (x86-64-v4: the same 4 lanes, with
-// twice the registers to hold them), AVX2 (4 lanes per instruction) and the baseline (2 lanes per
-// SSE2 instruction). None uses FMA (-ffp-contract=off for this library: x86-64-v4 has it), so all
-// give the scalar code's bits.
-__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) void encode_hits_per_pixel(
-    const LowTriangle* low, const glm::vec3* high_corner_normals, const ShadeSamples& samples, std::size_t count,
-    double* const value[3], std::uint8_t* degenerate) {
-  for (std::size_t i = 0; i < count; i += kLanes) {
-    const std::int32_t* lt = samples.low_tri;
-    if (i + kLanes <= count && lt[i] == lt[i + 1] && lt[i] == lt[i + 2] && lt[i] == lt[i + 3])
-      encode_block<true>(low, high_corner_normals, samples, i, count, value, degenerate);
-    else encode_block<false>(low, high_corner_normals, samples, i, count, value, degenerate);
+// Every block of L::n samples.
+template <typename L>
+[[gnu::always_inline]] inline void encode_blocks(const LowTriangle* low, const glm::vec3* high_corner_normals,
+                                                 const ShadeSamples& samples, std::size_t count, double* const value[3],
+                                                 std::uint8_t* degenerate) {
+  constexpr int kN = L::n;
+  const std::int32_t* lt = samples.low_tri;
+  for (std::size_t i = 0; i < count; i += kN) {
+    bool same = i + kN <= count;
+    for (int k = 1; k < kN && same; ++k) same = lt[i + std::size_t(k)] == lt[i];
+    if (same) encode_block<L, true>(low, high_corner_normals, samples, i, count, value, degenerate);
+    else encode_block<L, false>(low, high_corner_normals, samples, i, count, value, degenerate);
   }
 }
+
+// Two versions, chosen once at load time by the CPU: AVX2 (4 lanes per instruction) and the
+// baseline (2 lanes per SSE2 instruction).
+__attribute__((target_clones("avx2", "default"))) void encode_by_4(const LowTriangle* low, const glm::vec3* high_corner_normals,
+                                                                   const ShadeSamples& samples, std::size_t count,
+                                                                   double* const value[3], std::uint8_t* degenerate) {
+  encode_blocks<Lanes4>(low, high_corner_normals, samples, count, value, degenerate);
+}
+
+// AVX-512 (x86-64-v4), 8 lanes per instruction.
+__attribute__((target("arch=x86-64-v4"))) void encode_by_8(const LowTriangle* low, const glm::vec3* high_corner_normals,
+                                                           const ShadeSamples& samples, std::size_t count, double* const value[3],
+                                                           std::uint8_t* degenerate) {
+  encode_blocks<Lanes8>(low, high_corner_normals, samples, count, value, degenerate);
+}
+
+}  // namespace
+
+// The widest version the CPU runs (or the one `lanes` asks for). None uses FMA (-ffp-contract=off
+// for this library: x86-64-v4 has it), so all give the scalar code's bits.
+void encode_hits_per_pixel(const LowTriangle* low, const glm::vec3* high_corner_normals, const ShadeSamples& samples,
+                           std::size_t count, double* const value[3], std::uint8_t* degenerate, int lanes) {
+  if (lanes == 8 || (lanes == 0 && has_x86_64_v4())) encode_by_8(low, high_corner_normals, samples, count, value, degenerate);
+  else encode_by_4(low, high_corner_normals, samples, count, value, degenerate);
+}
+
+bool kernel_lanes_available(int lanes) { return lanes == 4 || (lanes == 8 && has_x86_64_v4()); }
 
 }  // namespace nmbake

@@ -80,7 +80,13 @@ constexpr double kShortHitNormal2 = 1e-24;
 // (value unspecified) for a miss, or when the interpolated hit normal's squared length is at most
 // kShortHitNormal2, the frame singular or the result not finite. high_corner_normals holds 3 normals per
 // high-poly triangle.
+// `lanes`: 0 for the fastest version this CPU runs (8 lanes per instruction on an AVX-512 CPU, else
+// 4), or 4 or 8 to ask for one (for tests; 8 only where kernel_lanes_available(8)).
 void encode_hits_per_pixel(const LowTriangle* low, const glm::vec3* high_corner_normals, const ShadeSamples& samples,
-                           std::size_t count, double* const value[3], std::uint8_t* degenerate);
+                           std::size_t count, double* const value[3], std::uint8_t* degenerate, int lanes = 0);
+
+// Whether the kernels' versions of `lanes` lanes (4 or 8) run on this CPU: 4 always, 8 on an
+// AVX-512 (x86-64-v4) one.
+bool kernel_lanes_available(int lanes);
 
 }  // namespace nmbake

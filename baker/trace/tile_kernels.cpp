@@ -15,10 +15,11 @@ namespace {
 
 // P + front N and -N for one triangle at barycentrics w: default_ray (shade_batch.h), as
 // sample_rays makes it. `good`: lanes whose squared normal length exceeds 1e-24 (the others take
-// low_ray_normal's fallback).
-[[gnu::always_inline]] inline void default_ray_lanes(const LowTriangle& lt, double front, const V (&w)[3], V3& org, V3& dir,
-                                                     unsigned& good) {
-  V3 p, n;
+// low_ray_normal's fallback). V: the lanes' vector type (lanes.h).
+template <typename V>
+[[gnu::always_inline]] inline void default_ray_lanes(const LowTriangle& lt, double front, const V (&w)[3], codec::Vec3<V>& org,
+                                                     codec::Vec3<V>& dir, unsigned& good) {
+  codec::Vec3<V> p, n;
   V len2;
   low_point_and_normal(p, n, len2, lt, w);
   good = bits(len2 > 1e-24);
@@ -29,24 +30,27 @@ namespace {
 // inward_ray (pipeline/rays.h), term for term. Besides origin and direction: the ray's far end,
 // its base (the search distance) and where its preferred part begins. `good`: lanes whose cage
 // point lies off the low-poly (the others take cage_ray's fallback direction).
+template <typename V>
 struct CageLanes {
-  V3 org, dir;
+  codec::Vec3<V> org, dir;
   V far, base, prefer_lo;
 };
+template <typename V>
 [[gnu::always_inline]] inline void weighted(V& r, const V (&w)[3], const double c[3]) {
   r = w[0] * c[0];
   r = r + w[1] * c[1];
   r = r + w[2] * c[2];
 }
+template <typename V>
 [[gnu::always_inline]] inline void cage_ray_lanes(const LowTriangle& lt, const CageTriangle& ct, double diagonal, const V (&w)[3],
-                                                  CageLanes& r, unsigned& good) {
-  V3 p, pc;
+                                                  CageLanes<V>& r, unsigned& good) {
+  codec::Vec3<V> p, pc;
   corner_sum(p, lt.p, w);
   corner_sum(pc, ct.corner, w);
   V rear, search;
   weighted(rear, w, ct.rear);
   weighted(search, w, ct.search);
-  const V3 d = {p.x - pc.x, p.y - pc.y, p.z - pc.z};
+  const codec::Vec3<V> d = {p.x - pc.x, p.y - pc.y, p.z - pc.z};
   V len2, len;
   dot(len2, d, d);
   vsqrt(len, len2);
@@ -56,7 +60,7 @@ struct CageLanes {
   r.org = {p.x - s * r.dir.x, p.y - s * r.dir.y, p.z - s * r.dir.z};
   r.far = s + rear;
   r.base = s;
-  const V zero = {0.0, 0.0, 0.0, 0.0};
+  const V zero = {};
   r.prefer_lo = s > len ? s - len : zero;
 }
 
@@ -88,15 +92,21 @@ struct CageLanes {
   return true;
 }
 
-// Four lanes of samples of triangle t (those `m` marks covered, barycentrics b before any inset)
-// into slots slot0 .. slot0 + 3, with their rays when rays.low: each slot that already holds a
-// triangle is left as it is and counted. Returns that count.
-[[gnu::always_inline]] inline std::size_t store_lanes(unsigned m, const V (&b)[3], std::int32_t t, const KernelRays& rays,
-                                                      const SampleSlots& slots, std::size_t slot0) {
-  const V zero = {0.0, 0.0, 0.0, 0.0};
-  CageLanes cr{{zero, zero, zero}, {zero, zero, zero}, zero, zero, zero};
-  V3& org = cr.org;
-  V3& dir = cr.dir;
+// L::n lanes of samples of triangle t (those `m` marks covered, barycentrics b before any inset)
+// into slots slot0 .. slot0 + L::n - 1, with their rays when rays.low: each slot that already
+// holds a triangle is left as it is and counted. Returns that count.
+template <typename L>
+[[gnu::always_inline]] inline std::size_t store_lanes(unsigned m, const typename L::V (&b)[3], std::int32_t t,
+                                                      const KernelRays& rays, const SampleSlots& slots, std::size_t slot0) {
+  using V = typename L::V;
+  using M = typename L::M;
+  using F = typename L::F;
+  using I = typename L::I;
+  constexpr int kN = L::n;
+  constexpr unsigned kAll = (1u << kN) - 1u;
+  CageLanes<V> cr{};
+  codec::Vec3<V>& org = cr.org;
+  codec::Vec3<V>& dir = cr.dir;
   unsigned good = 0;
   if (rays.cage) {
     cage_ray_lanes(rays.low[t], rays.cage[t], rays.diagonal, b, cr, good);
@@ -106,14 +116,14 @@ struct CageLanes {
   const F of[3] = {__builtin_convertvector(org.x, F), __builtin_convertvector(org.y, F), __builtin_convertvector(org.z, F)};
   const F df[3] = {__builtin_convertvector(dir.x, F), __builtin_convertvector(dir.y, F), __builtin_convertvector(dir.z, F)};
   const F far = __builtin_convertvector(cr.far, F), lo = __builtin_convertvector(cr.prefer_lo, F);
-  if (m == 0xfu) {
-    // The common case, four lanes at once: all four samples covered, their slots free, none
-    // near enough to an edge to be moved in (inset_from_edges leaves them as they are).
+  if (m == kAll) {
+    // The common case, all lanes at once: every sample covered, their slots free, none near
+    // enough to an edge to be moved in (inset_from_edges leaves them as they are).
     I held;
     std::memcpy(&held, &slots.tri[slot0], sizeof held);
     const M far_from_edges = (b[0] >= kEdgeInset) & (b[1] >= kEdgeInset) & (b[2] >= kEdgeInset);
-    if (bits(held < 0) == 0xfu && bits(far_from_edges) == 0xfu) {
-      const I tris = {t, t, t, t};
+    if (bits(held < 0) == kAll && bits(far_from_edges) == kAll) {
+      const I tris = I{} + t;
       std::memcpy(&slots.tri[slot0], &tris, sizeof tris);
       for (int c = 0; c < 3; ++c) std::memcpy(&slots.b[c][slot0], &b[c], sizeof(V));
       if (!rays.low) return 0;
@@ -126,12 +136,12 @@ struct CageLanes {
         std::memcpy(&slots.base[slot0], &cr.base, sizeof(V));
         std::memcpy(&slots.prefer_lo[slot0], &lo, sizeof(F));
       }
-      store_flags(&slots.ray_fallback[slot0], ~good);
+      store_lane_flags<kN>(&slots.ray_fallback[slot0], ~good);
       return 0;
     }
   }
   std::size_t taken = 0;
-  for (int k = 0; k < kLanes; ++k) {
+  for (int k = 0; k < kN; ++k) {
     if (!(m >> k & 1u)) continue;
     const std::size_t slot = slot0 + std::size_t(k);
     if (slots.tri[slot] >= 0) {
@@ -161,6 +171,82 @@ struct CageLanes {
 // 1 / d.y of each edge, for row_bounds (which need not be exact).
 [[gnu::always_inline]] inline void inverse_dy(const TexelTriangle& tt, double inv_dy[3]) {
   for (int k = 0; k < 3; ++k) inv_dy[k] = tt.edge_d[k].y != 0.0 ? 1.0 / tt.edge_d[k].y : 0.0;
+}
+
+// cover_rect_samples with L::n samples of a texel per vector operation.
+template <typename L>
+[[gnu::always_inline]] inline std::size_t cover_samples(const TexelTriangle& tt, std::int32_t t, int x0, int x1, int y0, int y1,
+                                                        const double* ox, const double* oy, int count, const KernelRays& rays,
+                                                        const SampleSlots& slots, std::size_t first, std::size_t row_stride) {
+  using V = typename L::V;
+  using M = typename L::M;
+  constexpr int kN = L::n;
+  std::size_t taken = 0;
+  const V zero = {};
+  double inv_dy[3];
+  inverse_dy(tt, inv_dy);
+  const int groups = (count + kN - 1) / kN;  // of L::n samples; the last may be short
+  for (int y = y0; y <= y1; ++y) {
+    // The row's texels where some sample can be covered: the union of each sample's bounds.
+    int xa = x1 + 1, xb = x0 - 1;
+    for (int k = 0; k < count; ++k) {
+      const double qy = y + oy[k];
+      double row_term[3];
+      for (int e = 0; e < 3; ++e) row_term[e] = tt.edge_d[e].x * (qy - tt.edge_a[e].y);
+      int a, b;
+      if (!row_bounds(tt, row_term, inv_dy, ox[k], x0, x1, a, b)) continue;
+      xa = std::min(xa, a);
+      xb = std::max(xb, b);
+    }
+    if (xa > xb) continue;
+    const std::size_t row = first + std::size_t(y - y0) * row_stride;
+    for (int g = 0; g < groups; ++g) {
+      // Lanes: samples n g .. n g + n - 1 of each texel (a short group repeats its last sample,
+      // masked out).
+      M valid;
+      V oxv, oyv;
+      for (int j = 0; j < kN; ++j) {
+        const int k = std::min(kN * g + j, count - 1);
+        valid[j] = kN * g + j < count ? -1 : 0;
+        oxv[j] = ox[k];
+        oyv[j] = oy[k];
+      }
+      const V qy = (zero + double(y)) + oyv;  // y + oy per lane
+      V row_term[3];
+      for (int e = 0; e < 3; ++e) row_term[e] = tt.edge_d[e].x * (qy - tt.edge_a[e].y);
+      for (int x = xa; x <= xb; ++x) {
+        const V qx = (zero + double(x)) + oxv;
+        M in = valid;
+        // covers() (core/rasterize.h), n samples at a time.
+        V w[3], sum, b[3];
+        edge_weights(in, w, tt, row_term, qx, zero);
+        weight_sum(in, sum, w, zero);
+        const unsigned m = bits(in);
+        if (!m) continue;
+        normalize_weights(b, w, sum);
+        taken += store_lanes<L>(m, b, t, rays, slots, row + std::size_t(x - x0) * std::size_t(count) + std::size_t(kN * g));
+      }
+    }
+  }
+  return taken;
+}
+
+// Two versions, chosen once at load time by the CPU: AVX2 and the SSE2 baseline.
+__attribute__((target_clones("avx2", "default"))) std::size_t cover_samples_by_4(const TexelTriangle& tt, std::int32_t t, int x0,
+                                                                                 int x1, int y0, int y1, const double* ox,
+                                                                                 const double* oy, int count,
+                                                                                 const KernelRays& rays, const SampleSlots& slots,
+                                                                                 std::size_t first, std::size_t row_stride) {
+  return cover_samples<Lanes4>(tt, t, x0, x1, y0, y1, ox, oy, count, rays, slots, first, row_stride);
+}
+
+// AVX-512 (x86-64-v4), eight lanes per instruction.
+__attribute__((target("arch=x86-64-v4"))) std::size_t cover_samples_by_8(const TexelTriangle& tt, std::int32_t t, int x0, int x1,
+                                                                         int y0, int y1, const double* ox, const double* oy,
+                                                                         int count, const KernelRays& rays,
+                                                                         const SampleSlots& slots, std::size_t first,
+                                                                         std::size_t row_stride) {
+  return cover_samples<Lanes8>(tt, t, x0, x1, y0, y1, ox, oy, count, rays, slots, first, row_stride);
 }
 
 }  // namespace
@@ -193,61 +279,21 @@ __attribute__((target_clones("avx2", "default"))) std::size_t cover_rect(const T
       const unsigned m = bits(in);
       if (!m) continue;
       normalize_weights(b, w, sum);
-      taken += store_lanes(m, b, t, rays, slots, row + std::size_t(x - x0));
+      taken += store_lanes<Lanes4>(m, b, t, rays, slots, row + std::size_t(x - x0));
     }
   }
   return taken;
 }
 
-// As cover_rect, with an AVX-512 version too (x86-64-v4: the same 4 lanes with twice the registers;
-// no FMA, as -ffp-contract=off keeps it out of this library).
-__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) std::size_t cover_rect_samples(
-    const TexelTriangle& tt, std::int32_t t, int x0, int x1, int y0, int y1, const double* ox, const double* oy, int count,
-    const KernelRays& rays, const SampleSlots& slots, std::size_t first, std::size_t row_stride) {
-  std::size_t taken = 0;
-  const V zero = {0.0, 0.0, 0.0, 0.0};
-  double inv_dy[3];
-  inverse_dy(tt, inv_dy);
-  const int groups = (count + kLanes - 1) / kLanes;  // of four samples; the last may be short
-  for (int y = y0; y <= y1; ++y) {
-    // The row's texels where some sample can be covered: the union of each sample's bounds.
-    int xa = x1 + 1, xb = x0 - 1;
-    for (int k = 0; k < count; ++k) {
-      const double qy = y + oy[k];
-      double row_term[3];
-      for (int e = 0; e < 3; ++e) row_term[e] = tt.edge_d[e].x * (qy - tt.edge_a[e].y);
-      int a, b;
-      if (!row_bounds(tt, row_term, inv_dy, ox[k], x0, x1, a, b)) continue;
-      xa = std::min(xa, a);
-      xb = std::max(xb, b);
-    }
-    if (xa > xb) continue;
-    const std::size_t row = first + std::size_t(y - y0) * row_stride;
-    for (int g = 0; g < groups; ++g) {
-      // Lanes: samples 4g .. 4g + 3 of each texel (a short group repeats its last sample, masked out).
-      int k[kLanes];
-      for (int j = 0; j < kLanes; ++j) k[j] = std::min(kLanes * g + j, count - 1);
-      const M valid = {kLanes * g < count ? -1 : 0, kLanes * g + 1 < count ? -1 : 0, kLanes * g + 2 < count ? -1 : 0,
-                       kLanes * g + 3 < count ? -1 : 0};
-      const V oxv = {ox[k[0]], ox[k[1]], ox[k[2]], ox[k[3]]};
-      const V qy = V{double(y), double(y), double(y), double(y)} + V{oy[k[0]], oy[k[1]], oy[k[2]], oy[k[3]]};
-      V row_term[3];
-      for (int e = 0; e < 3; ++e) row_term[e] = tt.edge_d[e].x * (qy - tt.edge_a[e].y);
-      for (int x = xa; x <= xb; ++x) {
-        const V qx = V{double(x), double(x), double(x), double(x)} + oxv;
-        M in = valid;
-        // covers() (core/rasterize.h), four samples at a time.
-        V w[3], sum, b[3];
-        edge_weights(in, w, tt, row_term, qx, zero);
-        weight_sum(in, sum, w, zero);
-        const unsigned m = bits(in);
-        if (!m) continue;
-        normalize_weights(b, w, sum);
-        taken += store_lanes(m, b, t, rays, slots, row + std::size_t(x - x0) * std::size_t(count) + std::size_t(kLanes * g));
-      }
-    }
-  }
-  return taken;
+// The widest version the CPU runs whose groups the samples fill (or the one `lanes` asks for): a
+// short group takes the lanes one at a time. None uses FMA (-ffp-contract=off for this library:
+// x86-64-v4 has it), so all give cover_rect's bits.
+std::size_t cover_rect_samples(const TexelTriangle& tt, std::int32_t t, int x0, int x1, int y0, int y1, const double* ox,
+                               const double* oy, int count, const KernelRays& rays, const SampleSlots& slots, std::size_t first,
+                               std::size_t row_stride, int lanes) {
+  if (lanes == 8 || (lanes == 0 && count % 8 == 0 && has_x86_64_v4()))
+    return cover_samples_by_8(tt, t, x0, x1, y0, y1, ox, oy, count, rays, slots, first, row_stride);
+  return cover_samples_by_4(tt, t, x0, x1, y0, y1, ox, oy, count, rays, slots, first, row_stride);
 }
 
 __attribute__((target_clones("avx2", "default"))) std::size_t compact_samples(const SampleSlots& slots, std::size_t slot_count,

@@ -56,10 +56,12 @@ std::size_t cover_rect(const TexelTriangle& tt, std::int32_t t, int x0, int x1, 
 // cover_rect for `count` samples per texel at once, sample k at offset (ox[k], oy[k]): slot
 // first + (y - y0) * row_stride + (x - x0) * count + k, so a texel's samples lie side by side in
 // sample order. Each slot gets the bits cover_rect gives it for that one offset (four samples of a
-// texel per vector operation instead of four texels).
+// texel per vector operation instead of four texels; eight on an AVX-512 CPU when `count` is a
+// multiple of 8). `lanes`: 0 for the fastest version, 4 or 8 to ask for one (tests; 8 only where
+// kernel_lanes_available(8), shade_batch.h).
 std::size_t cover_rect_samples(const TexelTriangle& tt, std::int32_t t, int x0, int x1, int y0, int y1, const double* ox,
                                const double* oy, int count, const KernelRays& rays, const SampleSlots& slots, std::size_t first,
-                               std::size_t row_stride);
+                               std::size_t row_stride, int lanes = 0);
 
 // A tile's covered samples, in order, as arrays: triangle, barycentrics, texel of the tile and,
 // with rays, the ray's origin and direction and whether the caller must make the ray itself.
