@@ -41,20 +41,31 @@ template <typename L, bool same_triangle>
   }
   V b[3], tw[3];
   V3 n[3], t[3], hn[3];
+  // One triangle's value in every lane (broadcast), or each lane's triangle's (gathered).
+  const auto low_value = [&](V& r, auto field) {
+    if constexpr (same_triangle) r = zero + field(lp[0]);
+    else gather(r, [&](int k) { return field(lp[k]); });
+  };
+  // The hit normals' floats gathered, then widened to double at once (exact).
+  const auto high_value = [&](V& r, auto field) {
+    F f;
+    for (int k = 0; k < kN; ++k) f[k] = field(hp[k]);
+    r = __builtin_convertvector(f, V);
+  };
 #pragma GCC unroll 3
   for (int c = 0; c < 3; ++c) {
     if (full) std::memcpy(&b[c], &in.b[c][i], sizeof(V));
     else gather(b[c], [&](int k) { return in.b[c][at[k]]; });
-    gather(n[c].x, [&](int k) { return lp[k]->n[c].x; });
-    gather(n[c].y, [&](int k) { return lp[k]->n[c].y; });
-    gather(n[c].z, [&](int k) { return lp[k]->n[c].z; });
-    gather(t[c].x, [&](int k) { return lp[k]->t[c].x; });
-    gather(t[c].y, [&](int k) { return lp[k]->t[c].y; });
-    gather(t[c].z, [&](int k) { return lp[k]->t[c].z; });
-    gather(tw[c], [&](int k) { return lp[k]->t[c].w; });
-    gather(hn[c].x, [&](int k) { return double(hp[k][c].x); });
-    gather(hn[c].y, [&](int k) { return double(hp[k][c].y); });
-    gather(hn[c].z, [&](int k) { return double(hp[k][c].z); });
+    low_value(n[c].x, [c](const LowTriangle* l) { return l->n[c].x; });
+    low_value(n[c].y, [c](const LowTriangle* l) { return l->n[c].y; });
+    low_value(n[c].z, [c](const LowTriangle* l) { return l->n[c].z; });
+    low_value(t[c].x, [c](const LowTriangle* l) { return l->t[c].x; });
+    low_value(t[c].y, [c](const LowTriangle* l) { return l->t[c].y; });
+    low_value(t[c].z, [c](const LowTriangle* l) { return l->t[c].z; });
+    low_value(tw[c], [c](const LowTriangle* l) { return l->t[c].w; });
+    high_value(hn[c].x, [c](const glm::vec3* h) { return h[c].x; });
+    high_value(hn[c].y, [c](const glm::vec3* h) { return h[c].y; });
+    high_value(hn[c].z, [c](const glm::vec3* h) { return h[c].z; });
   }
   V u, v;
   if (full) {

@@ -104,18 +104,24 @@ template <typename L>
   using I = typename L::I;
   constexpr int kN = L::n;
   constexpr unsigned kAll = (1u << kN) - 1u;
-  CageLanes<V> cr{};
-  codec::Vec3<V>& org = cr.org;
-  codec::Vec3<V>& dir = cr.dir;
+  // Each part computed only where used (zeroing the lanes of them all cost as much as a third of
+  // the kernel at eight lanes).
+  CageLanes<V> cr;
   unsigned good = 0;
-  if (rays.cage) {
-    cage_ray_lanes(rays.low[t], rays.cage[t], rays.diagonal, b, cr, good);
-  } else if (rays.low) {
-    default_ray_lanes(rays.low[t], double(rays.front), b, org, dir, good);
+  F of[3], df[3], far, lo;
+  if (rays.low) {
+    if (rays.cage) {
+      cage_ray_lanes(rays.low[t], rays.cage[t], rays.diagonal, b, cr, good);
+      far = __builtin_convertvector(cr.far, F);
+      lo = __builtin_convertvector(cr.prefer_lo, F);
+    } else {
+      default_ray_lanes(rays.low[t], double(rays.front), b, cr.org, cr.dir, good);
+    }
+    of[0] = __builtin_convertvector(cr.org.x, F), of[1] = __builtin_convertvector(cr.org.y, F);
+    of[2] = __builtin_convertvector(cr.org.z, F);
+    df[0] = __builtin_convertvector(cr.dir.x, F), df[1] = __builtin_convertvector(cr.dir.y, F);
+    df[2] = __builtin_convertvector(cr.dir.z, F);
   }
-  const F of[3] = {__builtin_convertvector(org.x, F), __builtin_convertvector(org.y, F), __builtin_convertvector(org.z, F)};
-  const F df[3] = {__builtin_convertvector(dir.x, F), __builtin_convertvector(dir.y, F), __builtin_convertvector(dir.z, F)};
-  const F far = __builtin_convertvector(cr.far, F), lo = __builtin_convertvector(cr.prefer_lo, F);
   if (m == kAll) {
     // The common case, all lanes at once: every sample covered, their slots free, none near
     // enough to an edge to be moved in (inset_from_edges leaves them as they are).
