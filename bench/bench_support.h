@@ -30,9 +30,10 @@ struct Timing {
   void keep_min(const Timing& t) { keep_min(t.wall, t.cpu); }
 };
 
-// How a bare loop hands the rays to Embree: one rtcIntersect1 per ray, 8-wide packets filled from
-// the Ray structs (Scene::intersect(const Ray*, ...)), or 8-wide packets from rays already held as
-// arrays (raycast::RayBatch, the bake's own layout; the arrays are filled before the clock starts).
+// How a bare loop hands the rays to Embree: one rtcIntersect1 per ray, packets (of
+// Scene::packet_width rays) filled from the Ray structs (Scene::intersect(const Ray*, ...)), or
+// packets from rays already held as arrays (raycast::RayBatch, the bake's own layout; the arrays
+// are filled before the clock starts).
 enum class Bare { single, packets, arrays };
 
 // Casts `rays` with `threads` threads in chunks of 4096, nothing but Embree calls.

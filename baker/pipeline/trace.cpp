@@ -416,6 +416,7 @@ class TileTracer {
     // In registers for the tile: the stores below could alias the thread's counters.
     double dsum = 0.0, dmin = ts_.dmin, dmax = ts_.dmax;
     const std::size_t per = std::size_t(sh_.rays_per_sample);
+    std::uint32_t last_hit = raycast::no_hit;
     for (std::size_t r = 0; r < sample_count; ++r) {
       double dist = 0.0;
       const std::size_t h = chosen_hit(hits_, r * per, signed_base_.data(), sh_.setup.closest, &dist);
@@ -442,10 +443,14 @@ class TileTracer {
       if (hits_.triangle[h] != raycast::no_hit) {
         if (sh_.hit_rule) ts_.facing_away += (hits_.flags[h] & raycast::hit_normal_disagrees) != 0;
         // The hit triangles' corner normals are scattered over the high-poly: ask for them all
-        // before shading needs the first, so the cache misses overlap.
-        const char* line = reinterpret_cast<const char*>(&sh_.scene.normals[3 * std::size_t(hits_.triangle[h])]);
-        __builtin_prefetch(line);
-        __builtin_prefetch(line + sizeof(glm::vec3) * 3 - 1);
+        // before shading needs the first, so the cache misses overlap (once for a run of samples
+        // on one triangle: a texel's samples mostly hit the same few).
+        if (hits_.triangle[h] != last_hit) {
+          last_hit = hits_.triangle[h];
+          const char* line = reinterpret_cast<const char*>(&sh_.scene.normals[3 * std::size_t(last_hit)]);
+          __builtin_prefetch(line);
+          __builtin_prefetch(line + sizeof(glm::vec3) * 3 - 1);
+        }
         ++tile_hits;
         dmin = std::min(dmin, dist);
         dmax = std::max(dmax, dist);
