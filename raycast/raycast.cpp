@@ -123,15 +123,29 @@ struct RuleContext {
   // the ray's tfar. A rejected hit (valid = 0) leaves the range as it was.
   static void filter(const RTCFilterFunctionNArguments* args) {
     RuleContext& rc = *reinterpret_cast<RuleContext*>(args->context);
+    const unsigned n = args->N;
+    if (n > 32) {
+      for (unsigned i = 0; i < n; ++i)
+        if (args->valid[i] == -1) filter_lane(args, rc, i);
+      return;
+    }
+    // The valid lanes as bits, without a branch per lane: a packet's call has a few valid lanes
+    // in no pattern, and a test per lane mispredicted about as often as it ran.
+    std::uint32_t lanes = 0;
+    for (unsigned i = 0; i < n; ++i) lanes |= std::uint32_t(args->valid[i] == -1) << i;
+    for (; lanes; lanes &= lanes - 1) filter_lane(args, rc, unsigned(__builtin_ctz(lanes)));
+  }
+
+  // One valid lane of a filter call: the rule, as HitRule says.
+  static void filter_lane(const RTCFilterFunctionNArguments* args, RuleContext& rc, unsigned i) {
     const HitRule& rule = *rc.rule;
     const unsigned n = args->N;
-    for (unsigned i = 0; i < n; ++i) {
-      if (args->valid[i] != -1) continue;
+    {
       const unsigned lane = RTCRayN_id(args->ray, n, i) & unsigned(kMaxPacket - 1);
       const std::uint32_t prim = RTCHitN_primID(args->hit, n, i);
       if (rule.group && rule.group[prim] != rc.group[lane]) {  // not in this ray's scene
         args->valid[i] = 0;
-        continue;
+        return;
       }
       // The low-poly's outside: -direction for inward rays, +direction for outward ones.
       const float side = rc.outward[lane] ? 1.0f : -1.0f;
@@ -145,7 +159,7 @@ struct RuleContext {
         rc.backface_t[lane] = std::min(rc.backface_t[lane], t);
         rc.marked = true;
         args->valid[i] = 0;
-        continue;
+        return;
       }
       const float u = RTCHitN_u(args->hit, n, i), v = RTCHitN_v(args->hit, n, i);
       // The normals are read only when they could point away: the face is no nearer the outside
@@ -159,17 +173,17 @@ struct RuleContext {
         if (!(glm::dot(nh, out) > 0.0f)) {
           rc.keep(rc.kept[1][lane], t, t, u, v, prim);
           args->valid[i] = 0;
-          continue;
+          return;
         }
       }
       if (t < rc.prefer_lo[lane] || t > rc.prefer_hi[lane]) {
         rc.keep(rc.kept[0][lane], t < rc.prefer_lo[lane] ? rc.prefer_lo[lane] - t : t - rc.prefer_hi[lane], t, u, v, prim);
         args->valid[i] = 0;
-        continue;
+        return;
       }
       if (t == rc.accepted_t[lane] && prim > rc.accepted_prim[lane]) {
         args->valid[i] = 0;
-        continue;
+        return;
       }
       rc.accepted_t[lane] = t;
       rc.accepted_prim[lane] = prim;
