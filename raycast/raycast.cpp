@@ -126,20 +126,26 @@ struct RuleContext {
     const unsigned n = args->N;
     if (n > 32) {
       for (unsigned i = 0; i < n; ++i)
-        if (args->valid[i] == -1) filter_lane(args, rc, i);
+        if (args->valid[i] == -1) filter_lane<0>(args, rc, i);
       return;
     }
     // The valid lanes as bits, without a branch per lane: a packet's call has a few valid lanes
     // in no pattern, and a test per lane mispredicted about as often as it ran.
     std::uint32_t lanes = 0;
     for (unsigned i = 0; i < n; ++i) lanes |= std::uint32_t(args->valid[i] == -1) << i;
-    for (; lanes; lanes &= lanes - 1) filter_lane(args, rc, unsigned(__builtin_ctz(lanes)));
+    if (n == 16) {  // the bake's packets: the fields' offsets known at compile time
+      for (; lanes; lanes &= lanes - 1) filter_lane<16>(args, rc, unsigned(__builtin_ctz(lanes)));
+      return;
+    }
+    for (; lanes; lanes &= lanes - 1) filter_lane<0>(args, rc, unsigned(__builtin_ctz(lanes)));
   }
 
   // One valid lane of a filter call: the rule, as HitRule says.
-  static void filter_lane(const RTCFilterFunctionNArguments* args, RuleContext& rc, unsigned i) {
+  // kN: the call's N when known (16), else 0 (args->N).
+  template <unsigned kN>
+  [[gnu::always_inline]] static inline void filter_lane(const RTCFilterFunctionNArguments* args, RuleContext& rc, unsigned i) {
     const HitRule& rule = *rc.rule;
-    const unsigned n = args->N;
+    const unsigned n = kN ? kN : args->N;
     {
       const unsigned lane = RTCRayN_id(args->ray, n, i) & unsigned(kMaxPacket - 1);
       const std::uint32_t prim = RTCHitN_primID(args->hit, n, i);

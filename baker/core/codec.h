@@ -17,13 +17,18 @@
 
 namespace nmbake::codec {
 
-// What the steps need beyond + - * /, per number type: the square root. lanes.h gives the
-// four-lane one.
+// What the steps need beyond + - * /, per number type: the square root, and the comparisons
+// (a bool for one sample, a lane mask for vectors: lanes.h gives the four- and eight-lane ones).
 template <typename T>
 struct Ops;
 template <>
 struct Ops<double> {
   static void root(double& r, const double& a) { r = std::sqrt(a); }
+  static bool gt(double a, double b) { return a > b; }
+  static bool ge(double a, double b) { return a >= b; }
+  static bool lt(double a, double b) { return a < b; }
+  static bool le(double a, double b) { return a <= b; }
+  static bool invert(bool m) { return !m; }
 };
 
 template <typename T>
@@ -110,7 +115,9 @@ constexpr double kSingular = 1e-24;
 // mask for four.
 template <typename T, typename Mask>
 [[gnu::always_inline]] inline void trusted(Mask& r, const Encoding<T>& e) {
-  r = (e.det * e.det > kSingular * e.scale2) & (e.det >= -DBL_MAX) & (e.det <= DBL_MAX) & (e.len > 0.0) & (e.len <= DBL_MAX);
+  const T zero{};
+  r = Ops<T>::gt(e.det * e.det, kSingular * e.scale2) & Ops<T>::ge(e.det, zero - DBL_MAX) & Ops<T>::le(e.det, zero + DBL_MAX) &
+      Ops<T>::gt(e.len, zero) & Ops<T>::le(e.len, zero + DBL_MAX);
 }
 
 // The encoded tangent-space unit vector, given the factor x is scaled by: inv where det > 0, -inv

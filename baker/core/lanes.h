@@ -18,6 +18,10 @@
 // is written before use (all four are assigned at once). Off for the kernel files that include this.
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+// The comparisons below (codec::Ops) return vectors: always inlined, they are never called across
+// the clones' conventions -Wpsabi warns about (nmbake_trace, which instantiates codec.h's and
+// rasterize.h's templates with them, is built with -Wno-psabi for the same reason).
+#pragma GCC diagnostic ignored "-Wpsabi"
 #endif
 
 namespace nmbake::lanes {
@@ -71,18 +75,26 @@ template <typename Fn>
 [[gnu::always_inline]] inline void gather(V8& r, Fn f) {
   r = V8{f(0), f(1), f(2), f(3), f(4), f(5), f(6), f(7)};
 }
+// Kept a loop (no unrolling) for GCC's loop vectorizer to make one vector square root of it (the
+// kernels' library has no errno: -fno-math-errno); unrolled, the lanes were taken apart and the
+// comparisons after them made one lane at a time (-O3 without SLP vectorization).
 [[gnu::always_inline]] inline void vsqrt(V8& r, const V8& a) {
+#pragma GCC unroll 1
   for (int k = 0; k < 8; ++k) r[k] = std::sqrt(a[k]);
 }
 [[gnu::always_inline]] inline unsigned bits(const I8& m) {
-  unsigned r = 0;
-  for (int k = 0; k < 8; ++k) r |= unsigned(m[k] != 0) << k;
-  return r;
+  const I8 t = m & I8{1, 2, 4, 8, 16, 32, 64, 128};
+  const I u = __builtin_shufflevector(t, t, 0, 1, 2, 3) | __builtin_shufflevector(t, t, 4, 5, 6, 7);
+  const I v = u | I{u[2], u[3], 0, 0};
+  return unsigned(v[0] | v[1]);
 }
+// With vector operations (narrowed, weighted, or-ed together): a loop over the lanes made GCC
+// compute the comparisons before it one lane at a time.
 [[gnu::always_inline]] inline unsigned bits(const M8& m) {
-  unsigned r = 0;
-  for (int k = 0; k < 8; ++k) r |= unsigned(m[k] != 0) << k;
-  return r;
+  const I8 t = __builtin_convertvector(m, I8) & I8{1, 2, 4, 8, 16, 32, 64, 128};
+  const I u = __builtin_shufflevector(t, t, 0, 1, 2, 3) | __builtin_shufflevector(t, t, 4, 5, 6, 7);
+  const I v = u | I{u[2], u[3], 0, 0};
+  return unsigned(v[0] | v[1]);
 }
 
 // The vector types of one width, for kernels written once over it.
@@ -121,10 +133,43 @@ inline bool has_x86_64_v4() {
 namespace nmbake::codec {
 template <>
 struct Ops<lanes::V> {
-  [[gnu::always_inline]] static void root(lanes::V& r, const lanes::V& a) { lanes::vsqrt(r, a); }
+  using V = lanes::V;
+  using M = lanes::M;
+  [[gnu::always_inline]] static void root(V& r, const V& a) { lanes::vsqrt(r, a); }
+  [[gnu::always_inline]] static M gt(const V& a, const V& b) { return a > b; }
+  [[gnu::always_inline]] static M ge(const V& a, const V& b) { return a >= b; }
+  [[gnu::always_inline]] static M lt(const V& a, const V& b) { return a < b; }
+  [[gnu::always_inline]] static M le(const V& a, const V& b) { return a <= b; }
+  [[gnu::always_inline]] static M invert(const M& m) { return ~m; }
 };
+// Eight lanes compared as two halves of four: GCC 12 made some eight-lane comparisons one lane at
+// a time (a scalar compare, a set and an insert per lane), the halves take one instruction each.
 template <>
 struct Ops<lanes::V8> {
-  [[gnu::always_inline]] static void root(lanes::V8& r, const lanes::V8& a) { lanes::vsqrt(r, a); }
+  using V8 = lanes::V8;
+  using M8 = lanes::M8;
+  using V = lanes::V;
+  using M = lanes::M;
+  [[gnu::always_inline]] static void root(V8& r, const V8& a) { lanes::vsqrt(r, a); }
+  template <typename Fn>
+  [[gnu::always_inline]] static M8 halves(const V8& a, const V8& b, Fn f) {
+    const V al = __builtin_shufflevector(a, a, 0, 1, 2, 3), ah = __builtin_shufflevector(a, a, 4, 5, 6, 7);
+    const V bl = __builtin_shufflevector(b, b, 0, 1, 2, 3), bh = __builtin_shufflevector(b, b, 4, 5, 6, 7);
+    const M lo = f(al, bl), hi = f(ah, bh);
+    return __builtin_shufflevector(lo, hi, 0, 1, 2, 3, 4, 5, 6, 7);
+  }
+  [[gnu::always_inline]] static M8 gt(const V8& a, const V8& b) {
+    return halves(a, b, [](const V& x, const V& y) { return M(x > y); });
+  }
+  [[gnu::always_inline]] static M8 ge(const V8& a, const V8& b) {
+    return halves(a, b, [](const V& x, const V& y) { return M(x >= y); });
+  }
+  [[gnu::always_inline]] static M8 lt(const V8& a, const V8& b) {
+    return halves(a, b, [](const V& x, const V& y) { return M(x < y); });
+  }
+  [[gnu::always_inline]] static M8 le(const V8& a, const V8& b) {
+    return halves(a, b, [](const V& x, const V& y) { return M(x <= y); });
+  }
+  [[gnu::always_inline]] static M8 invert(const M8& m) { return ~m; }
 };
 }  // namespace nmbake::codec

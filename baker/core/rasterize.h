@@ -16,6 +16,7 @@
 
 #include <glm/glm.hpp>
 
+#include "core/codec.h"
 #include "core/mesh.h"
 
 namespace nmbake {
@@ -63,7 +64,7 @@ template <typename T, typename Mask, typename Row>
     const T e = row[k] - tri.edge_d[k].y * (qx - tri.edge_a[k].x);
     // e < 0 rejects when the opposite corner is on the positive side, else e >= 0 (a NaN passes
     // both tests; the sum test rejects it).
-    in &= tri.edge_side[k] > 0.0 ? ((e < zero) == 0) : ((e >= zero) == 0);
+    in &= codec::Ops<T>::invert(tri.edge_side[k] > 0.0 ? codec::Ops<T>::lt(e, zero) : codec::Ops<T>::ge(e, zero));
     w[(k + 2) % 3] = e * tri.edge_inv_side[k];
   }
 }
@@ -71,7 +72,7 @@ template <typename T, typename Mask, typename Row>
 template <typename T, typename Mask>
 [[gnu::always_inline]] inline void weight_sum(Mask& in, T& sum, const T w[3], const T& zero) {
   sum = w[0] + w[1] + w[2];
-  in &= (sum > zero) & (sum <= DBL_MAX);
+  in &= codec::Ops<T>::gt(sum, zero) & codec::Ops<T>::le(sum, zero + DBL_MAX);
 }
 // The barycentrics: the weights times 1 / sum.
 template <typename T>

@@ -22,7 +22,7 @@ template <typename V>
   codec::Vec3<V> p, n;
   V len2;
   low_point_and_normal(p, n, len2, lt, w);
-  good = bits(len2 > 1e-24);
+  good = bits(codec::Ops<V>::gt(len2, V{} + 1e-24));
   default_ray(org, dir, p, n, front);
 }
 
@@ -35,6 +35,17 @@ struct CageLanes {
   codec::Vec3<V> org, dir;
   V far, base, prefer_lo;
 };
+// a where m is set, else b (m: all ones or zero per lane), by the bits.
+template <typename V, typename M>
+[[gnu::always_inline]] inline V select(const M& m, const V& a, const V& b) {
+  M ai, bi;
+  std::memcpy(&ai, &a, sizeof ai);
+  std::memcpy(&bi, &b, sizeof bi);
+  const M r = (ai & m) | (bi & ~m);
+  V out;
+  std::memcpy(&out, &r, sizeof out);
+  return out;
+}
 template <typename V>
 [[gnu::always_inline]] inline void weighted(V& r, const V (&w)[3], const double c[3]) {
   r = w[0] * c[0];
@@ -54,14 +65,14 @@ template <typename V>
   V len2, len;
   dot(len2, d, d);
   vsqrt(len, len2);
-  good = bits(len > 1e-9 * diagonal);
+  good = bits(codec::Ops<V>::gt(len, V{} + 1e-9 * diagonal));
   r.dir = {d.x / len, d.y / len, d.z / len};
-  const V s = len < search ? search : len;  // std::max(len, search)
+  const V s = select(codec::Ops<V>::lt(len, search), search, len);  // std::max(len, search)
   r.org = {p.x - s * r.dir.x, p.y - s * r.dir.y, p.z - s * r.dir.z};
   r.far = s + rear;
   r.base = s;
   const V zero = {};
-  r.prefer_lo = s > len ? s - len : zero;
+  r.prefer_lo = select(codec::Ops<V>::gt(s, len), s - len, zero);
 }
 
 // The texels x0 <= x <= x1 of one row whose sample at x offset ox can be covered, xa .. xb: each
@@ -127,7 +138,8 @@ template <typename L>
     // enough to an edge to be moved in (inset_from_edges leaves them as they are).
     I held;
     std::memcpy(&held, &slots.tri[slot0], sizeof held);
-    const M far_from_edges = (b[0] >= kEdgeInset) & (b[1] >= kEdgeInset) & (b[2] >= kEdgeInset);
+    const V inset = V{} + kEdgeInset;
+    const M far_from_edges = codec::Ops<V>::ge(b[0], inset) & codec::Ops<V>::ge(b[1], inset) & codec::Ops<V>::ge(b[2], inset);
     if (bits(held < 0) == kAll && bits(far_from_edges) == kAll) {
       const I tris = I{} + t;
       std::memcpy(&slots.tri[slot0], &tris, sizeof tris);
