@@ -186,6 +186,19 @@ template <typename L>
   return taken;
 }
 
+// covers() (core/rasterize.h) for the lanes `in` marks, at qx on a row whose edges' first products
+// are row_term (one per edge, or per lane): the covered lanes as bits, and their barycentrics in b.
+template <typename V, typename M, typename Row>
+[[gnu::always_inline]] inline unsigned covered_lanes(M in, V (&b)[3], const TexelTriangle& tt, const Row (&row_term)[3],
+                                                     const V& qx, const V& zero) {
+  V w[3], sum;
+  edge_weights(in, w, tt, row_term, qx, zero);
+  weight_sum(in, sum, w, zero);
+  const unsigned m = bits(in);
+  if (m) normalize_weights(b, w, sum);
+  return m;
+}
+
 // 1 / d.y of each edge, for row_bounds (which need not be exact).
 [[gnu::always_inline]] inline void inverse_dy(const TexelTriangle& tt, double inv_dy[3]) {
   for (int k = 0; k < 3; ++k) inv_dy[k] = tt.edge_d[k].y != 0.0 ? 1.0 / tt.edge_d[k].y : 0.0;
@@ -234,14 +247,9 @@ template <typename L>
       for (int e = 0; e < 3; ++e) row_term[e] = tt.edge_d[e].x * (qy - tt.edge_a[e].y);
       for (int x = xa; x <= xb; ++x) {
         const V qx = (zero + double(x)) + oxv;
-        M in = valid;
-        // covers() (core/rasterize.h), n samples at a time.
-        V w[3], sum, b[3];
-        edge_weights(in, w, tt, row_term, qx, zero);
-        weight_sum(in, sum, w, zero);
-        const unsigned m = bits(in);
+        V b[3];
+        const unsigned m = covered_lanes(valid, b, tt, row_term, qx, zero);
         if (!m) continue;
-        normalize_weights(b, w, sum);
         taken += store_lanes<L>(m, b, t, rays, slots, row + std::size_t(x - x0) * std::size_t(count) + std::size_t(kN * g));
       }
     }
@@ -289,14 +297,10 @@ __attribute__((target_clones("avx2", "default"))) std::size_t cover_rect(const T
     if (!row_bounds(tt, row_term, inv_dy, ox, x0, x1, xa, xb)) continue;
     for (int x = xa; x <= xb; x += kLanes) {
       const V qx = V{double(x), double(x + 1), double(x + 2), double(x + 3)} + ox;
-      M in = {x <= xb ? -1 : 0, x + 1 <= xb ? -1 : 0, x + 2 <= xb ? -1 : 0, x + 3 <= xb ? -1 : 0};
-      // covers() (core/rasterize.h), four samples at a time.
-      V w[3], sum, b[3];
-      edge_weights(in, w, tt, row_term, qx, zero);
-      weight_sum(in, sum, w, zero);
-      const unsigned m = bits(in);
+      const M in = {x <= xb ? -1 : 0, x + 1 <= xb ? -1 : 0, x + 2 <= xb ? -1 : 0, x + 3 <= xb ? -1 : 0};
+      V b[3];
+      const unsigned m = covered_lanes(in, b, tt, row_term, qx, zero);
       if (!m) continue;
-      normalize_weights(b, w, sum);
       taken += store_lanes<Lanes4>(m, b, t, rays, slots, row + std::size_t(x - x0));
     }
   }
