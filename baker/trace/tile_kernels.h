@@ -1,6 +1,6 @@
-// The trace loop's first steps for a tile, four samples per vector operation: which samples of a
-// rectangle of texels one triangle covers, with their barycentrics, and, for the cage-first
-// policy (default rays or a cage), their rays.
+// The trace loop's first steps for a tile, four samples per vector operation (eight for a texel's
+// samples on an AVX-512 CPU): which samples of a rectangle of texels one triangle covers, with
+// their barycentrics, and, for the cage-first policy (default rays or a cage), their rays.
 //
 // Each result has exactly the bits of its one-sample definition, computed in the same order of
 // operations: covers() in rasterize.h for the coverage and barycentrics, and for the rays the
