@@ -223,11 +223,12 @@ class Scene {
   std::size_t triangle_count() const;
 
   // How many rays intersect(RayBatch, ...) hands Embree at once: 16 where Embree traces packets
-  // of 16 natively (an AVX-512 CPU), else 8. The hits do not depend on it under a HitRule, whose
-  // choice among hits does not depend on the order Embree finds them in; without one, of two
-  // triangles at one distance the packet's traversal decides. set_packet_width (8 or 16; not while
-  // another thread traces) is for tests and benchmarks: 16 on a CPU without native packets of 16
-  // is correct but slow (Embree splits them).
+  // of 16 natively (an AVX-512 CPU), else 8. Under a HitRule the hits do not depend on it, except
+  // for a ray through a vertex or edge exactly: Embree's 8- and 16-wide triangle tests may report
+  // different ones of the triangles meeting there (the same point, the same t), and along a mesh's
+  // rim one may miss. Without a rule, of two triangles at one distance the packet's traversal
+  // decides. set_packet_width (8 or 16; not while another thread traces) is for tests and
+  // benchmarks: 16 on a CPU without native packets of 16 is correct but slow (Embree splits them).
   int packet_width() const;
   void set_packet_width(int width);
 

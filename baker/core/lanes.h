@@ -56,10 +56,11 @@ template <typename Fn>
   return bits(narrow);
 }
 
-// to[k] = bit k of `bits` (0 or 1), for the four lanes: per-lane flags stored at once.
-[[gnu::always_inline]] inline void store_flags(std::uint8_t* to, unsigned bits) {
-  const std::uint8_t flags[kLanes] = {std::uint8_t(bits & 1u), std::uint8_t(bits >> 1 & 1u), std::uint8_t(bits >> 2 & 1u),
-                                      std::uint8_t(bits >> 3 & 1u)};
+// to[k] = bit k of `bits` (0 or 1) for the L lanes: per-lane flags stored at once.
+template <int L>
+[[gnu::always_inline]] inline void store_lane_flags(std::uint8_t* to, unsigned bits) {
+  std::uint8_t flags[L];
+  for (int k = 0; k < L; ++k) flags[k] = std::uint8_t(bits >> k & 1u);
   std::memcpy(to, flags, sizeof flags);
 }
 
@@ -82,19 +83,16 @@ template <typename Fn>
 #pragma GCC unroll 1
   for (int k = 0; k < 8; ++k) r[k] = std::sqrt(a[k]);
 }
+// With vector operations (weighted, or-ed together), not a loop over the lanes.
 [[gnu::always_inline]] inline unsigned bits(const I8& m) {
   const I8 t = m & I8{1, 2, 4, 8, 16, 32, 64, 128};
   const I u = __builtin_shufflevector(t, t, 0, 1, 2, 3) | __builtin_shufflevector(t, t, 4, 5, 6, 7);
   const I v = u | I{u[2], u[3], 0, 0};
   return unsigned(v[0] | v[1]);
 }
-// With vector operations (narrowed, weighted, or-ed together): a loop over the lanes made GCC
-// compute the comparisons before it one lane at a time.
 [[gnu::always_inline]] inline unsigned bits(const M8& m) {
-  const I8 t = __builtin_convertvector(m, I8) & I8{1, 2, 4, 8, 16, 32, 64, 128};
-  const I u = __builtin_shufflevector(t, t, 0, 1, 2, 3) | __builtin_shufflevector(t, t, 4, 5, 6, 7);
-  const I v = u | I{u[2], u[3], 0, 0};
-  return unsigned(v[0] | v[1]);
+  const I8 narrow = __builtin_convertvector(m, I8);
+  return bits(narrow);
 }
 
 // The vector types of one width, for kernels written once over it.
@@ -112,14 +110,6 @@ struct Lanes8 {
   using I = I8;
   static constexpr int n = 8;
 };
-
-// to[k] = bit k of `bits` (0 or 1) for the L lanes.
-template <int L>
-[[gnu::always_inline]] inline void store_lane_flags(std::uint8_t* to, unsigned bits) {
-  std::uint8_t flags[L];
-  for (int k = 0; k < L; ++k) flags[k] = std::uint8_t(bits >> k & 1u);
-  std::memcpy(to, flags, sizeof flags);
-}
 
 // Whether this CPU runs the kernels' AVX-512 (x86-64-v4) versions: AVX-512 F, VL, BW and DQ.
 inline bool has_x86_64_v4() {

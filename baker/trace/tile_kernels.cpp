@@ -483,7 +483,7 @@ __attribute__((target_clones("avx2", "default"))) void write_texel_row(const Tex
                          __builtin_shufflevector(rg_mid, out[2], 0, 5, 1, 2),  // g1 b1 r2 g2
                          __builtin_shufflevector(out[2], rg_hi, 2, 4, 5, 3)};  // b2 r3 g3 b3
       std::memcpy(rgb + 3 * std::size_t(x), rgb4, sizeof rgb4);
-      store_flags(covered + x, 0xfu);
+      store_lane_flags<kLanes>(covered + x, 0xfu);
       continue;
     }
     for (int k = 0; k < n; ++k) {
