@@ -1,4 +1,6 @@
-# The dynamic loader's share of every start: which libraries it searches first.
+# The dynamic loader's share of loading OpenImageIO: which libraries it searches first. Only
+# libnmbake-oiio.so links it (baker/io/oiio_module.h); the rule is the same for a module dlopen
+# loads as for a program, its own libraries searched in its DT_NEEDED order after the program's.
 #
 # OpenImageIO loads ~260 shared libraries (OpenVDB, GDAL through OpenCV, DCMTK, ...), most linked
 # with BIND_NOW, so each start of a program that links it resolves ~157,000 symbols before main.
@@ -13,7 +15,7 @@
 option(NMBAKE_LOAD_ORDER "List the libraries with the most symbol relocations first (faster process start)" ON)
 set(NMBAKE_LOAD_ORDER_COUNT 12 CACHE STRING "How many libraries nmbake_load_order names first")
 
-# nmbake_load_order(TARGET LIBRARY): every program linking TARGET (an INTERFACE library) names,
+# nmbake_load_order(TARGET LIBRARY): every program or module linking TARGET (an INTERFACE library) names,
 # first, the heaviest libraries that LIBRARY (a shared library's path) loads.
 function(nmbake_load_order target library)
   if(NOT NMBAKE_LOAD_ORDER OR NOT EXISTS "${library}" OR NOT CMAKE_SYSTEM_NAME STREQUAL "Linux")

@@ -473,6 +473,9 @@ void bake_job(const Args& a, const JobEnv& env) {
   const int bits = a.bits ? a.bits : default_bits_for(a.output);
   check_udim_outputs(a);
   check_outputs(a, bits);
+  for (MapKind k : parse_maps(a.maps)) prepare_write(map_path(a.output, k));
+  for (const std::string& mask : {a.miss_mask, a.suspect_mask})
+    if (!mask.empty()) prepare_write(mask);
   WarningLog warnings(a.quiet < 2 && !a.no_warnings, a.strict);
 
   // Load.

@@ -1,5 +1,6 @@
 // Reading and writing images: PNG is written by png_write.cpp, everything else goes through
-// OpenImageIO (image_io.cpp, image_read.cpp: the only code that includes it).
+// OpenImageIO, in a module loaded on first use (oiio_module.h: image_io_oiio.cpp and
+// image_read.cpp are the only code that includes it).
 #pragma once
 
 #include <map>
@@ -53,6 +54,13 @@ struct WriteOptions {
 // file in errors. Throws OutputError "<path>: cannot write: <reason>", one short line (the
 // system's reason where a write failed: "No space left on device"), the temporary removed.
 void write_image(const std::string& path, const Image& image, const WriteOptions& options = {});
+
+// Starts loading what writing `path` needs, on a thread of its own, so that it runs beside the
+// caller's work (a bake): OpenImageIO's module for a format other than PNG, 0.3 s of one core.
+// write_image waits for it. Does nothing for PNG; starts no thread when "all cores" is one thread
+// (nmbake --threads 1: no thread beside the stages). Throws OutputError naming `path` when the
+// module is not to be found, so that a command fails before its work rather than at the write.
+void prepare_write(const std::string& path);
 
 // Reads any format OpenImageIO reads, converted to float (integer formats scaled to [0,1]).
 // Throws InputError naming the file when it cannot be read.

@@ -1,5 +1,5 @@
 // The reading half of image_io.h: read_image and read_image_metadata through OpenImageIO, with the
-// checks of image_read_guard.h before any pixel is allocated.
+// checks of image_read_guard.h before any pixel is allocated. Part of libnmbake-oiio.so (oiio_module.h).
 #include <algorithm>
 #include <cctype>
 #include <cstdint>
@@ -12,7 +12,7 @@
 
 #include "core/errors.h"
 #include "core/memory_budget.h"
-#include "io/image_io.h"
+#include "io/oiio_module.h"
 #include "io/image_read_guard.h"
 
 namespace nmbake {
@@ -76,7 +76,7 @@ Image read_pixels(const std::string& path, OIIO::ImageInput& in, std::uint64_t f
 
 }  // namespace
 
-Image read_image(const std::string& path) {
+Image oiio_module::read(const std::string& path) {
   // Only a regular file: a FIFO or a device would block or never end.
   const std::uint64_t file_size = regular_file_size(path);
   try {
@@ -90,7 +90,7 @@ Image read_image(const std::string& path) {
   }
 }
 
-std::map<std::string, std::string> read_image_metadata(const std::string& path) {
+std::map<std::string, std::string> oiio_module::read_metadata(const std::string& path) {
   regular_file_size(path);
   try {
     auto in = OIIO::ImageInput::open(path);
