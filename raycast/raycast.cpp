@@ -308,8 +308,12 @@ namespace {
 
 void build(Scene::Impl& impl, const float* positions, std::size_t vertex_count, const std::uint32_t* indices,
            std::size_t triangle_count, BuildQuality quality, int threads, bool share) {
-  std::string config = threads > 0 ? "threads=" + std::to_string(threads) : std::string();
-  impl.device = rtcNewDevice(config.empty() ? nullptr : config.c_str());
+  // Huge pages for Embree's blocks (the BVH's nodes and build arrays): where the kernel gives them
+  // only when asked (transparent_hugepage "madvise"), 4 KiB page faults were much of the build's time
+  // and did not shrink with threads (baker/cli/large_pages.cpp does the same for nmbake's arrays).
+  std::string config = "hugepages=1";
+  if (threads > 0) config += ",threads=" + std::to_string(threads);
+  impl.device = rtcNewDevice(config.c_str());
   check_device(impl.device);
   rtcSetDeviceErrorFunction(impl.device, throw_on_error, nullptr);
   impl.triangles = triangle_count;
