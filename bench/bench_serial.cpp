@@ -22,7 +22,7 @@ constexpr int kSerialPredictThreads = 16;
 
 // The rows of the table: the report's stages, then what its total holds beyond them, then what
 // the process's wall time holds beyond the total (start, reading the libraries, exit).
-constexpr const char* kSerialStages[] = {"load", "prepare", "bvh", "distances", "trace", "padding", "write"};
+constexpr const char* kSerialStages[] = {"load", "prepare", "bvh", "distances", "trace", "padding", "topology", "write"};
 constexpr int kSerialStageCount = int(sizeof kSerialStages / sizeof kSerialStages[0]);
 constexpr int kSerialRowCount = kSerialStageCount + 2;
 

@@ -227,3 +227,27 @@ TEST(Stability, TopologyAndInversionAreReportedByTheCli) {
   EXPECT_EQ(r.report["options"]["keep_backfaces"], true);
   EXPECT_EQ(r.report["backfaces_skipped"], false);
 }
+
+// A high-poly with normals in its file is checked after the bake: on one thread before the write,
+// on several beside it. The same counts either way, and the report's seconds say what the check
+// took ("topology"); a high-poly whose normals the bake computed (no normals in its file) was
+// checked on the way (0).
+TEST(Stability, TopologyCheckedBesideTheWriteCountsTheSame) {
+  const std::string sample =
+      " '" + test::data_path("sample/torus_low.obj") + "' '" + test::data_path("sample/torus_high.ply") + "'";
+  const CliRun one = run_nmbake(sample + " -o one.png --size 64 --threads 1 --report r.json");
+  const CliRun two = run_nmbake(sample + " -o two.png --size 64 --threads 2 --report r.json");
+  ASSERT_EQ(one.code, 0);
+  ASSERT_EQ(two.code, 0);
+  for (const char* key : {"boundary_edges", "non_manifold_edges", "duplicate_faces", "isolated_vertices", "welded_vertices",
+                          "inconsistent_winding_faces"})
+    EXPECT_EQ(one.report["high_mesh"][key], two.report["high_mesh"][key]) << key;
+  EXPECT_GT(one.report["high_mesh"]["welded_vertices"].get<double>(), 0.0);
+  EXPECT_GT(one.report["seconds"]["topology"].get<double>(), 0.0);
+  EXPECT_GE(two.report["seconds"]["topology"].get<double>(), 0.0);
+  const CliRun computed = run_nmbake("'" + data("flat_grid_low.obj") + "' '" + data("isolated_vertices_high.obj") +
+                                     "' -o out.png --size 32 --report r.json");
+  ASSERT_EQ(computed.code, 0);
+  EXPECT_EQ(computed.report["high_normals_computed"], true);
+  EXPECT_EQ(computed.report["seconds"]["topology"].get<double>(), 0.0);
+}

@@ -565,12 +565,21 @@ void bake_job(const Args& a, const JobEnv& env) {
     if (udim) udim->trace_inputs.reset();
   }
   // Topology checks are only reported. A bake that computed the high-poly's normals found them on
-  // the way; otherwise they run beside the image write, after the bake (and the estimate) have
-  // freed the BVH, so that they take neither the bake's threads nor its peak memory.
+  // the way; otherwise they run after the bake (and the estimate) have freed the BVH, so that they
+  // add nothing to its peak memory: beside the image write, on threads of their own, where the
+  // write leaves cores idle (its file and sync); on one thread (--threads 1), before it, so that
+  // the command never takes a core --threads did not give it.
   std::future<MeshTopology> topology;
-  if (!s.prepare.high_topology)
-    topology = std::async(std::launch::async, [&high, threads = o.threads] { return inspect_topology(high, threads); });
-
+  if (!s.prepare.high_topology) {
+    *env.doing = "checking the high-poly's topology";
+    if (worker_threads(o.threads) > 1) {
+      topology = std::async(std::launch::async, [&high, threads = o.threads] { return inspect_topology(high, threads); });
+    } else {
+      t0 = Clock::now();
+      run.high_topology = inspect_topology(high, o.threads);
+      run.seconds_topology = seconds_since(t0);
+    }
+  }
   // Every output to its temporary file, then all renamed into place together.
   OutputSet outputs;
   *env.doing = "writing the outputs";
@@ -578,8 +587,14 @@ void bake_job(const Args& a, const JobEnv& env) {
   t0 = Clock::now();
   write_outputs(env, outputs, a, o, r, udim ? &*udim : nullptr, low, bits);
   run.seconds_write = seconds_since(t0);
-  *env.doing = "checking the high-poly's topology";
-  run.high_topology = s.prepare.high_topology ? *s.prepare.high_topology : topology.get();
+  if (s.prepare.high_topology) {
+    run.high_topology = *s.prepare.high_topology;
+  } else if (topology.valid()) {
+    *env.doing = "checking the high-poly's topology";
+    t0 = Clock::now();
+    run.high_topology = topology.get();
+    run.seconds_topology = seconds_since(t0);  // what the check adds after the write
+  }
   if (env.keep_progress) env.progress.hold();
   else env.progress.finish();
   warnings.add(bake_warnings(s, run.high_topology, a.low, a.high, uv_tiles_note(low, a, o.width, o.height),

@@ -151,6 +151,7 @@ nlohmann::json make_report(const BakeOptions& o, const BakeStats& s, const RunIn
         {"distances", s.distances.seconds},
         {"trace", s.trace.seconds},
         {"padding", s.pad.seconds},
+        {"topology", r.seconds_topology},
         {"write", r.seconds_write},
         {"total", r.seconds_total}}},
       {"rays", s.trace.rays},

@@ -29,6 +29,9 @@ struct RunInfo {
   std::vector<std::size_t> high_triangles;      // each file's triangles
   MeshTopology high_topology;                   // inspect_topology(high)
   double seconds_load = 0, seconds_write = 0, seconds_total = 0;
+  // The high-poly's topology check after the bake: on one thread all its time, beside the write what
+  // it adds after the write; 0 when the bake found it with the normals.
+  double seconds_topology = 0;
   std::uint64_t peak_memory_bytes = 0;
   unsigned threads_used = 0;
   std::vector<std::string> command;      // argv, as given
