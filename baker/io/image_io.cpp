@@ -209,10 +209,12 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
 }
 
 Image read_image(const std::string& path) {
-  regular_file_size(path);  // "no such file" without loading the module
+  // Only a regular file (a FIFO or a device would block or never end), and "no such file" without
+  // loading the module.
+  const std::uint64_t file_size = regular_file_size(path);
   Image image;
   oiio_module::Failure failure;
-  oiio_module::api(path, ExitCode::input).read(path, all_cores_setting().load(), &image, &failure);
+  oiio_module::api(path, ExitCode::input).read(path, file_size, all_cores_setting().load(), &image, &failure);
   rethrow(failure);
   return image;
 }

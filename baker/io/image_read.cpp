@@ -76,9 +76,7 @@ Image read_pixels(const std::string& path, OIIO::ImageInput& in, std::uint64_t f
 
 }  // namespace
 
-Image oiio_module::read(const std::string& path) {
-  // Only a regular file: a FIFO or a device would block or never end.
-  const std::uint64_t file_size = regular_file_size(path);
+Image oiio_module::read(const std::string& path, std::uint64_t file_size) {
   try {
     OIIO::ImageSpec config;
     config.attribute("oiio:UnassociatedAlpha", 1);  // alpha is coverage: do not premultiply
@@ -91,7 +89,6 @@ Image oiio_module::read(const std::string& path) {
 }
 
 std::map<std::string, std::string> oiio_module::read_metadata(const std::string& path) {
-  regular_file_size(path);
   try {
     auto in = OIIO::ImageInput::open(path);
     if (!in) fail_read(path, OIIO::geterror());

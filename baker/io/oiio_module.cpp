@@ -31,9 +31,9 @@ void write_call(const std::string& path, const Image& image, const WriteOptions&
   guarded(path, ExitCode::output, failure, [&] { write(path, image, options, bits); });
 }
 
-void read_call(const std::string& path, int all_cores, Image* image, Failure* failure) {
+void read_call(const std::string& path, std::uint64_t file_size, int all_cores, Image* image, Failure* failure) {
   const AllCores cores(all_cores);
-  guarded(path, ExitCode::input, failure, [&] { *image = read(path); });
+  guarded(path, ExitCode::input, failure, [&] { *image = read(path, file_size); });
 }
 
 void read_metadata_call(const std::string& path, std::map<std::string, std::string>* out, Failure* failure) {

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <map>
 #include <string>
 
@@ -31,7 +32,7 @@ inline constexpr const char* kFileName = "libnmbake-oiio.so";
 
 // Raised when the calls below change their signature or meaning, so that a module of another
 // build is refused rather than called.
-inline constexpr int kAbi = 1;
+inline constexpr int kAbi = 2;
 
 // An error a call ended with: the ExitCode of the nmbake::Error it stands for (0: none) and its
 // message (one line, naming the file).
@@ -48,7 +49,7 @@ struct Api {
   // gave `bits`. `all_cores` is the loader's all_cores_setting().
   void (*write)(const std::string& path, const Image& image, const WriteOptions& options, int bits, int all_cores,
                 Failure* failure);
-  void (*read)(const std::string& path, int all_cores, Image* image, Failure* failure);  // read_image
+  void (*read)(const std::string& path, std::uint64_t file_size, int all_cores, Image* image, Failure* failure);  // read_image
   void (*read_metadata)(const std::string& path, std::map<std::string, std::string>* out,
                         Failure* failure);  // read_image_metadata
 };
@@ -56,7 +57,9 @@ struct Api {
 // The three calls as the module implements them (image_io_oiio.cpp, image_read.cpp); they throw
 // nmbake::Error as image_io.h documents.
 void write(const std::string& path, const Image& image, const WriteOptions& options, int bits);
-Image read(const std::string& path);
+// The reads take a path the loader found a regular file (regular_file_size, image_read_guard.h), of
+// `file_size` bytes.
+Image read(const std::string& path, std::uint64_t file_size);
 std::map<std::string, std::string> read_metadata(const std::string& path);
 
 // The loader's side (image_io.cpp). The module is looked for beside the program or library that
