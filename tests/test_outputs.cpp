@@ -243,6 +243,40 @@ TEST(Outputs, FileSizeLimitIsAnOutputError) {
   EXPECT_EQ(slurp(d + "/r.json"), "old");
 }
 
+// A file written from spans: more of them than one writev takes (1024), empty ones among them, and
+// spans that are parts of one buffer, in order; the same bytes as the buffer joined. Under a file
+// size limit that cuts it inside a later call, an error and no file.
+TEST(Outputs, SpansWrittenInOrder) {
+  const std::string d = test::scratch_dir();
+  std::string joined;
+  std::vector<std::string> parts;
+  for (int i = 0; i < 3000; ++i)
+    parts.push_back(i % 7 == 3 ? std::string() : std::string(std::size_t(i % 13 + 1), char('a' + i % 26)));
+  std::vector<ByteSpan> spans;
+  for (const std::string& p : parts) {
+    spans.push_back({p.data(), p.size()});
+    joined += p;
+  }
+  write_spans_file(d + "/s.bin", d + "/s.bin", spans);
+  EXPECT_EQ(slurp(d + "/s.bin"), joined);
+  write_spans_file(d + "/e.bin", d + "/e.bin", {});
+  EXPECT_EQ(slurp(d + "/e.bin"), "");
+  const int code = in_child([&] {
+    protect_standard_streams();
+    const struct rlimit limit { 9000, 9000 };  // past the first call's spans
+    if (::setrlimit(RLIMIT_FSIZE, &limit) != 0) return 10;
+    try {
+      write_spans_file(d + "/c.bin", d + "/.c.tmp", spans);
+    } catch (const OutputError& e) {
+      return std::string(e.what()) == d + "/c.bin: cannot write: File too large" ? 0 : 1;
+    }
+    return 2;
+  });
+  EXPECT_EQ(code, 0) << "1: another message, 2: no error";
+  EXPECT_FALSE(fs::exists(d + "/.c.tmp"));
+  EXPECT_FALSE(fs::exists(d + "/c.bin"));
+}
+
 // In a child process that removes temporaries on signals (nmdiff's and nmview's;
 // remove_temporaries_on_signals): `before`, then `path` written to a set not committed, then
 // SIGTERM. The child's status: 128 + SIGTERM when the signal ended it.

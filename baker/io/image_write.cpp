@@ -180,10 +180,10 @@ std::string temp_path_for(const std::string& path) {
   return (target.parent_path() / name).string();
 }
 
-void write_file_bytes(const std::string& path, const std::vector<unsigned char>& bytes, const WriteOptions& options) {
+void write_file_spans(const std::string& path, const std::vector<ByteSpan>& spans, const WriteOptions& options) {
   const std::string temp = options.temp_path.empty() ? temp_path_for(path) : options.temp_path;
-  write_bytes_file(path, temp, bytes.data(), bytes.size());  // the temporary removed on an error
-  if (!options.temp_path.empty()) return;                    // the caller renames it
+  write_spans_file(path, temp, spans);     // the temporary removed on an error
+  if (!options.temp_path.empty()) return;  // the caller renames it
   if (std::rename(temp.c_str(), path.c_str()) != 0) {
     std::string reason = std::strerror(errno);
     std::error_code ec;

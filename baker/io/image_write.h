@@ -9,6 +9,7 @@
 
 #include "core/image.h"
 #include "io/image_io.h"
+#include "io/text_file.h"
 
 namespace nmbake::image_write {
 
@@ -42,9 +43,9 @@ bool date_time_fields(const std::string& text, int fields[6]);
 // A temporary beside `path` for a write without WriteOptions::temp_path (nmdiff, the tests).
 std::string temp_path_for(const std::string& path);
 
-// `bytes` to the temporary (options.temp_path, else temp_path_for(path)), flushed to disk (fsync),
+// The spans' bytes, in order, to the temporary (options.temp_path, else temp_path_for(path)), flushed to disk (fsync),
 // then renamed to `path` unless options.temp_path is given (the caller renames it). Errors name
 // `path` and remove the temporary.
-void write_file_bytes(const std::string& path, const std::vector<unsigned char>& bytes, const WriteOptions& options);
+void write_file_spans(const std::string& path, const std::vector<ByteSpan>& spans, const WriteOptions& options);
 
 }  // namespace nmbake::image_write

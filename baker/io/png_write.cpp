@@ -192,53 +192,147 @@ bool valid_sizes(int width, int height, int channels, int bits, std::string* err
   return false;
 }
 
+// An encoded file as spans in order: bytes of its own (the signature, the chunks' headers, text
+// and checksums, the zlib stream's header and Adler-32) and the bands' deflate streams, which are
+// written out where they are, not joined into one buffer first (on a file of some MiB, the copies
+// and the fresh pages they fill cost as much as a band's encoding, on one thread).
+struct Encoded {
+  std::vector<Band> bands;
+  std::vector<unsigned char> own;
+  struct Piece {
+    int band;  // -1: own
+    std::size_t at, size;
+  };
+  std::vector<Piece> pieces;
+
+  void add_own(const std::vector<unsigned char>& bytes) {
+    pieces.push_back({-1, own.size(), bytes.size()});
+    own.insert(own.end(), bytes.begin(), bytes.end());
+  }
+  const unsigned char* data(const Piece& p) const {
+    return (p.band < 0 ? own.data() : bands[std::size_t(p.band)].bytes.data()) + p.at;
+  }
+  std::vector<ByteSpan> spans() const {
+    std::vector<ByteSpan> out;
+    out.reserve(pieces.size());
+    for (const Piece& p : pieces) out.push_back({data(p), p.size});
+    return out;
+  }
+  std::vector<unsigned char> joined() const {
+    std::size_t n = 0;
+    for (const Piece& p : pieces) n += p.size;
+    std::vector<unsigned char> out;
+    out.reserve(n);
+    for (const Piece& p : pieces) out.insert(out.end(), data(p), data(p) + p.size);
+    return out;
+  }
+};
+
+// A chunk's bytes before its data: length and type.
+std::vector<unsigned char> chunk_head(const char type[5], std::size_t n) {
+  std::vector<unsigned char> head;
+  put32(head, std::uint32_t(n));
+  head.insert(head.end(), type, type + 4);
+  return head;
+}
+
+// The zlib stream (header, the bands' streams, Adler-32) cut into IDAT chunks of kIdatBytes, as
+// pieces of `e`, then IEND. The chunks' CRCs are worked out on `threads` threads, each over its
+// own chunk's pieces.
+void add_idat_chunks(Encoded& e, uLong adler, int threads) {
+  // The stream as (piece) segments.
+  std::vector<Encoded::Piece> stream;
+  const std::size_t header_at = e.own.size();
+  e.own.insert(e.own.end(), {0x78, 0x01});  // deflate, 32K window, no preset dictionary; check bits
+  stream.push_back({-1, header_at, 2});
+  for (std::size_t b = 0; b < e.bands.size(); ++b)
+    if (!e.bands[b].bytes.empty()) stream.push_back({int(b), 0, e.bands[b].bytes.size()});
+  const std::size_t adler_at = e.own.size();
+  put32(e.own, std::uint32_t(adler));
+  stream.push_back({-1, adler_at, 4});
+  std::size_t total = 0;
+  for (const Encoded::Piece& p : stream) total += p.size;
+
+  struct Chunk {
+    std::size_t first_piece, pieces, crc_at;  // its data's pieces in e.pieces; its CRC in e.own
+  };
+  std::vector<Chunk> chunks;
+  std::size_t seg = 0, seg_used = 0;  // the next byte of the stream: segment, bytes of it used
+  for (std::size_t at = 0; at < total; at += kIdatBytes) {
+    const std::size_t n = std::min(kIdatBytes, total - at);
+    e.add_own(chunk_head("IDAT", n));
+    Chunk c{e.pieces.size(), 0, 0};
+    for (std::size_t left = n; left > 0;) {
+      const Encoded::Piece& s = stream[seg];
+      const std::size_t take = std::min(left, s.size - seg_used);
+      e.pieces.push_back({s.band, s.at + seg_used, take});
+      ++c.pieces;
+      left -= take;
+      seg_used += take;
+      if (seg_used == s.size) ++seg, seg_used = 0;
+    }
+    c.crc_at = e.own.size();
+    e.pieces.push_back({-1, c.crc_at, 4});
+    e.own.insert(e.own.end(), 4, 0);
+    chunks.push_back(c);
+  }
+  e.add_own(chunk_head("IEND", 0));
+  const std::size_t iend_crc = e.own.size();
+  put32(e.own, std::uint32_t(crc32(0, reinterpret_cast<const Bytef*>("IEND"), 4)));
+  e.pieces.push_back({-1, iend_crc, 4});
+  // `own` is complete: the pieces' addresses stay put from here.
+  parallel_chunks(threads, chunks.size(), 1, [&](std::size_t i, std::size_t) {
+    const Chunk& c = chunks[i];
+    uLong crc = crc32(0, reinterpret_cast<const Bytef*>("IDAT"), 4);
+    for (std::size_t k = c.first_piece; k < c.first_piece + c.pieces; ++k)
+      crc = crc32(crc, e.data(e.pieces[k]), uInt(e.pieces[k].size));
+    const unsigned char v[4] = {static_cast<unsigned char>(crc >> 24), static_cast<unsigned char>(crc >> 16),
+                                static_cast<unsigned char>(crc >> 8), static_cast<unsigned char>(crc)};
+    std::memcpy(e.own.data() + c.crc_at, v, 4);
+  });
+}
+
 // encode_png with its rows from `row` (layout.row_bytes each), called from every thread (each row
-// of a band in order).
-std::vector<unsigned char> encode_rows(const RowSource& row, int width, int height, const Layout& layout,
-                                       const std::vector<std::pair<std::string, std::string>>& metadata,
-                                       const PngSettings& settings, int threads, std::string* error) {
+// of a band in order). False, with *error set, on failure.
+bool encode_rows(const RowSource& row, int width, int height, const Layout& layout,
+                 const std::vector<std::pair<std::string, std::string>>& metadata, const PngSettings& settings, int threads,
+                 Encoded& e, std::string* error) {
   const int type = filter_type(settings.filters);
   if (type < 0) {
     *error = "filters: one of 0x08, 0x10, 0x20, 0x40, 0x80 expected, not " + std::to_string(settings.filters);
-    return {};
+    return false;
   }
   for (const auto& item : metadata)
     if (item.first != "DateTime" && !valid_keyword(item.first)) {
       *error = "tEXt: invalid keyword \"" + item.first + "\"";
-      return {};
+      return false;
     }
   const std::size_t bpp = layout.bpp, row_bytes = layout.row_bytes;
   try {
     const int bands = std::max(1, std::min(kBands, height));
-    std::vector<Band> band(static_cast<std::size_t>(bands));
-    std::vector<const char*> failed(band.size(), nullptr);
-    parallel_chunks(threads, band.size(), 1, [&](std::size_t b, std::size_t) {
+    e.bands.assign(static_cast<std::size_t>(bands), Band{});
+    std::vector<const char*> failed(e.bands.size(), nullptr);
+    parallel_chunks(threads, e.bands.size(), 1, [&](std::size_t b, std::size_t) {
       const int y0 = int(std::int64_t(height) * std::int64_t(b) / bands),
                 y1 = int(std::int64_t(height) * std::int64_t(b + 1) / bands);
-      failed[b] = deflate_band(row, row_bytes, bpp, type, y0, y1, b + 1 == band.size(), settings, band[b]);
+      failed[b] = deflate_band(row, row_bytes, bpp, type, y0, y1, b + 1 == e.bands.size(), settings, e.bands[b]);
     });
     for (const char* f : failed)
       if (f) {
         *error = f;
-        return {};
+        return false;
       }
-    // The zlib stream: header (deflate, 32K window, no preset dictionary; check bits), the bands'
-    // streams joined, the Adler-32 of everything they compress.
-    std::vector<unsigned char> z = {0x78, 0x01};
+    // The Adler-32 of everything the bands compress.
     uLong adler = 1;
-    for (const Band& b : band) {
-      z.insert(z.end(), b.bytes.begin(), b.bytes.end());
-      adler = adler32_combine(adler, b.adler, z_off_t(b.length));
-    }
-    put32(z, std::uint32_t(adler));
+    for (const Band& b : e.bands) adler = adler32_combine(adler, b.adler, z_off_t(b.length));
 
-    std::vector<unsigned char> out = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    std::vector<unsigned char> head = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
     std::vector<unsigned char> ihdr;
     put32(ihdr, std::uint32_t(width));
     put32(ihdr, std::uint32_t(height));
     ihdr.insert(ihdr.end(), {static_cast<unsigned char>(layout.depth), static_cast<unsigned char>(layout.color_type), 0, 0, 0});
-    chunk(out, "IHDR", ihdr.data(), ihdr.size());
-    if (layout.color_type == 3) chunk(out, "PLTE", layout.palette.data(), layout.palette.size());
+    chunk(head, "IHDR", ihdr.data(), ihdr.size());
+    if (layout.color_type == 3) chunk(head, "PLTE", layout.palette.data(), layout.palette.size());
     unsigned char when[7];
     bool has_time = false;
     for (const auto& [key, value] : metadata) {
@@ -249,16 +343,15 @@ std::vector<unsigned char> encode_rows(const RowSource& row, int width, int heig
       std::string text = key == "ImageDescription" ? "Description" : key;
       text.push_back('\0');
       text += value;
-      chunk(out, "tEXt", reinterpret_cast<const unsigned char*>(text.data()), text.size());
+      chunk(head, "tEXt", reinterpret_cast<const unsigned char*>(text.data()), text.size());
     }
-    if (has_time) chunk(out, "tIME", when, 7);
-    for (std::size_t at = 0; at < z.size(); at += kIdatBytes)
-      chunk(out, "IDAT", z.data() + at, std::min(kIdatBytes, z.size() - at));
-    chunk(out, "IEND", nullptr, 0);
-    return out;
+    if (has_time) chunk(head, "tIME", when, 7);
+    e.add_own(head);
+    add_idat_chunks(e, adler, threads);
+    return true;
   } catch (const std::bad_alloc&) {
     *error = "insufficient memory";
-    return {};
+    return false;
   }
 }
 
@@ -378,7 +471,14 @@ std::vector<unsigned char> encode_png(const void* rows, int width, int height, i
     if (bits == 16) big_endian16(out, row_bytes);
   };
   if (!valid_sizes(width, height, channels, bits, error)) return {};
-  return encode_rows(row, width, height, sample_layout(width, channels, bits), metadata, settings, threads, error);
+  Encoded e;
+  if (!encode_rows(row, width, height, sample_layout(width, channels, bits), metadata, settings, threads, e, error)) return {};
+  try {
+    return e.joined();
+  } catch (const std::bad_alloc&) {
+    *error = "insufficient memory";
+    return {};
+  }
 }
 
 // The image's float values are quantized row by row inside the bands' encoders (the values
@@ -394,7 +494,8 @@ void write_png_image(const std::string& path, const Image& image, const WriteOpt
   }
   std::string error;
   if (!valid_sizes(image.width, image.height, image.channels, bits, &error)) image_write::fail_write(path, error);
-  std::vector<unsigned char> bytes;
+  Encoded encoded;
+  bool encoded_ok;
   IndexedColors indexed;
   bool use_index;
   if (!options.palette.empty()) {  // an image of indices: indexed while it can be, else its RGB image
@@ -416,7 +517,8 @@ void write_png_image(const std::string& path, const Image& image, const WriteOpt
     const RowSource row = [&](int y, unsigned char* out) {
       pack_indices(indexed.index.data() + std::size_t(y) * std::size_t(image.width), image.width, indexed.depth, out);
     };
-    bytes = encode_rows(row, image.width, image.height, layout, metadata, kIndexedSettings, options.threads, &error);
+    encoded_ok =
+        encode_rows(row, image.width, image.height, layout, metadata, kIndexedSettings, options.threads, encoded, &error);
   } else {
     const std::size_t values = std::size_t(image.width) * std::size_t(image.channels);
     const RowSource row = [&](int y, unsigned char* out) {
@@ -429,11 +531,11 @@ void write_png_image(const std::string& path, const Image& image, const WriteOpt
       image_write::quantize16_run(image.pixels.data() + first, values, samples);
       big_endian16(out, 2 * values);
     };
-    bytes = encode_rows(row, image.width, image.height, sample_layout(image.width, image.channels, bits), metadata, PngSettings{},
-                        options.threads, &error);
+    encoded_ok = encode_rows(row, image.width, image.height, sample_layout(image.width, image.channels, bits), metadata,
+                             PngSettings{}, options.threads, encoded, &error);
   }
-  if (bytes.empty()) image_write::fail_write(path, error);
-  image_write::write_file_bytes(path, bytes, options);
+  if (!encoded_ok) image_write::fail_write(path, error);
+  image_write::write_file_spans(path, encoded.spans(), options);
 }
 
 }  // namespace nmbake

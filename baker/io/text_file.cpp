@@ -1,8 +1,10 @@
 #include "io/text_file.h"
 
 #include <fcntl.h>
+#include <sys/uio.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -17,23 +19,45 @@ void write_text_file(const std::string& path, const std::string& temp, const std
 }
 
 void write_bytes_file(const std::string& path, const std::string& temp, const void* data, std::size_t size) {
-  const char* bytes = static_cast<const char*>(data);
+  write_spans_file(path, temp, {ByteSpan{data, size}});
+}
+
+void write_spans_file(const std::string& path, const std::string& temp, const std::vector<ByteSpan>& spans) {
   auto fail = [&](int err) {
     ::unlink(temp.c_str());
     throw OutputError(path + ": cannot write: " + std::strerror(err));
   };
   const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0666);
   if (fd < 0) throw OutputError(path + ": cannot write: " + std::strerror(errno));
-  std::size_t done = 0;
-  while (done < size) {
-    const ssize_t n = ::write(fd, bytes + done, size - done);
+  // From span `next`, `skip` bytes in: the rest, up to kMaxSpans spans a call (writev's limit is at
+  // least 1024), until every byte is written.
+  constexpr std::size_t kMaxSpans = 1024;
+  std::size_t next = 0, skip = 0;
+  iovec io[kMaxSpans];
+  while (true) {
+    while (next < spans.size() && skip == spans[next].size) ++next, skip = 0;
+    if (next == spans.size()) break;
+    int count = 0;
+    for (std::size_t i = next; i < spans.size() && std::size_t(count) < kMaxSpans; ++i) {
+      const std::size_t from = i == next ? skip : 0;
+      if (from == spans[i].size) continue;
+      io[count].iov_base = const_cast<char*>(static_cast<const char*>(spans[i].data) + from);
+      io[count].iov_len = spans[i].size - from;
+      ++count;
+    }
+    const ssize_t n = ::writev(fd, io, count);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) {
       const int err = n < 0 ? errno : EIO;
       ::close(fd);
       fail(err);
     }
-    done += std::size_t(n);
+    for (std::size_t left = std::size_t(n); left > 0;) {  // past what was written
+      const std::size_t step = std::min(left, spans[next].size - skip);
+      skip += step;
+      left -= step;
+      if (skip == spans[next].size) ++next, skip = 0;
+    }
   }
   // A full disk or a failing device may only show here, on some filesystems (NFS) only at close.
   if (::fsync(fd) != 0) {

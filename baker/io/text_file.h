@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <string>
+#include <vector>
 
 namespace nmbake {
 
@@ -14,6 +15,16 @@ void write_text_file(const std::string& path, const std::string& temp, const std
 
 // The same for `size` bytes at `data` (the image writers' encoded files).
 void write_bytes_file(const std::string& path, const std::string& temp, const void* data, std::size_t size);
+
+// Bytes in several places, written in order as one file.
+struct ByteSpan {
+  const void* data;
+  std::size_t size;
+};
+
+// The same for the spans' bytes one after another (a file encoded in parts, written without
+// joining them into one buffer first).
+void write_spans_file(const std::string& path, const std::string& temp, const std::vector<ByteSpan>& spans);
 
 // write_text_file to a temporary file beside `path`, then renamed over it. Throws OutputError
 // "<path>: cannot write: <reason>" (the temporary removed).
