@@ -172,7 +172,8 @@ TEST(MeshTopology, FacesTurnedInANonOrientablePieceFollowTheEdgeOrder) {
     // are position numbers).
     std::vector<std::uint8_t> flip(m.triangle_count(), 0), skip(m.triangle_count(), 0);
     for (std::size_t f : k.turned) flip[f] = 1;
-    const std::vector<glm::dvec3> sum = angle_weighted_sums(m, &m.position_index, m.positions.size(), &skip, &flip);
+    const std::vector<glm::dvec3> sum =
+        angle_weighted_sums(m, m.position_index.data(), m.positions.size(), skip.data(), flip.data());
     std::size_t reoriented = 0;
     const std::vector<glm::vec3> n = compute_high_corner_normals(m, &reoriented);
     EXPECT_EQ(reoriented, k.turned.size());

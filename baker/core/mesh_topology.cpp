@@ -1,11 +1,13 @@
 #include "core/mesh_topology.h"
 
+#include "core/image.h"
 #include "core/normals.h"
 #include "core/parallel.h"
 
 #include <algorithm>
 #include <atomic>
 #include <cstring>
+#include <mutex>
 #include <utility>
 
 namespace nmbake {
@@ -15,7 +17,6 @@ namespace {
 // A position's coordinates as bits, -0 made +0: equal keys are one vertex.
 struct PosKey {
   std::uint32_t bits[3];
-  std::uint32_t id;  // in the weld table: 1 + the vertex id, 0 for an empty slot
 };
 
 PosKey key_of(const glm::vec3& p) {
@@ -34,16 +35,21 @@ std::uint64_t hash_of(const PosKey& k) {
   return (h ^ (h >> 29)) * 0xBF58476D1CE4E5B9ull;
 }
 
-// Its top bits: a table index of `shift` = 64 - log2(table size).
-std::size_t slot_of(const PosKey& k, unsigned shift) { return std::size_t(hash_of(k) >> shift); }
+// Arrays each written whole by a loop on every thread before they are read: not zeroed first (on
+// one thread, which the first touch of their pages would also be).
+template <typename T>
+using Unset = std::vector<T, DefaultInitAllocator<T>>;
+
+// weld_positions into `out`.
+void weld_into(const std::vector<glm::vec3>& positions, Unset<std::uint32_t>& out, std::size_t* count, int threads);
 
 // Everything the checks and the normals share: welded corners, duplicate faces, and the faces to
 // turn so that every piece has one winding.
 struct Analysis {
-  std::vector<std::uint32_t> weld;    // per position
-  std::vector<std::uint32_t> corner;  // per corner: welded vertex
-  std::vector<std::uint8_t> skip;     // per triangle: duplicate or collapsed (two corners welded)
-  std::vector<std::uint8_t> flip;     // per triangle: wound against its piece's majority
+  Unset<std::uint32_t> weld;    // per position
+  Unset<std::uint32_t> corner;  // per corner: welded vertex
+  Unset<std::uint8_t> skip;     // per triangle: duplicate or collapsed (two corners welded)
+  Unset<std::uint8_t> flip;     // per triangle: wound against its piece's majority
   MeshTopology topo;
 };
 
@@ -57,13 +63,6 @@ struct Adjacency {
   void link(std::uint32_t f, std::uint32_t g, std::uint32_t same) { face[3 * std::size_t(f) + count[f]++] = g << 1 | same; }
 };
 
-// Counting sort: counts in start[key + 2] become, by the prefix sum, the bucket starts at
-// start[key + 1], which the scatter (start[key + 1]++) leaves as bucket key's range [start[key],
-// start[key + 1]). Items scattered in increasing order stay in that order within their bucket.
-void prefix_sum(std::vector<std::uint32_t>& start) {
-  for (std::size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
-}
-
 void sort3(std::uint32_t v[3]) {
   if (v[0] > v[1]) std::swap(v[0], v[1]);
   if (v[1] > v[2]) std::swap(v[1], v[2]);
@@ -74,8 +73,11 @@ void sort3(std::uint32_t v[3]) {
 // only ever set to 1, a relaxed atomic store (the value does not depend on which thread sets it).
 void count_vertices(const Mesh& m, std::size_t ids, Analysis& a, int threads) {
   constexpr std::size_t kChunk = std::size_t(1) << 16;
-  const auto mark = [threads](const std::vector<std::uint32_t>& index, std::size_t n) {
-    std::vector<std::uint8_t> used(n, 0);
+  const auto mark = [threads](const auto& index, std::size_t n) {
+    Unset<std::uint8_t> used(n);
+    parallel_chunks(threads, n, kChunk, [&](std::size_t begin, std::size_t end) {
+      std::fill(used.begin() + std::ptrdiff_t(begin), used.begin() + std::ptrdiff_t(end), 0);
+    });
     parallel_chunks(threads, index.size(), kChunk, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) __atomic_store_n(&used[index[i]], std::uint8_t(1), __ATOMIC_RELAXED);
     });
@@ -89,37 +91,14 @@ void count_vertices(const Mesh& m, std::size_t ids, Analysis& a, int threads) {
   a.topo.welded_vertices = mark(a.corner, ids);
 }
 
-// Per vertex, the faces (not collapsed) it is the smallest or the middle vertex of, in face order:
-// the faces with an edge from it to a larger vertex. Collapsed faces (two corners welded) are
-// marked skipped: they have no edges and no direction.
-struct VertexFaces {
-  std::vector<std::uint32_t> start;  // vertex v's faces: face[start[v]] .. face[start[v + 1] - 1]
-  std::vector<std::uint32_t> face;
+// Per vertex, the edges from it to a larger vertex of the faces not collapsed (two corners welded:
+// no edges, no direction; marked skipped): half-edges, larger vertex << 32 | face << 1 | forward
+// (the face runs from the vertex to the larger one; face < 2^31), in face order, and of one face
+// in corner order. A face has two at its smallest vertex and one at its middle one.
+struct VertexEdges {
+  Unset<std::size_t> start;  // vertex v's: edge[start[v]] .. edge[start[v + 1] - 1]
+  Unset<std::uint64_t> edge;
 };
-
-// On one thread: a counting sort in face order. (With atomic counts and scatter on two threads it
-// took twice as long here: 16M atomic increments cost more than the loop they would share.)
-VertexFaces list_faces_by_vertex(std::size_t ids, Analysis& a) {
-  const std::size_t tris = a.skip.size();
-  VertexFaces vf;
-  vf.start.assign(ids + 2, 0);
-  for (std::size_t t = 0; t < tris; ++t) {
-    std::uint32_t v[3] = {a.corner[3 * t], a.corner[3 * t + 1], a.corner[3 * t + 2]};
-    sort3(v);
-    if (v[0] == v[1] || v[1] == v[2]) a.skip[t] = 1;
-    else ++vf.start[v[0] + 2], ++vf.start[v[1] + 2];
-  }
-  prefix_sum(vf.start);
-  vf.face.resize(vf.start[ids + 1]);
-  for (std::size_t t = 0; t < tris; ++t) {
-    if (a.skip[t]) continue;
-    std::uint32_t v[3] = {a.corner[3 * t], a.corner[3 * t + 1], a.corner[3 * t + 2]};
-    sort3(v);
-    vf.face[vf.start[v[0] + 1]++] = std::uint32_t(t);
-    vf.face[vf.start[v[1] + 1]++] = std::uint32_t(t);
-  }
-  return vf;
-}
 
 // Per face whose smallest vertex is the one visited: (middle << 32 | largest vertex, face).
 using FacePairs = std::vector<std::pair<std::uint64_t, std::uint32_t>>;
@@ -147,45 +126,35 @@ std::size_t mark_duplicates(FacePairs& pairs, Analysis& a) {
   return marked;
 }
 
-// At vertex `b`, given `faces` (in face order) it is the smallest or the middle vertex of: among
-// those whose smallest vertex is b, each face whose (middle, largest) pair an earlier one has is
-// marked a duplicate (the faces a global sort of (sorted triple, face) finds after the first of
-// each run). Only the faces whose smallest vertex is b are read or written, so vertices may be
+// At vertex b, its half-edges `e` (n of them, as VertexEdges keeps them): the faces whose smallest
+// vertex b is, the two half-edges in a row of one face, each with its (middle, largest) pair; each
+// whose pair an earlier face has is marked a duplicate (the faces a global sort of (sorted triple,
+// face) finds after the first of each run). Only those faces are written, so vertices may be
 // visited in any order, on any thread. How many were marked.
-std::size_t mark_duplicates_at(std::uint32_t b, const std::uint32_t* faces, std::size_t n, Analysis& a, FacePairs& pairs) {
+std::size_t mark_duplicates_at(const std::uint64_t* e, std::size_t n, Analysis& a, FacePairs& pairs) {
   pairs.clear();
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::uint32_t t = faces[i];
-    std::uint32_t v[3] = {a.corner[3 * std::size_t(t)], a.corner[3 * std::size_t(t) + 1], a.corner[3 * std::size_t(t) + 2]};
-    sort3(v);
-    if (v[0] != b) continue;
-    pairs.emplace_back(std::uint64_t(v[1]) << 32 | v[2], t);
-  }
+  for (std::size_t i = 0; i + 1 < n; ++i)
+    if (std::uint32_t(e[i]) >> 1 == std::uint32_t(e[i + 1]) >> 1) {
+      const std::uint64_t x = e[i] >> 32, y = e[i + 1] >> 32;
+      pairs.emplace_back(std::min(x, y) << 32 | std::max(x, y), std::uint32_t(e[i]) >> 1);
+      ++i;
+    }
   return pairs.size() >= 2 ? mark_duplicates(pairs, a) : 0;
 }
 
-// At vertex `b`, once every duplicate is marked: the edges from b to a larger vertex of its faces
-// (`faces`, as above) left, sorted by (larger vertex, face): the order of a global sort of all edges
-// by (key, face). Runs of one key are one edge. A half-edge is larger vertex << 32 | face << 1 |
-// forward (the face runs from b to the larger vertex); face < 2^31, as the bucket starts count 2
-// per face in 32 bits. Faces are distinct within one edge, so sorting by value sorts by (key, face).
-void edges_at(std::uint32_t b, const std::uint32_t* faces, std::size_t n, const Analysis& a, std::vector<std::uint64_t>& edges) {
+// At a vertex, its half-edges `e` (n of them) of the faces left (all of them when `skip` is null),
+// sorted by (larger vertex, face): the order of a global sort of all edges by (key, face). Runs of
+// one key are one edge. Faces are distinct within one edge, so sorting by value sorts by (key, face).
+void edges_at(const std::uint64_t* e, std::size_t n, const std::uint8_t* skip, std::vector<std::uint64_t>& edges) {
   edges.clear();
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::uint32_t t = faces[i];
-    if (a.skip[t]) continue;
-    const std::uint32_t* c = &a.corner[3 * std::size_t(t)];
-    for (int k = 0; k < 3; ++k) {
-      const std::uint32_t p = c[k], q = c[k == 2 ? 0 : k + 1];
-      if (std::min(p, q) == b) edges.push_back((std::uint64_t(std::max(p, q)) << 32) | (std::uint64_t(t) << 1) | (p < q));
-    }
-  }
+  for (std::size_t i = 0; i < n; ++i)
+    if (!skip || !skip[std::uint32_t(e[i]) >> 1]) edges.push_back(e[i]);
   if (edges.size() <= 16) {  // insertion sort: a vertex has a handful of edges
     for (std::size_t i = 1; i < edges.size(); ++i) {
-      const std::uint64_t e = edges[i];
+      const std::uint64_t x = edges[i];
       std::size_t j = i;
-      for (; j > 0 && edges[j - 1] > e; --j) edges[j] = edges[j - 1];
-      edges[j] = e;
+      for (; j > 0 && edges[j - 1] > x; --j) edges[j] = edges[j - 1];
+      edges[j] = x;
     }
   } else {
     std::sort(edges.begin(), edges.end());
@@ -204,56 +173,152 @@ void for_each_edge(const std::vector<std::uint64_t>& edges, Fn&& fn) {
 }
 
 // Whether the two half-edges run the edge the same way (one face is wound against the other).
-std::uint32_t same_way(std::uint64_t e, std::uint64_t f) { return (e & 1) == (f & 1); }
+std::uint32_t same_way_of(std::uint64_t e, std::uint64_t f) { return (e & 1) == (f & 1); }
 
-// Counted on every core, vertex by vertex: first the duplicates (at each face's smallest vertex),
-// then the edges of the faces left (boundary, non-manifold, and manifold edges whose two faces run
-// it the same way). Returns the last: only when there are some does a piece need turning.
-std::size_t count_edges(const VertexFaces& vf, std::size_t ids, Analysis& a, int threads) {
-  constexpr std::size_t kVertices = 4096;  // per chunk
-  std::atomic<std::size_t> duplicates{0}, boundary{0}, non_manifold{0}, same{0};
-  parallel_chunks(threads, ids, kVertices, [&](std::size_t begin, std::size_t end) {
-    FacePairs pairs;
-    std::size_t found = 0;
-    for (std::size_t b = begin; b < end; ++b)
-      found += mark_duplicates_at(std::uint32_t(b), vf.face.data() + vf.start[b], vf.start[b + 1] - vf.start[b], a, pairs);
-    duplicates += found;
+// Edges by how many faces use them, and how many manifold ones their two faces run the same way.
+struct EdgeCounts {
+  std::size_t boundary = 0, non_manifold = 0, same_way = 0;
+  void add(const std::vector<std::uint64_t>& edges) {
+    for_each_edge(edges, [&](std::size_t i, std::size_t n) {
+      if (n == 1) ++boundary;
+      else if (n > 2) ++non_manifold;
+      else same_way += same_way_of(edges[i], edges[i + 1]);
+    });
+  }
+  void add(const EdgeCounts& o) { boundary += o.boundary, non_manifold += o.non_manifold, same_way += o.same_way; }
+};
+
+// The half-edges of the faces not collapsed, bucketed by their smaller vertex, on every thread.
+// The vertices are cut into parts of 2^shift consecutive ids (at most 2^16, so that a half-edge's
+// vertex within its part fits 16 bits). Faces go in chunks: per chunk, how many half-edges it
+// sends to each part; then each chunk lists its half-edges in their parts' lists (part by part,
+// chunk by chunk within a part: each list in face order); then each part sorts its own list by
+// vertex (a counting sort, which keeps face order) and finds its vertices' duplicate faces. Parts
+// are ranges of ids, so their lists follow one another in `edge` as one counting sort of all the
+// half-edges would lay them out: the same arrays, whatever the threads. Returns the duplicates
+// marked. Each part also counts its vertices' edges as if no face were a duplicate, into
+// `if_no_duplicates`: the counts when none is (the common case), without a pass of their own.
+std::size_t list_edges_by_vertex(std::size_t ids, Analysis& a, int threads, VertexEdges& ve, EdgeCounts& if_no_duplicates) {
+  const std::size_t tris = a.skip.size();
+  constexpr std::size_t kChunk = std::size_t(1) << 16;  // faces
+  unsigned shift = 0;
+  while ((ids >> shift) > 256 && shift < 16) ++shift;
+  const std::size_t parts = (ids >> shift) + 1, chunks = (tris + kChunk - 1) / kChunk;
+  const auto chunk_end = [&](std::size_t c) { return std::min(tris, (c + 1) * kChunk); };
+  std::vector<std::size_t> at(chunks * parts, 0);
+  parallel_chunks(threads, chunks, 1, [&](std::size_t c, std::size_t) {
+    std::size_t* count = &at[c * parts];
+    for (std::size_t t = c * kChunk; t < chunk_end(c); ++t) {
+      std::uint32_t v[3] = {a.corner[3 * t], a.corner[3 * t + 1], a.corner[3 * t + 2]};
+      sort3(v);
+      a.skip[t] = v[0] == v[1] || v[1] == v[2];
+      if (!a.skip[t]) count[v[0] >> shift] += 2, ++count[v[1] >> shift];
+    }
   });
+  std::vector<std::size_t> part_start(parts + 1, 0);
+  std::size_t next = 0;
+  for (std::size_t p = 0; p < parts; ++p) {
+    part_start[p] = next;
+    for (std::size_t c = 0; c < chunks; ++c) {
+      const std::size_t k = at[c * parts + p];
+      at[c * parts + p] = next;
+      next += k;
+    }
+  }
+  part_start[parts] = next;
+  ve.edge.resize(next);
+  Unset<std::uint16_t> within(next);  // per listed half-edge: its smaller vertex within its part
+  parallel_chunks(threads, chunks, 1, [&](std::size_t c, std::size_t) {
+    std::size_t* to = &at[c * parts];
+    for (std::size_t t = c * kChunk; t < chunk_end(c); ++t) {
+      if (a.skip[t]) continue;
+      const std::uint32_t* v = &a.corner[3 * t];
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t p = v[k], q = v[k == 2 ? 0 : k + 1], lo = std::min(p, q);
+        const std::size_t i = to[lo >> shift]++;
+        ve.edge[i] = std::uint64_t(std::max(p, q)) << 32 | std::uint64_t(t) << 1 | (p < q);
+        within[i] = std::uint16_t(lo & ((1u << shift) - 1));
+      }
+    }
+  });
+  ve.start.resize(ids + 1);
+  ve.start[ids] = next;
+  std::atomic<std::size_t> duplicates{0};
+  std::atomic<std::size_t> next_part{0};
+  std::mutex counted;
+  // Parts shared out as parallel_chunks does, each thread's buffers kept from part to part (a
+  // buffer freed and made again takes fresh pages from the system each time).
+  run_on_threads(worker_threads(threads), [&](int) {
+    std::vector<std::size_t> place;
+    Unset<std::uint64_t> sorted;
+    FacePairs pairs;
+    std::vector<std::uint64_t> edges;
+    EdgeCounts counts;
+    std::size_t found = 0;
+    for (std::size_t p; (p = next_part++) < parts;) {
+      const std::size_t v0 = std::min(ids, p << shift), v1 = std::min(ids, (p + 1) << shift);
+      const std::size_t first = part_start[p], n = part_start[p + 1] - first;
+      // Counts (vertex v's at v - v0 + 1), then where each vertex's half-edges go (at v - v0).
+      place.assign(v1 - v0 + 1, 0);
+      for (std::size_t k = first; k < first + n; ++k) ++place[within[k] + 1];
+      for (std::size_t v = v0, sum = 0; v < v1; ++v) {
+        const std::size_t count = place[v - v0 + 1];
+        ve.start[v] = first + sum;
+        place[v - v0] = sum;
+        sum += count;
+      }
+      sorted.resize(n);
+      for (std::size_t k = first; k < first + n; ++k) sorted[place[within[k]]++] = ve.edge[k];
+      std::copy(sorted.begin(), sorted.begin() + std::ptrdiff_t(n), ve.edge.begin() + std::ptrdiff_t(first));
+      // (The next part's first start may not be written yet: each vertex's end is where its
+      // scatter left place[v - v0].)
+      for (std::size_t v = v0, from = 0; v < v1; from = place[v - v0], ++v) {
+        const std::uint64_t* e = ve.edge.data() + first + from;
+        found += mark_duplicates_at(e, place[v - v0] - from, a, pairs);
+        edges_at(e, place[v - v0] - from, nullptr, edges);
+        counts.add(edges);
+      }
+    }
+    duplicates += found;
+    const std::lock_guard<std::mutex> lock(counted);
+    if_no_duplicates.add(counts);
+  });
+  return duplicates;
+}
+
+// Counted on every core, vertex by vertex, once the duplicates are marked: the edges of the faces
+// left.
+EdgeCounts count_edges(const VertexEdges& ve, std::size_t ids, const Analysis& a, int threads) {
+  constexpr std::size_t kVertices = 4096;  // per chunk
+  EdgeCounts all;
+  std::mutex counted;
   parallel_chunks(threads, ids, kVertices, [&](std::size_t begin, std::size_t end) {
     std::vector<std::uint64_t> edges;
-    std::size_t counts[3] = {0, 0, 0};  // boundary, non-manifold, same way
+    EdgeCounts counts;
     for (std::size_t b = begin; b < end; ++b) {
-      edges_at(std::uint32_t(b), vf.face.data() + vf.start[b], vf.start[b + 1] - vf.start[b], a, edges);
-      for_each_edge(edges, [&](std::size_t i, std::size_t n) {
-        if (n == 1) ++counts[0];
-        else if (n > 2) ++counts[1];
-        else counts[2] += same_way(edges[i], edges[i + 1]);
-      });
+      edges_at(ve.edge.data() + ve.start[b], ve.start[b + 1] - ve.start[b], a.skip.data(), edges);
+      counts.add(edges);
     }
-    boundary += counts[0];
-    non_manifold += counts[1];
-    same += counts[2];
+    const std::lock_guard<std::mutex> lock(counted);
+    all.add(counts);
   });
-  a.topo.duplicate_faces = duplicates;
-  a.topo.boundary_edges = boundary;
-  a.topo.non_manifold_edges = non_manifold;
-  return same;
+  return all;
 }
 
 // Faces linked across manifold edges, vertex by vertex in increasing order (the duplicates marked).
-Adjacency link_faces(const VertexFaces& vf, std::size_t ids, const Analysis& a) {
+Adjacency link_faces(const VertexEdges& ve, std::size_t ids, const Analysis& a) {
   const std::size_t tris = a.skip.size();
   Adjacency adj;
   adj.face.resize(3 * tris);
   adj.count.assign(tris, 0);
   std::vector<std::uint64_t> edges;
   for (std::size_t b = 0; b < ids; ++b) {
-    edges_at(std::uint32_t(b), vf.face.data() + vf.start[b], vf.start[b + 1] - vf.start[b], a, edges);
+    edges_at(ve.edge.data() + ve.start[b], ve.start[b + 1] - ve.start[b], a.skip.data(), edges);
     for_each_edge(edges, [&](std::size_t i, std::size_t n) {
       if (n != 2) return;
       const std::uint32_t f = std::uint32_t(edges[i]) >> 1, g = std::uint32_t(edges[i + 1]) >> 1;
-      adj.link(f, g, same_way(edges[i], edges[i + 1]));
-      adj.link(g, f, same_way(edges[i], edges[i + 1]));
+      adj.link(f, g, same_way_of(edges[i], edges[i + 1]));
+      adj.link(g, f, same_way_of(edges[i], edges[i + 1]));
     });
   }
   return adj;
@@ -299,18 +364,28 @@ Analysis analyze(const Mesh& m, int threads) {
   Analysis a;
   const std::size_t tris = m.triangle_count();
   std::size_t ids = 0;
-  a.weld = weld_positions(m.positions, &ids, threads);
-  a.corner.resize(3 * tris);
+  weld_into(m.positions, a.weld, &ids, threads);
+  a.corner.resize(3 * tris);  // written whole by the loop below
   parallel_chunks(threads, 3 * tris, std::size_t(1) << 16, [&](std::size_t begin, std::size_t end) {
     for (std::size_t c = begin; c < end; ++c) a.corner[c] = a.weld[m.position_index[c]];
   });
   count_vertices(m, ids, a, threads);
-  a.skip.assign(tris, 0);
-  const VertexFaces vf = list_faces_by_vertex(ids, a);
+  a.skip.resize(tris);  // written whole by list_edges_by_vertex
+  VertexEdges ve;
+  EdgeCounts counts;
+  a.topo.duplicate_faces = list_edges_by_vertex(ids, a, threads, ve, counts);
+  if (a.topo.duplicate_faces > 0) counts = count_edges(ve, ids, a, threads);  // again, without the duplicates
+  a.topo.boundary_edges = counts.boundary;
+  a.topo.non_manifold_edges = counts.non_manifold;
   // With every manifold edge run opposite ways by its two faces, each piece is wound one way: no
   // face to turn, and no need for the links (the common case, and the slower half of the work).
-  if (count_edges(vf, ids, a, threads) > 0) orient_pieces(link_faces(vf, ids, a), a);
-  else a.flip.assign(tris, 0);
+  if (counts.same_way > 0) orient_pieces(link_faces(ve, ids, a), a);
+  else {
+    a.flip.resize(tris);
+    parallel_chunks(threads, tris, std::size_t(1) << 16, [&](std::size_t begin, std::size_t end) {
+      std::fill(a.flip.begin() + std::ptrdiff_t(begin), a.flip.begin() + std::ptrdiff_t(end), 0);
+    });
+  }
   return a;
 }
 
@@ -318,135 +393,107 @@ Analysis analyze(const Mesh& m, int threads) {
 
 namespace {
 
-// Open addressing with linear probing over a table at most half full, for `items` keys.
-class KeyTable {
- public:
-  explicit KeyTable(std::size_t items = 0) { start(items); }
-  void start(std::size_t items) {
-    shift_ = 64 - 4;
-    while ((std::size_t(1) << (64 - shift_)) < 2 * items) --shift_;
-    mask_ = (std::size_t(1) << (64 - shift_)) - 1;
-    slots_.assign(mask_ + 1, PosKey{});
-  }
-  void prefetch(const PosKey& k) const { __builtin_prefetch(&slots_[slot_of(k, shift_)]); }
-  // The entry with k's bits, or the empty one (id 0) where k goes.
-  PosKey& find(const PosKey& k) {
-    for (std::size_t s = slot_of(k, shift_);; s = (s + 1) & mask_) {
-      PosKey& e = slots_[s];
-      if (e.id == 0 || (e.bits[0] == k.bits[0] && e.bits[1] == k.bits[1] && e.bits[2] == k.bits[2])) return e;
-    }
-  }
-
- private:
-  unsigned shift_ = 0;
-  std::size_t mask_ = 0;
-  std::vector<PosKey> slots_;
-};
-
-// On one thread: one table, the positions in order.
-std::vector<std::uint32_t> weld_serial(const std::vector<glm::vec3>& positions, std::size_t* count) {
-  KeyTable table(positions.size());
-  std::vector<std::uint32_t> out(positions.size());
-  std::uint32_t ids = 0;
-  for (std::size_t i = 0; i < positions.size(); ++i) {
-    // The table is larger than the caches: its slot for a position some steps ahead is fetched now.
-    constexpr std::size_t kAhead = 8;
-    if (i + kAhead < positions.size()) table.prefetch(key_of(positions[i + kAhead]));
-    const PosKey k = key_of(positions[i]);
-    PosKey& e = table.find(k);
-    if (e.id == 0) {
-      e = k;
-      e.id = ++ids;
-    }
-    out[i] = e.id - 1;
-  }
-  if (count) *count = ids;
-  return out;
-}
-
-}  // namespace
-
-// Ids in order of first occurrence. On every core: the positions' keys are dealt into kParts parts
-// by their hash (each part in position order), each part finds every position's first occurrence
-// in an open-addressing table of its own (linear probing, at most half full, small enough for the
-// caches), and the first occurrences are numbered in position order. The ids do not depend on the
-// threads.
-std::vector<std::uint32_t> weld_positions(const std::vector<glm::vec3>& positions, std::size_t* count, int threads) {
+// Ids in order of first occurrence, on every core. One open-addressing table (linear probing, at
+// most half full) shared by the threads: a slot holds 32 bits of a key's hash and 1 + the first
+// position with that key, claimed and lowered by compare-and-swap, so whatever the order the
+// threads come in, each key's slot ends with its first position. Each position notes the first it
+// saw; a first that a smaller one displaced later is marked stale, and the positions that saw it
+// look again (rare: a key met by two threads at once). Then the firsts are numbered in position
+// order and every other position takes its first's number. The ids do not depend on the threads.
+void weld_into(const std::vector<glm::vec3>& positions, Unset<std::uint32_t>& out, std::size_t* count, int threads) {
   const std::size_t n = positions.size();
   constexpr std::size_t kChunk = std::size_t(1) << 16;  // positions
-  constexpr std::size_t kParts = 256;
   const std::size_t chunks = (n + kChunk - 1) / kChunk;
-  // One thread's table of all positions is faster than the parts' three passes (the same ids).
-  if (std::min(worker_threads(threads), int(chunks)) <= 1) return weld_serial(positions, count);
   const auto chunk_end = [&](std::size_t c) { return std::min(n, (c + 1) * kChunk); };
-  // The low bits of the hash: a part's table indexes by the top ones.
-  const auto part_of = [](const PosKey& k) { return std::size_t(hash_of(k) & (kParts - 1)); };
-  // Per chunk, how many of its positions go to each part; then where they go (part by part, chunk
-  // by chunk within a part, so each part's list is in position order).
-  std::vector<std::uint32_t> at(chunks * kParts, 0);
-  parallel_chunks(threads, chunks, 1, [&](std::size_t c0, std::size_t c1) {
-    for (std::size_t c = c0; c < c1; ++c)
-      for (std::size_t i = c * kChunk; i < chunk_end(c); ++i) ++at[c * kParts + part_of(key_of(positions[i]))];
+  unsigned bits = 4;
+  while ((std::size_t(1) << bits) < 2 * n) ++bits;
+  const std::size_t mask = (std::size_t(1) << bits) - 1;
+  Unset<std::uint64_t> table(mask + 1);  // (32 bits of the hash) << 32 | 1 + position; 0: empty
+  parallel_chunks(threads, table.size(), kChunk, [&](std::size_t begin, std::size_t end) {
+    std::fill(table.begin() + std::ptrdiff_t(begin), table.begin() + std::ptrdiff_t(end), 0);
   });
-  std::vector<std::size_t> part_start(kParts + 1, 0);
-  std::uint32_t next = 0;
-  for (std::size_t p = 0; p < kParts; ++p) {
-    part_start[p] = next;
-    for (std::size_t c = 0; c < chunks; ++c) {
-      const std::uint32_t k = at[c * kParts + p];
-      at[c * kParts + p] = next;
-      next += k;
+  Unset<std::uint8_t> stale(n);
+  parallel_chunks(threads, n, kChunk, [&](std::size_t begin, std::size_t end) {
+    std::fill(stale.begin() + std::ptrdiff_t(begin), stale.begin() + std::ptrdiff_t(end), 0);
+  });
+  const auto same_key = [&](const PosKey& k, std::uint64_t entry) {
+    const PosKey e = key_of(positions[std::uint32_t(entry) - 1]);
+    return e.bits[0] == k.bits[0] && e.bits[1] == k.bits[1] && e.bits[2] == k.bits[2];
+  };
+  // The slot of key k (hash h): its own, or the empty one where it goes.
+  const auto slot_for = [&](const PosKey& k, std::uint64_t h) {
+    for (std::size_t s = std::size_t(h >> (64 - bits));; s = (s + 1) & mask) {
+      const std::uint64_t e = __atomic_load_n(&table[s], __ATOMIC_RELAXED);
+      if (e == 0 || ((e >> 32) == (h & 0xffffffffu) && same_key(k, e))) return s;
     }
-  }
-  part_start[kParts] = next;
-  std::vector<PosKey> listed(n);  // the keys part by part, each with its position (in `id`)
-  parallel_chunks(threads, chunks, 1, [&](std::size_t c0, std::size_t c1) {
-    for (std::size_t c = c0; c < c1; ++c)
-      for (std::size_t i = c * kChunk; i < chunk_end(c); ++i) {
-        PosKey k = key_of(positions[i]);
-        k.id = std::uint32_t(i);
-        listed[at[c * kParts + part_of(k)]++] = k;
-      }
-  });
-  // Per position, the first with its key (in `out` for now), and which are firsts.
-  std::vector<std::uint32_t> out(n);
-  std::vector<std::uint8_t> is_first(n);
-  parallel_chunks(threads, kParts, 1, [&](std::size_t p0, std::size_t p1) {
-    KeyTable table;  // id: 1 + the position
-    for (std::size_t p = p0; p < p1; ++p) {
-      table.start(part_start[p + 1] - part_start[p]);
-      for (std::size_t k = part_start[p]; k < part_start[p + 1]; ++k) {
-        const PosKey& key = listed[k];
-        PosKey& e = table.find(key);
-        if (e.id == 0) {
-          e = key;
-          e.id = key.id + 1;
+  };
+  out.resize(n);  // per position: the first with its key (as it saw it, then final)
+  parallel_chunks(threads, chunks, 1, [&](std::size_t c, std::size_t) {
+    for (std::size_t i = c * kChunk; i < chunk_end(c); ++i) {
+      // The table is larger than the caches: its slot for a position some steps ahead is fetched now.
+      constexpr std::size_t kAhead = 16;
+      if (i + kAhead < chunk_end(c))
+        __builtin_prefetch(&table[std::size_t(hash_of(key_of(positions[i + kAhead])) >> (64 - bits))]);
+      const PosKey k = key_of(positions[i]);
+      const std::uint64_t h = hash_of(k), mine = (h & 0xffffffffu) << 32 | (i + 1);
+      std::size_t s = std::size_t(h >> (64 - bits));
+      std::uint64_t e;
+      while (true) {
+        e = __atomic_load_n(&table[s], __ATOMIC_RELAXED);
+        if (e == 0) {  // claim it, unless another thread just did (then e is what it put there)
+          if (__atomic_compare_exchange_n(&table[s], &e, mine, false, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
+            e = mine;
+            break;
+          }
         }
-        out[key.id] = e.id - 1;
-        is_first[key.id] = e.id - 1 == key.id;
+        if ((e >> 32) == (h & 0xffffffffu) && same_key(k, e)) break;
+        s = (s + 1) & mask;  // another key's
       }
+      // The key's slot. Held by a later position (another thread's): take its place.
+      for (std::uint64_t seen = e; std::uint32_t(e) - 1 > i; seen = e)
+        if (__atomic_compare_exchange_n(&table[s], &e, mine, false, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
+          __atomic_store_n(&stale[std::uint32_t(seen) - 1], std::uint8_t(1), __ATOMIC_RELAXED);
+          e = mine;
+        }
+      out[i] = std::uint32_t(e) - 1;
     }
   });
-  // The firsts numbered in position order, then every other position takes its first's number.
+  // The firsts that were displaced are looked up again; then, per chunk, the firsts counted.
   std::vector<std::uint32_t> firsts_before(chunks + 1, 0);
-  parallel_chunks(threads, chunks, 1, [&](std::size_t c0, std::size_t c1) {
-    for (std::size_t c = c0; c < c1; ++c)
-      for (std::size_t i = c * kChunk; i < chunk_end(c); ++i) firsts_before[c + 1] += is_first[i];
+  parallel_chunks(threads, chunks, 1, [&](std::size_t c, std::size_t) {
+    std::uint32_t firsts = 0;
+    for (std::size_t i = c * kChunk; i < chunk_end(c); ++i) {
+      if (stale[out[i]]) {
+        const PosKey k = key_of(positions[i]);
+        out[i] = std::uint32_t(table[slot_for(k, hash_of(k))]) - 1;
+      }
+      firsts += out[i] == i;
+    }
+    firsts_before[c + 1] = firsts;
   });
   for (std::size_t c = 0; c < chunks; ++c) firsts_before[c + 1] += firsts_before[c];
-  parallel_chunks(threads, chunks, 1, [&](std::size_t c0, std::size_t c1) {
-    for (std::size_t c = c0; c < c1; ++c) {
-      std::uint32_t id = firsts_before[c];
-      for (std::size_t i = c * kChunk; i < chunk_end(c); ++i)
-        if (is_first[i]) out[i] = id++;
+  // The firsts numbered in position order (in `stale`'s place, their marks done with: 1 = first),
+  // then every other position takes its first's number.
+  parallel_chunks(threads, chunks, 1, [&](std::size_t c, std::size_t) {
+    std::uint32_t id = firsts_before[c];
+    for (std::size_t i = c * kChunk; i < chunk_end(c); ++i) {
+      stale[i] = out[i] == i;
+      if (stale[i]) out[i] = id++;
     }
   });
   parallel_chunks(threads, n, kChunk, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i)
-      if (!is_first[i]) out[i] = out[out[i]];
+      if (!stale[i]) out[i] = out[out[i]];
   });
   if (count) *count = firsts_before[chunks];
-  return out;
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> weld_positions(const std::vector<glm::vec3>& positions, std::size_t* count, int threads) {
+  Unset<std::uint32_t> ids;
+  weld_into(positions, ids, count, threads);
+  return std::vector<std::uint32_t>(ids.begin(), ids.end());
 }
 
 MeshTopology inspect_topology(const Mesh& mesh, int threads) { return analyze(mesh, threads).topo; }
@@ -455,7 +502,8 @@ void compute_high_corner_normals(const Mesh& m, glm::vec3* out, MeshTopology* to
   const Analysis a = analyze(m, threads);
   if (topology) *topology = a.topo;
   // Indexed by welded id (< positions).
-  const std::vector<glm::dvec3> sum = angle_weighted_sums(m, &a.corner, m.positions.size(), &a.skip, &a.flip, threads);
+  const std::vector<glm::dvec3> sum =
+      angle_weighted_sums(m, a.corner.data(), m.positions.size(), a.skip.data(), a.flip.data(), threads);
   parallel_chunks(threads, 3 * m.triangle_count(), std::size_t(1) << 16, [&](std::size_t begin, std::size_t end) {
     for (std::size_t c = begin; c < end; ++c) out[c] = unit_or_up(sum[a.corner[c]]);
   });

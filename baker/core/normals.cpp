@@ -24,25 +24,25 @@ struct FaceShares {
   glm::dvec3 share[3];
 };
 
-FaceShares face_shares(const Mesh& mesh, std::size_t t, const std::vector<std::uint32_t>* corner_vertex,
-                       const std::vector<std::uint8_t>* skip, const std::vector<std::uint8_t>* flip) {
+FaceShares face_shares(const Mesh& mesh, std::size_t t, const std::uint32_t* corner_vertex,
+                       const std::uint8_t* skip, const std::uint8_t* flip) {
   FaceShares f;
   f.vertex[0] = f.vertex[1] = f.vertex[2] = kNoShare;
-  if (skip && (*skip)[t]) return f;
+  if (skip && skip[t]) return f;
   const glm::dvec3 p[3] = {glm::dvec3(mesh.corner_position(t, 0)), glm::dvec3(mesh.corner_position(t, 1)),
                            glm::dvec3(mesh.corner_position(t, 2))};
   glm::dvec3 face = glm::cross(p[1] - p[0], p[2] - p[0]);
   const double len = glm::length(face);
   if (!(len > 0.0) || !std::isfinite(len)) return f;  // zero-area faces carry no direction
   face /= len;
-  if (flip && (*flip)[t]) face = -face;
+  if (flip && flip[t]) face = -face;
   for (int c = 0; c < 3; ++c) {
     const glm::dvec3 a = p[(c + 1) % 3] - p[c], b = p[(c + 2) % 3] - p[c];
     if (!(glm::length(a) > 0.0) || !(glm::length(b) > 0.0)) continue;
     // atan2 of |cross| and dot is accurate for angles near 0 and pi, unlike acos.
     const double angle = std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
     const std::size_t corner = 3 * t + std::size_t(c);
-    f.vertex[c] = corner_vertex ? (*corner_vertex)[corner] : mesh.position_index[corner];
+    f.vertex[c] = corner_vertex ? corner_vertex[corner] : mesh.position_index[corner];
     f.share[c] = angle * face;
   }
   return f;
@@ -55,9 +55,9 @@ FaceShares face_shares(const Mesh& mesh, std::size_t t, const std::vector<std::u
 // each share into its chunk's list for the thread that owns its vertex (runs of 64 ids dealt
 // round); then each thread adds its lists, chunk after chunk, to its own vertices' sums. So every
 // sum is the one the face-by-face loop makes, to the bit.
-std::vector<glm::dvec3> angle_weighted_sums(const Mesh& mesh, const std::vector<std::uint32_t>* corner_vertex,
-                                            std::size_t vertices, const std::vector<std::uint8_t>* skip,
-                                            const std::vector<std::uint8_t>* flip, int threads) {
+std::vector<glm::dvec3> angle_weighted_sums(const Mesh& mesh, const std::uint32_t* corner_vertex,
+                                            std::size_t vertices, const std::uint8_t* skip,
+                                            const std::uint8_t* flip, int threads) {
   std::vector<glm::dvec3> sum(vertices, glm::dvec3(0.0));
   const std::size_t tris = mesh.triangle_count();
   constexpr std::size_t kChunk = 4096;  // faces

@@ -12,12 +12,13 @@ namespace nmbake {
 
 // The one angle-weighted normal rule (Thuermer and Wuethrich 1998) of the baker and the viewer:
 // per vertex, the sum over its faces of the corner angle times the unit face normal. Vertices are
-// the corners' `corner_vertex` ids (null: the position index), `vertices` of them; faces marked in
-// `skip` count nothing, faces marked in `flip` count reversed. Zero-area faces carry no direction.
+// the corners' `corner_vertex` ids (3 per triangle; null: the position index), `vertices` of them;
+// faces marked in `skip` (1 per triangle, or null) count nothing, faces marked in `flip` count
+// reversed. Zero-area faces carry no direction.
 // Each sum adds its faces in face order: the same bits on any number of threads (<= 0: all cores).
-std::vector<glm::dvec3> angle_weighted_sums(const Mesh& mesh, const std::vector<std::uint32_t>* corner_vertex,
-                                            std::size_t vertices, const std::vector<std::uint8_t>* skip = nullptr,
-                                            const std::vector<std::uint8_t>* flip = nullptr, int threads = 0);
+std::vector<glm::dvec3> angle_weighted_sums(const Mesh& mesh, const std::uint32_t* corner_vertex, std::size_t vertices,
+                                            const std::uint8_t* skip = nullptr, const std::uint8_t* flip = nullptr,
+                                            int threads = 0);
 // A sum made unit, or (0,0,1) when it has no direction. Never NaN.
 glm::vec3 unit_or_up(const glm::dvec3& sum);
 
