@@ -24,8 +24,8 @@ struct FaceShares {
   glm::dvec3 share[3];
 };
 
-FaceShares face_shares(const Mesh& mesh, std::size_t t, const std::uint32_t* corner_vertex,
-                       const std::uint8_t* skip, const std::uint8_t* flip) {
+FaceShares face_shares(const Mesh& mesh, std::size_t t, const std::uint32_t* corner_vertex, const std::uint8_t* skip,
+                       const std::uint8_t* flip) {
   FaceShares f;
   f.vertex[0] = f.vertex[1] = f.vertex[2] = kNoShare;
   if (skip && skip[t]) return f;
@@ -55,9 +55,8 @@ FaceShares face_shares(const Mesh& mesh, std::size_t t, const std::uint32_t* cor
 // each share into its chunk's list for the thread that owns its vertex (runs of 64 ids dealt
 // round); then each thread adds its lists, chunk after chunk, to its own vertices' sums. So every
 // sum is the one the face-by-face loop makes, to the bit.
-std::vector<glm::dvec3> angle_weighted_sums(const Mesh& mesh, const std::uint32_t* corner_vertex,
-                                            std::size_t vertices, const std::uint8_t* skip,
-                                            const std::uint8_t* flip, int threads) {
+std::vector<glm::dvec3> angle_weighted_sums(const Mesh& mesh, const std::uint32_t* corner_vertex, std::size_t vertices,
+                                            const std::uint8_t* skip, const std::uint8_t* flip, int threads) {
   std::vector<glm::dvec3> sum(vertices, glm::dvec3(0.0));
   const std::size_t tris = mesh.triangle_count();
   constexpr std::size_t kChunk = 4096;  // faces
