@@ -52,6 +52,12 @@ TEST(Cull, KeepsExactlyWhatTheMarginReaches) {
   EXPECT_EQ(triangles_near(regions, 100.0, pos, idx), (std::vector<std::uint32_t>{0, 1, 2}));
   const std::vector<std::uint32_t> only_far = {2};
   EXPECT_TRUE(triangles_near(regions, 0.6, pos, idx, &only_far).empty());
+  // Listed only below `list_below`: 2 near, listed under a limit of 3, not at 2.
+  bool not_listed = true;
+  EXPECT_EQ(triangles_near(regions, 0.6, pos, idx, nullptr, 1, 3, &not_listed), (std::vector<std::uint32_t>{0, 1}));
+  EXPECT_FALSE(not_listed);
+  EXPECT_TRUE(triangles_near(regions, 0.6, pos, idx, nullptr, 2, 2, &not_listed).empty());
+  EXPECT_TRUE(not_listed);
 }
 
 TEST(Cull, TheAnswerDoesNotDependOnTheThreads) {

@@ -4,13 +4,15 @@
 #include <cmath>
 #include <limits>
 
+#include "core/image.h"
 #include "core/parallel.h"
 
 namespace nmbake {
 
 std::vector<std::uint32_t> triangles_near(const std::vector<Box>& regions, double margin, const std::vector<glm::vec3>& positions,
                                           const std::vector<std::uint32_t>& indices, const std::vector<std::uint32_t>* candidates,
-                                          int threads) {
+                                          int threads, std::size_t list_below, bool* not_listed) {
+  if (not_listed) *not_listed = false;
   const std::size_t tris = indices.size() / 3;
   std::vector<std::uint32_t> kept;
   if (regions.empty()) return kept;
@@ -54,7 +56,8 @@ std::vector<std::uint32_t> triangles_near(const std::vector<Box>& regions, doubl
   // axis where all three corners lie beyond one side: the answers of the box itself, bit for bit.
   // 10 bits per axis: 0 beyond the low side (whose cell is 0), 1 + the cell, or dim + 1 beyond the
   // high side (whose cell is dim - 1: the union's far side is dim cells from its near one).
-  std::vector<std::uint32_t> vertex_cells(positions.size());
+  // Written whole on every thread: not zeroed on one thread first.
+  std::vector<std::uint32_t, DefaultInitAllocator<std::uint32_t>> vertex_cells(positions.size());
   parallel_chunks(threads, positions.size(), std::size_t(1) << 16, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       const glm::dvec3 p(positions[i]);
@@ -102,10 +105,16 @@ std::vector<std::uint32_t> triangles_near(const std::vector<Box>& regions, doubl
       if (near(t)) part.push_back(t);
     }
   });
-  std::size_t total = 0;
-  for (const auto& part : parts) total += part.size();
-  kept.reserve(total);
-  for (const auto& part : parts) kept.insert(kept.end(), part.begin(), part.end());
+  std::vector<std::size_t> at(parts.size() + 1, 0);
+  for (std::size_t i = 0; i < parts.size(); ++i) at[i + 1] = at[i] + parts[i].size();
+  if (at.back() >= list_below) {  // the caller does not want so many listed
+    if (not_listed) *not_listed = true;
+    return kept;
+  }
+  kept.resize(at.back());
+  parallel_chunks(threads, parts.size(), 1, [&](std::size_t i, std::size_t) {
+    std::copy(parts[i].begin(), parts[i].end(), kept.begin() + std::ptrdiff_t(at[i]));
+  });
   return kept;
 }
 

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <atomic>
 #include <cstdint>
 #include <cstring>
 
+#include "core/image.h"
 #include "core/parallel.h"
 
 namespace nmbake {
@@ -33,17 +35,20 @@ double ray_margin(const Prepared& s, bool cage, double front, double rear) {
 }
 
 std::vector<std::uint32_t> select_reachable(const Prepared& s, const Mesh& high, double margin, int threads) {
-  std::vector<std::uint32_t> kept = triangles_near(low_regions(s), margin, s.high_pos, high.position_index, nullptr, threads);
-  if (kept.size() == high.triangle_count()) kept.clear();
-  return kept;
+  // Every triangle near: empty, all (not listed).
+  return triangles_near(low_regions(s), margin, s.high_pos, high.position_index, nullptr, threads, high.triangle_count());
 }
 
 bool narrow_reachable(const Prepared& s, const Mesh& high, double margin, std::vector<std::uint32_t>& kept, int threads) {
-  // Empty: all (no list of every triangle, which would add to the bake's peak memory).
-  std::vector<std::uint32_t> nearer =
-      triangles_near(low_regions(s), margin, s.high_pos, high.position_index, kept.empty() ? nullptr : &kept, threads);
+  // Empty: all (no list of every triangle, which would add to the bake's peak memory). Narrowed
+  // only below 0.8 of the current count (fewer than its ceiling, as counts are whole): a longer
+  // list is not made.
   const std::size_t current = kept.empty() ? high.triangle_count() : kept.size();
-  if (!(double(nearer.size()) < 0.8 * double(current))) return false;
+  bool not_listed = false;
+  std::vector<std::uint32_t> nearer =
+      triangles_near(low_regions(s), margin, s.high_pos, high.position_index, kept.empty() ? nullptr : &kept, threads,
+                     std::size_t(std::ceil(0.8 * double(current))), &not_listed);
+  if (not_listed || !(double(nearer.size()) < 0.8 * double(current))) return false;
   kept = std::move(nearer);
   return true;
 }
@@ -91,28 +96,30 @@ std::size_t drop_duplicate_floods(const Prepared& s, const Mesh& high, int threa
   // Count triangles per hash bucket: a group of k identical triangles puts k in one bucket.
   std::size_t buckets = 1024;
   while (buckets < 2 * n) buckets *= 2;
-  std::vector<std::uint16_t> count(buckets, 0);
-  std::vector<std::uint64_t> hash(n);
-  parallel_chunks(threads, n, 1 << 16, [&](std::size_t begin, std::size_t end) {
+  // Both written whole on every thread before they are read: not zeroed on one thread first.
+  std::vector<std::uint16_t, DefaultInitAllocator<std::uint16_t>> count(buckets);
+  std::vector<std::uint64_t, DefaultInitAllocator<std::uint64_t>> hash(n);
+  constexpr std::size_t kChunk = std::size_t(1) << 16;
+  parallel_chunks(threads, buckets, kChunk, [&](std::size_t begin, std::size_t end) {
+    std::fill(count.begin() + std::ptrdiff_t(begin), count.begin() + std::ptrdiff_t(end), 0);
+  });
+  parallel_chunks(threads, n, kChunk, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) hash[i] = key_hash(triangle_key(s, high, triangle(i)));
   });
-  // Counted on every core: each thread counts the buckets it owns (runs of 4096 dealt round),
-  // reading every hash, so no two threads touch one count.
-  const int owners = std::max(1, std::min(worker_threads(threads), int(n >> 16)));
+  // Counted on every core, each count raised by compare-and-swap up to its limit: the counts, and
+  // whether one passes kDuplicateFlood, do not depend on the order of the increments.
   std::atomic<bool> suspects{false};
-  run_on_threads(owners, [&](int id) {
+  parallel_chunks(threads, n, kChunk, [&](std::size_t begin, std::size_t end) {
     bool seen = false;
     constexpr std::size_t kAhead = 16;  // the counts are larger than the caches: fetch ahead
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::size_t b = hash[i] & (buckets - 1);
-      if (int((b >> 12) % std::size_t(owners)) != id) continue;
-      if (i + kAhead < n) {
-        const std::size_t ahead = hash[i + kAhead] & (buckets - 1);
-        if (int((ahead >> 12) % std::size_t(owners)) == id) __builtin_prefetch(&count[ahead], 1);
+    for (std::size_t i = begin; i < end; ++i) {
+      if (i + kAhead < end) __builtin_prefetch(&count[hash[i + kAhead] & (buckets - 1)], 1);
+      std::uint16_t* c = &count[hash[i] & (buckets - 1)];
+      std::uint16_t was = __atomic_load_n(c, __ATOMIC_RELAXED);
+      while (was < UINT16_MAX &&
+             !__atomic_compare_exchange_n(c, &was, std::uint16_t(was + 1), true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
       }
-      std::uint16_t& c = count[b];
-      if (c < UINT16_MAX) ++c;
-      seen |= c > kDuplicateFlood;
+      seen |= std::size_t(was < UINT16_MAX ? was + 1 : was) > kDuplicateFlood;
     }
     if (seen) suspects = true;
   });
