@@ -1,6 +1,7 @@
 // mesh_topology's exact answers: welded ids in order of first occurrence, the earliest of duplicate
 // faces kept, and the faces turned in a non-orientable piece, which follow the order of the
 // breadth-first walk (faces linked in the order of their edges' (smaller, larger vertex) keys).
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -13,6 +14,7 @@
 
 #include "core/mesh_topology.h"
 #include "core/normals.h"
+#include "core/parallel.h"
 #include "core/parallel.h"
 
 using namespace nmbake;
@@ -120,6 +122,28 @@ TEST(Parallel, AllCoresScopeBoundsTheDefaultThreads) {
   EXPECT_EQ(worker_threads(0), machine);
   const AllCores none(0);
   EXPECT_EQ(worker_threads(0), machine);
+}
+
+// touch_storage reserves each vector's storage (its elements kept, its size unchanged), for several
+// vectors of different types at once, one of them already large enough and one asked for nothing.
+TEST(Parallel, TouchStorageReservesAndKeepsTheElements) {
+  std::vector<std::uint32_t> a = {7, 8, 9};
+  std::vector<glm::dvec3> b;
+  std::vector<std::uint8_t> c(100, 5), d;
+  c.reserve(1000);
+  for (int threads : {1, 3}) {
+    touch_storage(threads, storage_for(a, std::size_t(1) << 20), storage_for(b, 300000), storage_for(c, 500), storage_for(d, 0));
+    EXPECT_GE(a.capacity(), std::size_t(1) << 20);
+    EXPECT_GE(b.capacity(), 300000u);
+    EXPECT_EQ(c.capacity(), 1000u);
+    EXPECT_EQ(a, (std::vector<std::uint32_t>{7, 8, 9}));
+    EXPECT_TRUE(b.empty());
+    EXPECT_EQ(c, std::vector<std::uint8_t>(100, 5));
+    EXPECT_TRUE(d.empty());
+  }
+  a.resize(std::size_t(1) << 20);
+  EXPECT_EQ(a[2], 9u);
+  EXPECT_EQ(std::count(a.begin() + 3, a.end(), 0u), std::ptrdiff_t((1 << 20) - 3));
 }
 
 TEST(MeshTopology, DuplicatesKeepTheEarliestFace) {

@@ -2,6 +2,7 @@
 // before return.
 // parallel_chunks: a loop over [0, count) in chunks shared out to `threads` threads (the caller's among them):
 // fn(begin, end) for each chunk, in no particular order. threads <= 0: all cores.
+// touch_storage: the fresh pages of large arrays about to be sized, first touched on every core.
 #pragma once
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include <exception>
 #include <mutex>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 namespace nmbake {
@@ -82,6 +84,49 @@ void parallel_chunks(int threads, std::size_t count, std::size_t chunk, Fn&& fn)
   std::atomic<std::size_t> next{0};
   run_on_threads(threads, [&](int) {
     for (std::size_t i; (i = next.fetch_add(chunk)) < count;) fn(i, std::min(count, i + chunk));
+  });
+}
+
+// Each vector given storage for its count of elements (reserve), and those pages touched on
+// `threads` threads (a byte written in every 4 KiB), before the caller sizes them. The system zeroes
+// a fresh page at its first touch, on the touching thread: a large std::vector sized on one thread
+// (which value-initializes it there) pays all of that on that thread; after this, the sizing only
+// writes to pages already there. For vectors of trivially copyable elements.
+template <typename T, typename A>
+struct StorageToTouch {
+  std::vector<T, A>* v;
+  std::size_t n;
+};
+
+// `v` to be sized to `n` (an argument of touch_storage).
+template <typename T, typename A>
+StorageToTouch<T, A> storage_for(std::vector<T, A>& v, std::size_t n) {
+  return {&v, n};
+}
+
+template <typename... Vs>
+void touch_storage(int threads, Vs... vs) {
+  struct Range {
+    unsigned char* begin;
+    std::size_t bytes;
+  };
+  std::vector<Range> ranges;
+  const auto add = [&](auto s) {
+    using T = typename std::remove_reference_t<decltype(*s.v)>::value_type;
+    static_assert(std::is_trivially_copyable_v<T>);
+    if (s.n <= s.v->capacity()) return;
+    s.v->reserve(s.n);
+    auto* base = reinterpret_cast<unsigned char*>(s.v->data());
+    ranges.push_back({base + s.v->size() * sizeof(T), (s.n - s.v->size()) * sizeof(T)});
+  };
+  (add(vs), ...);
+  constexpr std::size_t kPage = 4096, kStep = std::size_t(1) << 21;  // bytes per chunk
+  std::vector<std::size_t> first(ranges.size() + 1, 0);              // chunks before each range
+  for (std::size_t i = 0; i < ranges.size(); ++i) first[i + 1] = first[i] + (ranges[i].bytes + kStep - 1) / kStep;
+  parallel_chunks(threads, first.back(), 1, [&](std::size_t c, std::size_t) {
+    const std::size_t r = std::size_t(std::upper_bound(first.begin(), first.end(), c) - first.begin()) - 1;
+    const std::size_t at = (c - first[r]) * kStep, end = std::min(ranges[r].bytes, at + kStep);
+    for (std::size_t b = at; b < end; b += kPage) ranges[r].begin[b] = 0;
   });
 }
 
