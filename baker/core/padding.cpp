@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <thread>
 
@@ -70,8 +71,11 @@ std::size_t pad_islands(const std::vector<Image*>& images, const std::vector<std
   const int w = images.front()->width, h = images.front()->height;
   const std::size_t n = std::size_t(w) * h;
   // Nothing to fill from, or nothing to fill: skip the distance transform.
-  const std::size_t covered_count =
-      std::size_t(std::count_if(covered.begin(), covered.end(), [](std::uint8_t c) { return c != 0; }));
+  std::atomic<std::size_t> covered_count{0};
+  parallel_chunks(threads, n, std::size_t(1) << 20, [&](std::size_t begin, std::size_t end) {
+    covered_count += std::size_t(std::count_if(covered.begin() + std::ptrdiff_t(begin), covered.begin() + std::ptrdiff_t(end),
+                                               [](std::uint8_t c) { return c != 0; }));
+  });
   if (covered_count == 0 || covered_count == n) return 0;
   threads = worker_threads(threads);
   // Both passes split into independent parts (columns, then rows) shared out to the threads; each
@@ -87,14 +91,18 @@ std::size_t pad_islands(const std::vector<Image*>& images, const std::vector<std
   // With every covered texel at 0 and the rest infinite, that is the nearest covered row above or
   // below, the upper one on a tie (as distance_1d, where the parabolas' crossings are the exact
   // midpoints between covered rows, chooses): two scans, one down and one up. Columns go in blocks
-  // of kBlock neighbours, so the image is read and written a row segment at a time.
-  constexpr int kBlock = 16;
-  // Left unset: pass 1 writes every texel's, on every thread (the first touch of this memory, and
-  // the system's zeroing of it, is shared out too). -1: no covered texel in the column.
-  std::vector<int, DefaultInitAllocator<int>> gy(n);
+  // of up to kBlock neighbours, so the image is read and written a row segment at a time (long
+  // enough segments that the next row's is fetched while this one's is worked: 16 columns took
+  // twice as long).
+  constexpr int kBlock = 256;
+  // Left unset: pass 1 writes every texel's. Its pages are first touched on every thread, in runs of
+  // whole pages (the system's zeroing of them shared out), before pass 1 writes them column by
+  // column. -1: no covered texel in the column.
+  std::vector<int, DefaultInitAllocator<int>> gy;
+  touch_storage(threads, storage_for(gy, n));
+  gy.resize(n);
   const int m = std::max(w, h);
-  parallel((w + kBlock - 1) / kBlock, [&](int block) {
-    const int x0 = block * kBlock, nb = std::min(kBlock, w - x0);
+  const auto column_block = [&](int x0, int nb) {
     int near[kBlock];
     std::fill(near, near + kBlock, -1);
     for (int y = 0; y < h; ++y)  // down: the nearest covered row at or above, in gy for now
@@ -111,6 +119,14 @@ std::size_t pad_islands(const std::vector<Image*>& images, const std::vector<std
         const int above = gy[i], below = near[j];
         gy[i] = below < 0 || (above >= 0 && y - above <= below - y) ? above : below;
       }
+  };
+  // Each thread a run of neighbouring columns, whole multiples of 16 (not blocks dealt round): two
+  // threads' columns share the cache lines at their edges only, where dealt-round blocks shared
+  // them on every row.
+  run_on_threads(threads, [&](int id) {
+    const auto edge = [&](int k) { return std::min(w, int(std::int64_t(w) * k / threads) / 16 * 16); };
+    const int x1 = id + 1 == threads ? w : edge(id + 1);
+    for (int x0 = edge(id); x0 < x1; x0 += kBlock) column_block(x0, std::min(kBlock, x1 - x0));
   });
   // Pass 2, rows: combine into the exact Euclidean nearest covered texel, then copy it. A row
   // writes only its own uncovered texels and reads only covered ones.
