@@ -17,7 +17,7 @@ namespace {
 // vertex may read when it takes the positions in place (build_high_scene's `share`).
 std::vector<glm::vec3> recentre(const std::vector<glm::vec3>& pts, const glm::dvec3& c, std::size_t spare = 0) {
   std::vector<glm::vec3> out;
-  out.reserve(pts.size() + spare);
+  touch_storage(0, storage_for(out, pts.size() + spare));  // its pages first touched on every core
   out.resize(pts.size());
   parallel_chunks(0, pts.size(), std::size_t(1) << 16, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) out[i] = glm::vec3(glm::dvec3(pts[i]) - c);
@@ -172,6 +172,7 @@ Prepared prepare(const Mesh& low, const Mesh& high, const Mesh* cage, BakeStats&
     // The file's normals per corner and, from them while they are at hand, the facing codes: one
     // pass over the triangles (two read the corner normals twice, a memory-bound 0.14 s at 4M
     // triangles that a second thread did not shorten here).
+    touch_storage(0, storage_for(s.high_facing, high.triangle_count()));  // as recentre's
     s.high_corner_normals.resize(high.normal_index.size());
     s.high_facing.resize(high.triangle_count());
     parallel_chunks(0, high.triangle_count(), std::size_t(1) << 15, [&](std::size_t begin, std::size_t end) {
