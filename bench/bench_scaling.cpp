@@ -90,8 +90,13 @@ void run_triangle_scaling(const BenchRun& run, const Scenes& scenes, const Comma
                                  run.args.rounds));
   rows.push_back(run_command_row(run, "suz_L4 2048^2 1 sample .png", s4_low + scenes.s4 + "/high.ply", "s4.png", "--size 2048",
                                  run.args.rounds));
-  rows.push_back(m1_2k);
-  print_command_row("suz_L4_x4 (1M) 2048^2 1 sample .png (row of section 3)", m1_2k, run.run_dir + "/m1_2k.png");
+  if (m1_2k.wall > 0.0) {  // section 3 ran it
+    rows.push_back(m1_2k);
+    print_command_row("suz_L4_x4 (1M) 2048^2 1 sample .png (row of section 3)", m1_2k, run.run_dir + "/m1_2k.png");
+  } else {  // section 3 not asked for (--sections): the row run here
+    rows.push_back(run_command_row(run, "suz_L4_x4 (1M) 2048^2 1 sample .png", s4_low + scenes.m1_ply, "m1_2k.png", "--size 2048",
+                                   run.args.rounds));
+  }
   if (!run.args.quick)
     rows.push_back(run_command_row(run, "suz_L4_x16 (4M) 2048^2 1 sample .png", s4_low + scenes.m4_ply, "m4_2k.png",
                                    "--size 2048", run.args.rounds));
