@@ -56,34 +56,43 @@ std::pair<double, double> probe_scene(const ReachMode& mode, const BakeOptions& 
     const std::size_t stride = std::max<std::size_t>(1, tris / (mode.probing ? 50000 : 5000));
     static const double probe_bary[4][3] = {
         {1 / 3.0, 1 / 3.0, 1 / 3.0}, {4 / 6.0, 1 / 6.0, 1 / 6.0}, {1 / 6.0, 4 / 6.0, 1 / 6.0}, {1 / 6.0, 1 / 6.0, 4 / 6.0}};
-    std::vector<raycast::Ray> rays;
-    std::vector<std::uint32_t> ray_group;
-    for (std::size_t t = 0; t < tris; t += stride) {
-      if (groups.active() && groups.low[t] == kNoMatch) continue;
-      for (const auto& b : probe_bary) {
-        const glm::dvec3 p = low_point(low_tris[t], b), n = low_ray_normal(low_tris[t], b);
-        rays.push_back({glm::vec3(p), 0.0f, glm::vec3(n), float(mode.reach)});
-        rays.push_back({glm::vec3(p), 0.0f, glm::vec3(-n), float(mode.reach)});
-        if (groups.active()) ray_group.insert(ray_group.end(), 2, groups.low[t]);
+    // The probed triangles, then their rays (an outward and an inward one per point, 8 per
+    // triangle) made on every thread in that order.
+    std::vector<std::uint32_t> probed;
+    for (std::size_t t = 0; t < tris; t += stride)
+      if (!(groups.active() && groups.low[t] == kNoMatch)) probed.push_back(std::uint32_t(t));
+    constexpr std::size_t kPerTriangle = 2 * 4;
+    std::vector<raycast::Ray> rays(kPerTriangle * probed.size());
+    std::vector<std::uint32_t> ray_group(groups.active() ? rays.size() : 0);
+    parallel_chunks(threads, probed.size(), 1024, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t k = begin; k < end; ++k) {
+        const std::uint32_t t = probed[k];
+        raycast::Ray* r = &rays[kPerTriangle * k];
+        for (const auto& b : probe_bary) {
+          const glm::dvec3 p = low_point(low_tris[t], b), n = low_ray_normal(low_tris[t], b);
+          *r++ = {glm::vec3(p), 0.0f, glm::vec3(n), float(mode.reach)};
+          *r++ = {glm::vec3(p), 0.0f, glm::vec3(-n), float(mode.reach)};
+        }
+        if (groups.active()) std::fill_n(&ray_group[kPerTriangle * k], kPerTriangle, groups.low[t]);
       }
-    }
+    });
     std::vector<raycast::Hit> hits(rays.size());
     const std::size_t pairs = rays.size() / 2;
+    // A back face: its front (by its normals) faces away from the low-poly's outside, +direction
+    // of the outward probe (the first of a pair). Found for each chunk's hits on its thread.
+    std::vector<std::uint8_t> is_back(rays.size(), 0);
+    const ProbeTarget target{&*h.scene, h.positions, h.index, h.facing};
     std::atomic<std::size_t> next{0};
     run_parallel(threads, [&](int) {
       for (std::size_t i; (i = next.fetch_add(4096)) < pairs;) {
         const std::size_t n = std::min<std::size_t>(4096, pairs - i);
         intersect_first(*h.scene, &rays[2 * i], &hits[2 * i], 2 * n, groups.active() ? groups.high.data() : nullptr,
                         groups.active() ? &ray_group[2 * i] : nullptr);
+        for (std::size_t j = 2 * i; j < 2 * (i + n); ++j)
+          if (hits[j].hit()) is_back[j] = front_along(target, hits[j].triangle, rays[j & ~std::size_t(1)].direction) < 0.0f;
       }
     });
     std::size_t nearest_back = 0, probes_hit = 0;
-    // A back face: its front (by its normals) faces away from the low-poly's outside, +direction
-    // of the outward probe (the first of a pair).
-    std::vector<std::uint8_t> is_back(rays.size(), 0);
-    const ProbeTarget target{&*h.scene, h.positions, h.index, h.facing};
-    for (std::size_t i = 0; i < rays.size(); ++i)
-      if (hits[i].hit()) is_back[i] = front_along(target, hits[i].triangle, rays[i & ~std::size_t(1)].direction) < 0.0f;
     for (std::size_t i = 0; i < pairs; ++i) {  // how the faces point: by the nearest hit either way
       const raycast::Hit &o = hits[2 * i], &in = hits[2 * i + 1];
       if (!o.hit() && !in.hit()) continue;
