@@ -124,6 +124,19 @@ TEST(Parallel, AllCoresScopeBoundsTheDefaultThreads) {
   EXPECT_EQ(worker_threads(0), machine);
 }
 
+// mark_on_threads: 1 exactly at the indexed places (earlier contents cleared), whatever the threads.
+TEST(Parallel, MarkOnThreadsMarksExactlyTheIndexed) {
+  std::vector<std::uint32_t> index;
+  for (std::uint32_t i = 0; i < 300000; ++i) index.push_back((i * 7919u) % 200003u);
+  std::vector<std::uint8_t> want(400000, 0);
+  for (std::uint32_t i : index) want[i] = 1;
+  for (int threads : {1, 3}) {
+    std::vector<std::uint8_t> marks(400000, 9);
+    mark_on_threads(threads, index, marks);
+    EXPECT_EQ(marks, want) << threads << " threads";
+  }
+}
+
 // touch_storage reserves each vector's storage (its elements kept, its size unchanged), for several
 // vectors of different types at once, one of them already large enough and one asked for nothing.
 TEST(Parallel, TouchStorageReservesAndKeepsTheElements) {

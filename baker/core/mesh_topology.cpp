@@ -69,18 +69,12 @@ void sort3(std::uint32_t v[3]) {
   if (v[0] > v[1]) std::swap(v[0], v[1]);
 }
 
-// Welded vertex ids used by faces, and file vertices no face uses. On `threads` threads: a flag is
-// only ever set to 1, a relaxed atomic store (the value does not depend on which thread sets it).
+// Welded vertex ids used by faces, and file vertices no face uses, on `threads` threads.
 void count_vertices(const Mesh& m, std::size_t ids, Analysis& a, int threads) {
   constexpr std::size_t kChunk = std::size_t(1) << 16;
   const auto mark = [threads](const auto& index, std::size_t n) {
     Unset<std::uint8_t> used(n);
-    parallel_chunks(threads, n, kChunk, [&](std::size_t begin, std::size_t end) {
-      std::fill(used.begin() + std::ptrdiff_t(begin), used.begin() + std::ptrdiff_t(end), 0);
-    });
-    parallel_chunks(threads, index.size(), kChunk, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) __atomic_store_n(&used[index[i]], std::uint8_t(1), __ATOMIC_RELAXED);
-    });
+    mark_on_threads(threads, index, used);
     std::atomic<std::size_t> count{0};
     parallel_chunks(threads, n, kChunk, [&](std::size_t begin, std::size_t end) {
       count += std::size_t(std::count(used.begin() + std::ptrdiff_t(begin), used.begin() + std::ptrdiff_t(end), 1));
@@ -382,16 +376,10 @@ Analysis analyze(const Mesh& m, int threads) {
   if (counts.same_way > 0) orient_pieces(link_faces(ve, ids, a), a);
   else {
     a.flip.resize(tris);
-    parallel_chunks(threads, tris, std::size_t(1) << 16, [&](std::size_t begin, std::size_t end) {
-      std::fill(a.flip.begin() + std::ptrdiff_t(begin), a.flip.begin() + std::ptrdiff_t(end), 0);
-    });
+    fill_on_threads(threads, a.flip, std::uint8_t(0));
   }
   return a;
 }
-
-}  // namespace
-
-namespace {
 
 // Ids in order of first occurrence, on every core. One open-addressing table (linear probing, at
 // most half full) shared by the threads: a slot holds 32 bits of a key's hash and 1 + the first
@@ -409,13 +397,9 @@ void weld_into(const std::vector<glm::vec3>& positions, Unset<std::uint32_t>& ou
   while ((std::size_t(1) << bits) < 2 * n) ++bits;
   const std::size_t mask = (std::size_t(1) << bits) - 1;
   Unset<std::uint64_t> table(mask + 1);  // (32 bits of the hash) << 32 | 1 + position; 0: empty
-  parallel_chunks(threads, table.size(), kChunk, [&](std::size_t begin, std::size_t end) {
-    std::fill(table.begin() + std::ptrdiff_t(begin), table.begin() + std::ptrdiff_t(end), 0);
-  });
+  fill_on_threads(threads, table, std::uint64_t(0));
   Unset<std::uint8_t> stale(n);
-  parallel_chunks(threads, n, kChunk, [&](std::size_t begin, std::size_t end) {
-    std::fill(stale.begin() + std::ptrdiff_t(begin), stale.begin() + std::ptrdiff_t(end), 0);
-  });
+  fill_on_threads(threads, stale, std::uint8_t(0));
   const auto same_key = [&](const PosKey& k, std::uint64_t entry) {
     const PosKey e = key_of(positions[std::uint32_t(entry) - 1]);
     return e.bits[0] == k.bits[0] && e.bits[1] == k.bits[1] && e.bits[2] == k.bits[2];

@@ -2,12 +2,15 @@
 // before return.
 // parallel_chunks: a loop over [0, count) in chunks shared out to `threads` threads (the caller's among them):
 // fn(begin, end) for each chunk, in no particular order. threads <= 0: all cores.
+// fill_on_threads, mark_on_threads: a large array set on every core (its fresh pages first touched
+// there too).
 // touch_storage: the fresh pages of large arrays about to be sized, first touched on every core.
 #pragma once
 
 #include <algorithm>
 #include <atomic>
 #include <cstddef>
+#include <cstdint>
 #include <exception>
 #include <mutex>
 #include <thread>
@@ -84,6 +87,25 @@ void parallel_chunks(int threads, std::size_t count, std::size_t chunk, Fn&& fn)
   std::atomic<std::size_t> next{0};
   run_on_threads(threads, [&](int) {
     for (std::size_t i; (i = next.fetch_add(chunk)) < count;) fn(i, std::min(count, i + chunk));
+  });
+}
+
+// Every element of `v` set to `value`, in chunks on `threads` threads: a vector left unset as it
+// grew (DefaultInitAllocator) is zeroed where its pages are first touched, not on one thread.
+template <typename T, typename A>
+void fill_on_threads(int threads, std::vector<T, A>& v, const T& value) {
+  parallel_chunks(threads, v.size(), std::size_t(1) << 16, [&](std::size_t begin, std::size_t end) {
+    std::fill(v.begin() + std::ptrdiff_t(begin), v.begin() + std::ptrdiff_t(end), value);
+  });
+}
+
+// `marks` (bytes) all 0, then 1 at every value of `index`, on `threads` threads: a mark is only ever
+// set to 1 (relaxed atomic stores), so the marks do not depend on which thread set them.
+template <typename Index, typename A>
+void mark_on_threads(int threads, const Index& index, std::vector<std::uint8_t, A>& marks) {
+  fill_on_threads(threads, marks, std::uint8_t(0));
+  parallel_chunks(threads, index.size(), std::size_t(1) << 16, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) __atomic_store_n(&marks[index[i]], std::uint8_t(1), __ATOMIC_RELAXED);
   });
 }
 

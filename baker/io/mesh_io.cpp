@@ -244,15 +244,9 @@ void settle_normals(ParsedMesh& parsed, MeshLoadInfo& info) {
   }
   if (keep) {
     // Only normals some corner uses count: an unused zero normal in an OBJ harms nobody. Marked on
-    // every core (a mark is only ever set to 1: relaxed atomic stores), its zeros too.
-    constexpr std::size_t kChunk = std::size_t(1) << 16;
+    // every core.
     std::vector<std::uint8_t, DefaultInitAllocator<std::uint8_t>> used(m.normals.size());
-    parallel_chunks(0, used.size(), kChunk, [&](std::size_t begin, std::size_t end) {
-      std::fill(used.begin() + std::ptrdiff_t(begin), used.begin() + std::ptrdiff_t(end), 0);
-    });
-    parallel_chunks(0, m.normal_index.size(), kChunk, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t c = begin; c < end; ++c) __atomic_store_n(&used[m.normal_index[c]], std::uint8_t(1), __ATOMIC_RELAXED);
-    });
+    mark_on_threads(0, m.normal_index, used);
     // On every core, each chunk's counts summed after.
     std::atomic<std::size_t> zero{0}, renormalized{0};
     parallel_chunks(0, m.normals.size(), std::size_t(1) << 16, [&](std::size_t begin, std::size_t end) {

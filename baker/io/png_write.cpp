@@ -136,10 +136,15 @@ void put32(std::vector<unsigned char>& out, std::uint32_t v) {
   out.insert(out.end(), b, b + 4);
 }
 
-void chunk(std::vector<unsigned char>& out, const char type[5], const unsigned char* data, std::size_t n) {
+// A chunk's bytes before its data, appended to `out`: length and type.
+void chunk_head(std::vector<unsigned char>& out, const char type[5], std::size_t n) {
   put32(out, std::uint32_t(n));
-  const std::size_t at = out.size();
   out.insert(out.end(), type, type + 4);
+}
+
+void chunk(std::vector<unsigned char>& out, const char type[5], const unsigned char* data, std::size_t n) {
+  chunk_head(out, type, n);
+  const std::size_t at = out.size() - 4;
   if (n) out.insert(out.end(), data, data + n);
   put32(out, std::uint32_t(crc32(0, out.data() + at, uInt(4 + n))));
 }
@@ -228,14 +233,6 @@ struct Encoded {
   }
 };
 
-// A chunk's bytes before its data: length and type.
-std::vector<unsigned char> chunk_head(const char type[5], std::size_t n) {
-  std::vector<unsigned char> head;
-  put32(head, std::uint32_t(n));
-  head.insert(head.end(), type, type + 4);
-  return head;
-}
-
 // The zlib stream (header, the bands' streams, Adler-32) cut into IDAT chunks of kIdatBytes, as
 // pieces of `e`, then IEND. The chunks' CRCs are worked out on `threads` threads, each over its
 // own chunk's pieces.
@@ -260,7 +257,9 @@ void add_idat_chunks(Encoded& e, uLong adler, int threads) {
   std::size_t seg = 0, seg_used = 0;  // the next byte of the stream: segment, bytes of it used
   for (std::size_t at = 0; at < total; at += kIdatBytes) {
     const std::size_t n = std::min(kIdatBytes, total - at);
-    e.add_own(chunk_head("IDAT", n));
+    std::vector<unsigned char> head;
+    chunk_head(head, "IDAT", n);
+    e.add_own(head);
     Chunk c{e.pieces.size(), 0, 0};
     for (std::size_t left = n; left > 0;) {
       const Encoded::Piece& s = stream[seg];
@@ -276,10 +275,9 @@ void add_idat_chunks(Encoded& e, uLong adler, int threads) {
     e.own.insert(e.own.end(), 4, 0);
     chunks.push_back(c);
   }
-  e.add_own(chunk_head("IEND", 0));
-  const std::size_t iend_crc = e.own.size();
-  put32(e.own, std::uint32_t(crc32(0, reinterpret_cast<const Bytef*>("IEND"), 4)));
-  e.pieces.push_back({-1, iend_crc, 4});
+  std::vector<unsigned char> iend;
+  chunk(iend, "IEND", nullptr, 0);
+  e.add_own(iend);
   // `own` is complete: the pieces' addresses stay put from here.
   parallel_chunks(threads, chunks.size(), 1, [&](std::size_t i, std::size_t) {
     const Chunk& c = chunks[i];

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <array>
-#include <cmath>
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 
@@ -100,9 +100,7 @@ std::size_t drop_duplicate_floods(const Prepared& s, const Mesh& high, int threa
   std::vector<std::uint16_t, DefaultInitAllocator<std::uint16_t>> count(buckets);
   std::vector<std::uint64_t, DefaultInitAllocator<std::uint64_t>> hash(n);
   constexpr std::size_t kChunk = std::size_t(1) << 16;
-  parallel_chunks(threads, buckets, kChunk, [&](std::size_t begin, std::size_t end) {
-    std::fill(count.begin() + std::ptrdiff_t(begin), count.begin() + std::ptrdiff_t(end), 0);
-  });
+  fill_on_threads(threads, count, std::uint16_t(0));
   parallel_chunks(threads, n, kChunk, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) hash[i] = key_hash(triangle_key(s, high, triangle(i)));
   });
