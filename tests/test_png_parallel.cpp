@@ -100,6 +100,25 @@ TEST(PngParallel, EveryFilterReadsBackAsTheRowsOnAnyThreadCount) {
   EXPECT_LT(double(ours.size()), 1.05 * double(theirs.size()) + 200.0);
 }
 
+// A tall image is cut into many bands (one per 64 rows), and each thread writes the streams of the
+// bands it takes one after another into its own output blocks of 8 MiB (io/png_write.cpp): noise
+// that deflate cannot shrink fills several blocks per thread, a band's stream then starting a new
+// block. The file is the same on 1, 2, 3 and 5 threads and reads back as the rows.
+TEST(PngParallel, TallNoiseOverSeveralOutputBlocksReadsBackOnAnyThreadCount) {
+  const int w = 1500, h = 1000, channels = 4, bits = 16;  // 12 MB of rows: 16 bands, about 750 KB each
+  std::mt19937 rng(11);
+  std::vector<unsigned char> rows(std::size_t(w) * std::size_t(h) * std::size_t(channels) * 2);
+  for (unsigned char& b : rows) b = static_cast<unsigned char>(rng());
+  std::string error;
+  const nmbake::PngSettings s{};
+  const std::vector<unsigned char> one = nmbake::encode_png(rows.data(), w, h, channels, bits, {}, s, 1, &error);
+  ASSERT_FALSE(one.empty()) << error;
+  EXPECT_GT(one.size(), rows.size());  // noise: stored, not compressed, so more than one block's worth
+  for (int threads : {2, 3, 5})
+    EXPECT_TRUE(nmbake::encode_png(rows.data(), w, h, channels, bits, {}, s, threads, &error) == one) << threads << " threads";
+  EXPECT_EQ(read_back(one, bits), expected(rows, bits));
+}
+
 TEST(PngParallel, MetadataReadsBack) {
   const std::vector<unsigned char> rows = sample_rows(9, 12, 3, 8, 3);
   std::string error;

@@ -4,10 +4,12 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <functional>
+#include <memory>
 #include <new>
 
 #include "core/parallel.h"
@@ -16,10 +18,18 @@
 namespace nmbake {
 namespace {
 
-// Bands of rows compressed apart: fixed, so the file's bytes do not depend on the threads. Eight
-// keep both cores of a small machine busy to the end (bands of unequal cost), and cost a few bytes
-// each (a sync flush, and RLE's first run of a band).
-constexpr int kBands = 8;
+// Bands of rows compressed apart: fixed by the image's height, so the file's bytes do not depend on
+// the threads. Bands of kBandRows rows (at least kMinBands of them) let every core of a workstation
+// take a share and keep them all busy to the end (bands differ in cost: a map's background rows are
+// cheap); each costs a few bytes (a sync flush, and RLE's first run of a band). Eight bands of a
+// 4096-row map left one of two cores deflating alone for a tenth of the encode.
+constexpr int kBandRows = 64;
+constexpr int kMinBands = 8;
+constexpr int kMaxBands = 1024;
+
+int band_count(int height) {
+  return std::max(1, std::min(height, std::clamp((height + kBandRows - 1) / kBandRows, kMinBands, kMaxBands)));
+}
 constexpr std::size_t kIdatBytes = std::size_t(1) << 18;  // IDAT chunks of 256 KiB
 
 // The PNG filter type byte of a single-filter mask, or -1.
@@ -84,51 +94,102 @@ void filter_row(int type, const unsigned char* cur, const unsigned char* prior, 
   }
 }
 
-// One band's raw deflate stream (ended by a sync flush, or finished for the last band) and the
-// Adler-32 of what it compresses. Returns null, or zlib's reason it failed.
+// One band's raw deflate stream (ended by a sync flush, or finished for the last band), in its
+// thread's output blocks, and the Adler-32 of what it compresses.
 struct Band {
-  std::vector<unsigned char, DefaultInitAllocator<unsigned char>> bytes;  // deflateBound's room, not zeroed
+  const unsigned char* bytes = nullptr;
+  std::size_t size = 0;
   uLong adler = 1;
   std::size_t length = 0;  // bytes compressed
 };
 
-const char* deflate_band(const RowSource& row, std::size_t row_bytes, std::size_t bpp, int type, int y0, int y1, bool last,
-                         const PngSettings& settings, Band& band) {
-  z_stream zs{};
-  const int init = deflateInit2(&zs, settings.level, Z_DEFLATED, -15, 8, settings.strategy);
-  if (init == Z_MEM_ERROR) return "insufficient memory";
-  if (init != Z_OK) return "invalid compression settings";
-  std::vector<unsigned char> prior(row_bytes, 0), cur(row_bytes), filtered(row_bytes + 1);
-  if (y0 > 0) row(y0 - 1, prior.data());
-  band.bytes.resize(deflateBound(&zs, uLong(std::size_t(y1 - y0) * (row_bytes + 1))) + 64);
-  zs.next_out = band.bytes.data();
-  zs.avail_out = uInt(band.bytes.size());
-  bool ok = true;
-  for (int y = y0; y < y1 && ok; ++y) {
-    row(y, cur.data());
-    filter_row(type, cur.data(), prior.data(), row_bytes, bpp, filtered.data());
-    band.adler = adler32(band.adler, filtered.data(), uInt(filtered.size()));
-    band.length += filtered.size();
-    zs.next_in = filtered.data();
-    zs.avail_in = uInt(filtered.size());
-    const int flush = y + 1 < y1 ? Z_NO_FLUSH : last ? Z_FINISH : Z_SYNC_FLUSH;
-    while (ok) {
-      if (zs.avail_out == 0) {  // deflateBound's room used up (it should not be): grow
-        const std::size_t used = band.bytes.size();
-        band.bytes.resize(2 * used);
-        zs.next_out = band.bytes.data() + used;
-        zs.avail_out = uInt(band.bytes.size() - used);
-      }
-      const int r = deflate(&zs, flush);
-      ok = r == Z_OK || r == Z_STREAM_END || r == Z_BUF_ERROR;
-      if (flush == Z_FINISH ? r == Z_STREAM_END : (zs.avail_in == 0 && zs.avail_out > 0)) break;
-    }
-    std::swap(prior, cur);
+using Block = std::unique_ptr<unsigned char[]>;  // not zeroed
+
+// A thread's output blocks hold the streams of the bands it takes one after another, so the pages
+// touched are about the compressed bytes. Blocks of kBlockBytes come on huge pages (large_pages.cpp:
+// one page fault per 2 MiB where 4 KiB pages cost one each), which a block per band of a tall map
+// (a few hundred KiB) would not.
+constexpr std::size_t kBlockBytes = std::size_t(8) << 20;
+
+// One thread's band encoder: its zlib stream and row buffers made once and reset for each band it
+// takes (a stream's state is a few hundred KiB, fresh pages each time if made per band).
+class BandEncoder {
+ public:
+  // block_bytes: the size of its output blocks (larger ones where a band needs more room).
+  BandEncoder(const PngSettings& settings, std::size_t row_bytes, std::size_t block_bytes)
+      : init_(deflateInit2(&zs_, settings.level, Z_DEFLATED, -15, 8, settings.strategy)),
+        block_bytes_(block_bytes),
+        prior_(row_bytes),
+        cur_(row_bytes),
+        filtered_(row_bytes + 1) {}
+  BandEncoder(const BandEncoder&) = delete;
+  BandEncoder& operator=(const BandEncoder&) = delete;
+  ~BandEncoder() {
+    if (init_ == Z_OK) deflateEnd(&zs_);
   }
-  band.bytes.resize(band.bytes.size() - zs.avail_out);
-  deflateEnd(&zs);
-  return ok ? nullptr : "insufficient memory";  // deflate fails only for want of memory here
-}
+
+  // Rows y0 .. y1 - 1 into `band`. Returns null, or zlib's reason it failed.
+  const char* encode(const RowSource& row, std::size_t bpp, int type, int y0, int y1, bool last, Band& band) {
+    if (init_ == Z_MEM_ERROR) return "insufficient memory";
+    if (init_ != Z_OK) return "invalid compression settings";
+    if (deflateReset(&zs_) != Z_OK) return "insufficient memory";
+    const std::size_t row_bytes = cur_.size();
+    if (y0 > 0) row(y0 - 1, prior_.data());
+    else std::fill(prior_.begin(), prior_.end(), static_cast<unsigned char>(0));
+    room(deflateBound(&zs_, uLong(std::size_t(y1 - y0) * (row_bytes + 1))) + 64, 0);
+    bool ok = true;
+    for (int y = y0; y < y1 && ok; ++y) {
+      row(y, cur_.data());
+      filter_row(type, cur_.data(), prior_.data(), row_bytes, bpp, filtered_.data());
+      band.adler = adler32(band.adler, filtered_.data(), uInt(filtered_.size()));
+      band.length += filtered_.size();
+      zs_.next_in = filtered_.data();
+      zs_.avail_in = uInt(filtered_.size());
+      const int flush = y + 1 < y1 ? Z_NO_FLUSH : last ? Z_FINISH : Z_SYNC_FLUSH;
+      while (ok) {
+        if (zs_.avail_out == 0) {  // deflateBound's room used up (it should not be): twice as much
+          const std::size_t used = std::size_t(zs_.next_out - band_start_);
+          room(2 * used, used);
+        }
+        const int r = deflate(&zs_, flush);
+        ok = r == Z_OK || r == Z_STREAM_END || r == Z_BUF_ERROR;
+        if (flush == Z_FINISH ? r == Z_STREAM_END : (zs_.avail_in == 0 && zs_.avail_out > 0)) break;
+      }
+      std::swap(prior_, cur_);
+    }
+    band.bytes = band_start_;
+    band.size = std::size_t(zs_.next_out - band_start_);
+    used_ += band.size;
+    return ok ? nullptr : "insufficient memory";  // deflate fails only for want of memory here
+  }
+
+  // The blocks holding this encoder's bands, for the caller to keep.
+  std::vector<Block>& blocks() { return blocks_; }
+
+ private:
+  // `need` bytes of room for the band under way, whose first `kept` bytes are already written
+  // (moved to a new block when the room is not there).
+  void room(std::size_t need, std::size_t kept) {
+    if (blocks_.empty() || used_ + need > block_size_) {
+      const std::size_t size = std::max(block_bytes_, need);
+      blocks_.push_back(Block(new unsigned char[size]));
+      if (kept) std::memcpy(blocks_.back().get(), band_start_, kept);
+      block_size_ = size;
+      used_ = 0;
+    }
+    band_start_ = blocks_.back().get() + used_;
+    zs_.next_out = band_start_ + kept;
+    zs_.avail_out = uInt(need - kept);
+  }
+
+  z_stream zs_{};
+  int init_;
+  std::size_t block_bytes_;
+  std::vector<Block> blocks_;
+  std::size_t block_size_ = 0, used_ = 0;  // the last block's size and bytes taken by finished bands
+  unsigned char* band_start_ = nullptr;
+  std::vector<unsigned char> prior_, cur_, filtered_;
+};
 
 void put32(std::vector<unsigned char>& out, std::uint32_t v) {
   const unsigned char b[4] = {static_cast<unsigned char>(v >> 24), static_cast<unsigned char>(v >> 16),
@@ -203,6 +264,7 @@ bool valid_sizes(int width, int height, int channels, int bits, std::string* err
 // and the fresh pages they fill cost as much as a band's encoding, on one thread).
 struct Encoded {
   std::vector<Band> bands;
+  std::vector<Block> blocks;  // the bands' bytes
   std::vector<unsigned char> own;
   struct Piece {
     int band;  // -1: own
@@ -214,9 +276,7 @@ struct Encoded {
     pieces.push_back({-1, own.size(), bytes.size()});
     own.insert(own.end(), bytes.begin(), bytes.end());
   }
-  const unsigned char* data(const Piece& p) const {
-    return (p.band < 0 ? own.data() : bands[std::size_t(p.band)].bytes.data()) + p.at;
-  }
+  const unsigned char* data(const Piece& p) const { return (p.band < 0 ? own.data() : bands[std::size_t(p.band)].bytes) + p.at; }
   std::vector<ByteSpan> spans() const {
     std::vector<ByteSpan> out;
     out.reserve(pieces.size());
@@ -243,7 +303,7 @@ void add_idat_chunks(Encoded& e, uLong adler, int threads) {
   e.own.insert(e.own.end(), {0x78, 0x01});  // deflate, 32K window, no preset dictionary; check bits
   stream.push_back({-1, header_at, 2});
   for (std::size_t b = 0; b < e.bands.size(); ++b)
-    if (!e.bands[b].bytes.empty()) stream.push_back({int(b), 0, e.bands[b].bytes.size()});
+    if (e.bands[b].size) stream.push_back({int(b), 0, e.bands[b].size});
   const std::size_t adler_at = e.own.size();
   put32(e.own, std::uint32_t(adler));
   stream.push_back({-1, adler_at, 4});
@@ -307,14 +367,25 @@ bool encode_rows(const RowSource& row, int width, int height, const Layout& layo
     }
   const std::size_t bpp = layout.bpp, row_bytes = layout.row_bytes;
   try {
-    const int bands = std::max(1, std::min(kBands, height));
+    const int bands = band_count(height);
     e.bands.assign(static_cast<std::size_t>(bands), Band{});
     std::vector<const char*> failed(e.bands.size(), nullptr);
-    parallel_chunks(threads, e.bands.size(), 1, [&](std::size_t b, std::size_t) {
-      const int y0 = int(std::int64_t(height) * std::int64_t(b) / bands),
-                y1 = int(std::int64_t(height) * std::int64_t(b + 1) / bands);
-      failed[b] = deflate_band(row, row_bytes, bpp, type, y0, y1, b + 1 == e.bands.size(), settings, e.bands[b]);
+    std::atomic<std::size_t> next{0};  // the bands in order, each to the first thread free
+    const int workers = std::min(worker_threads(threads), bands);
+    std::vector<std::vector<Block>> blocks(static_cast<std::size_t>(workers));
+    // No larger than the whole image's room needs: a small image's blocks stay small.
+    const std::size_t block_bytes = std::min(kBlockBytes, std::size_t(height) * (row_bytes + 1) + std::size_t(bands) * 64);
+    run_on_threads(workers, [&](int id) {
+      BandEncoder encoder(settings, row_bytes, block_bytes);
+      for (std::size_t b; (b = next.fetch_add(1)) < e.bands.size();) {
+        const int y0 = int(std::int64_t(height) * std::int64_t(b) / bands),
+                  y1 = int(std::int64_t(height) * std::int64_t(b + 1) / bands);
+        failed[b] = encoder.encode(row, bpp, type, y0, y1, b + 1 == e.bands.size(), e.bands[b]);
+      }
+      blocks[std::size_t(id)] = std::move(encoder.blocks());
     });
+    for (std::vector<Block>& own_blocks : blocks)
+      for (Block& block : own_blocks) e.blocks.push_back(std::move(block));
     for (const char* f : failed)
       if (f) {
         *error = f;

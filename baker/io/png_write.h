@@ -1,4 +1,4 @@
-// PNG maps and masks, written without OpenImageIO. The rows are cut into a fixed number of bands;
+// PNG maps and masks, written without OpenImageIO. The rows are cut into bands (their number fixed by the height);
 // each band is filtered and deflated on its own, on every core (zlib, raw deflate ended by a sync
 // flush, so the bands' streams join into one), and the file is assembled around the joined stream:
 // IHDR, one tEXt per metadata item ("ImageDescription" as "Description", which OpenImageIO reads
