@@ -146,10 +146,11 @@ struct ImageWrite {
 
 // The images written, each to its temporary, largest first. One larger than all the rest together
 // (a plain normal map, one with its masks) takes every thread its encoder uses, alone; the others
-// go side by side, one per thread, so that one file's serial parts (assembling, checksums, the
-// write and its fsync) overlap another's encoding. The bytes do not depend on the threads
-// (WriteOptions::threads). An error is the first file's in `writes` order that failed, whatever
-// the threads did first.
+// go side by side, so that one file's serial parts (assembling, checksums, the write and its fsync)
+// overlap another's encoding: as many at once as there are threads or files, each file with its
+// share of the threads (a workstation's 16 threads write 4 UDIM tiles 4 at a time, 4 threads each,
+// not 4 threads in all). The bytes do not depend on the threads (WriteOptions::threads). An error
+// is the first file's in `writes` order that failed, whatever the threads did first.
 void write_images(const JobEnv& env, std::vector<ImageWrite>& writes, int threads) {
   std::vector<std::size_t> order(writes.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
@@ -166,12 +167,13 @@ void write_images(const JobEnv& env, std::vector<ImageWrite>& writes, int thread
   std::vector<std::exception_ptr> failed(writes.size());
   std::atomic<std::size_t> next{k};
   std::atomic<bool> stop{false};
-  run_on_threads(std::max(1, std::min(worker_threads(threads), int(order.size() - k))), [&](int) {
+  const int all = worker_threads(threads), side_by_side = std::max(1, std::min(all, int(order.size() - k)));
+  run_on_threads(side_by_side, [&](int) {
     for (std::size_t j; !stop && (j = next++) < order.size();) {
       ImageWrite& w = writes[order[j]];
       try {
         if (env.interrupted()) throw Cancelled();
-        w.options.threads = 1;
+        w.options.threads = std::max(1, all / side_by_side);
         write_image(w.path, *w.image, w.options);
       } catch (...) {
         failed[order[j]] = std::current_exception();
