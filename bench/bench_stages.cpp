@@ -65,7 +65,7 @@ BakeStats trace_by_texel(const Mesh& low, const Mesh& high, const BakeOptions& o
   const int threads = worker_threads(o.threads);
   BakeResult result;
   std::vector<std::uint8_t> disagree;
-  allocate_outputs(o, result, disagree);
+  allocate_outputs(o, result, disagree, threads);
   TraceInputs in;
   std::string stage;
   prepare_trace(low, high, nullptr, o, threads, in, result, stage);

@@ -58,13 +58,6 @@ struct Image {
     pixels.resize(n);
   }
 
-  // Touches every page of the pixels (writing 0 to one value per 4 KiB), so that the system's
-  // zeroing of fresh memory happens now, on this thread, and not at the first real write.
-  void fault_in() {
-    constexpr std::size_t kPageFloats = 4096 / sizeof(float);
-    for (std::size_t i = 0; i < pixels.size(); i += kPageFloats) pixels[i] = 0.0f;
-  }
-
   float* at(int x, int y) { return &pixels[(static_cast<std::size_t>(y) * width + x) * channels]; }
   const float* at(int x, int y) const { return &pixels[(static_cast<std::size_t>(y) * width + x) * channels]; }
 

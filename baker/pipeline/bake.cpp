@@ -97,13 +97,17 @@ void check_bake_inputs(const Mesh& low, const Mesh& high, const Mesh* cage, cons
 }
 
 // One map's buffers (bake_stages.h).
-void allocate_outputs(const BakeOptions& opt, BakeResult& result, std::vector<std::uint8_t>& disagree) {
+void allocate_outputs(const BakeOptions& opt, BakeResult& result, std::vector<std::uint8_t>& disagree, int threads) {
   const std::size_t texels = std::size_t(opt.width) * std::size_t(opt.height);
   result.map = Image(opt.width, opt.height, 3, Image::Unset{});  // the trace writes the covered texels, padding the rest
-  result.map.fault_in();
+  touch_pages(threads, result.map.pixels.data(), result.map.pixels.size() * sizeof(float));
+  touch_storage(threads, storage_for(result.coverage, texels));
   result.coverage.assign(texels, 0);
   if (opt.miss_mask) result.miss_mask = Image(opt.width, opt.height, 1, 0.0f);
-  if (opt.samples > 1) disagree.assign(texels, 0);
+  if (opt.samples > 1) {
+    touch_storage(threads, storage_for(disagree, texels));
+    disagree.assign(texels, 0);
+  }
 }
 
 std::vector<glm::dvec2> sample_offsets(int samples) {
@@ -305,8 +309,7 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     // The other maps' raw values and the curvature, made while the stages before the trace run.
     MapTargets map_out;
     std::vector<float> curvature;
-    OutputAllocation outputs([&opt, &result, &disagree, &map_out, &curvature, &high, extra] {
-      allocate_outputs(opt, result, disagree);
+    OutputAllocation outputs([&opt, &map_out, &curvature, &high, extra] {
       if (!extra) return;
       map_out = allocate_map_targets(opt.maps, opt.width, opt.height);
       curvature = map_curvature(opt, high);
@@ -316,10 +319,12 @@ BakeResult bake_normal_map(const Mesh& low, const Mesh& high, const Mesh* cage, 
     prepare_trace(low, high, cage, opt, threads, in, result, stage);
 
     announce_stage(opt, "tracing");
-    stage = "tracing (" + texels + ")";
     auto t0 = Clock::now();
     const double cpu0 = process_cpu_seconds();
     const TileBins bins = bin_triangles(low, opt.width, opt.height, trace_tile_side(opt));
+    stage = "allocating the map (" + texels + ")";
+    allocate_outputs(opt, result, disagree, threads);
+    stage = "tracing (" + texels + ")";
     outputs.wait();
     MapInputs map_in;
     if (extra) map_in = make_map_inputs(opt, in.s, in.scene, in.selection, high, std::move(curvature));

@@ -89,12 +89,14 @@ void narrow_and_rebuild(const Mesh& high, const ReachMode& mode, const BakeOptio
 int trace_tile_side(const BakeOptions& opt);
 
 // One map's output buffers at opt's size: result.map (pages touched, values unset), coverage
-// (zeros), the miss mask when asked, and `disagree` (zeros) with several samples.
-void allocate_outputs(const BakeOptions& opt, BakeResult& result, std::vector<std::uint8_t>& disagree);
+// (zeros), the miss mask when asked, and `disagree` (zeros) with several samples. Made at the
+// trace's start on `threads` threads: the system zeroes each fresh page at its first touch, work
+// that would otherwise fall between the trace's rays. (On a helper thread beside the stages before,
+// as it was, it took a core those stages use, and ran even at --threads 1.)
+void allocate_outputs(const BakeOptions& opt, BakeResult& result, std::vector<std::uint8_t>& disagree, int threads);
 
-// Runs `allocate` on a helper thread while the caller prepares: the system zeroes each fresh page
-// at its first touch, work that would otherwise fall between the trace's rays. wait() rethrows
-// what `allocate` threw.
+// Runs `allocate` (the texture set's other maps' buffers and the curvature) on a helper thread
+// while the caller prepares. wait() rethrows what `allocate` threw.
 class OutputAllocation {
  public:
   explicit OutputAllocation(std::function<void()> allocate)

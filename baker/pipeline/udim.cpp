@@ -197,8 +197,7 @@ UdimBake bake_udim_tiles(const Mesh& low, const Mesh& high, const Mesh* cage, co
     const bool extra = opt.maps.wants_extra();
     std::vector<MapTargets> map_out(extra ? n : 0);  // per tile, the other maps' raw values
     std::vector<float> curvature;
-    OutputAllocation outputs([&opt, &out, &disagree, &map_out, &curvature, &high, extra] {
-      for (std::size_t i = 0; i < out.tiles.size(); ++i) allocate_outputs(opt, out.tiles[i].result, disagree[i]);
+    OutputAllocation outputs([&opt, &map_out, &curvature, &high, extra] {
       for (MapTargets& t : map_out) t = allocate_map_targets(opt.maps, opt.width, opt.height);
       if (extra) curvature = map_curvature(opt, high);
     });
@@ -230,10 +229,11 @@ UdimBake bake_udim_tiles(const Mesh& low, const Mesh& high, const Mesh* cage, co
       const double cpu0 = process_cpu_seconds();
       const UvTileFilter only{&layout.tile_of, std::int32_t(i), tb.tile.u, tb.tile.v};
       const TileBins bins = bin_triangles(low, opt.width, opt.height, trace_tile_side(opt), &only);
-      if (i == 0) {  // the maps are allocated while the stages before the trace run
+      {  // each tile's buffers just before its trace; the other maps' while the stages before the trace ran
         const std::string tracing = stage;
         stage = allocating;
-        outputs.wait();
+        allocate_outputs(opt, tb.result, disagree[i], threads);
+        if (i == 0) outputs.wait();
         stage = tracing;
       }
       trace_and_shade(in.s, in.scene, bins, in.rays, tile_opt, threads,
