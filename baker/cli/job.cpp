@@ -572,7 +572,8 @@ void bake_job(const Args& a, const JobEnv& env) {
   // write leaves cores idle (its file and sync); on one thread (--threads 1), before it, so that
   // the command never takes a core --threads did not give it.
   std::future<MeshTopology> topology;
-  if (!s.prepare.high_topology) {
+  const std::optional<MeshTopology> checked = loaded->topology;  // an earlier job of the batch's, for this high-poly
+  if (!s.prepare.high_topology && !checked) {
     *env.doing = "checking the high-poly's topology";
     if (worker_threads(o.threads) > 1) {
       topology = std::async(std::launch::async, [&high, threads = o.threads] { return inspect_topology(high, threads); });
@@ -591,12 +592,15 @@ void bake_job(const Args& a, const JobEnv& env) {
   run.seconds_write = seconds_since(t0);
   if (s.prepare.high_topology) {
     run.high_topology = *s.prepare.high_topology;
+  } else if (checked) {
+    run.high_topology = *checked;
   } else if (topology.valid()) {
     *env.doing = "checking the high-poly's topology";
     t0 = Clock::now();
     run.high_topology = topology.get();
     run.seconds_topology = seconds_since(t0);  // what the check adds after the write
   }
+  if (env.cache) loaded->topology = run.high_topology;  // the batch's next job from this high-poly reads it
   if (env.keep_progress) env.progress.hold();
   else env.progress.finish();
   warnings.add(bake_warnings(s, run.high_topology, a.low, a.high, uv_tiles_note(low, a, o.width, o.height),

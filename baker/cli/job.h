@@ -5,6 +5,7 @@
 #include <chrono>
 #include <functional>
 #include <map>
+#include <optional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -15,6 +16,7 @@
 #include "cli/progress.h"
 #include "core/image.h"
 #include "core/mesh.h"
+#include "core/mesh_topology.h"
 #include "io/image_io.h"
 #include "io/mesh_io.h"
 #include "pipeline/bake.h"
@@ -28,6 +30,9 @@ struct LoadedHigh {
   std::vector<MeshLoadInfo> infos;     // each file's
   std::vector<std::size_t> triangles;  // each file's
   mutable BvhCache bvh;                // its BVH, built by the first job and reused by the next (bake.h)
+  // Its topology check, made by the first job that reports it and read by the next (it depends on
+  // the mesh alone).
+  mutable std::optional<MeshTopology> topology;
 };
 struct MeshCache {
   std::map<std::string, std::shared_ptr<const LoadedHigh>> highs;
