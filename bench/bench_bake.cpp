@@ -38,6 +38,7 @@
 #include "bench_bake.h"
 #include "bench_support.h"
 #include "io/mesh_io.h"
+#include "io/text_file.h"
 #include "tests/build_paths.h"
 
 using namespace nmbake::bench;
@@ -92,12 +93,32 @@ void generate_scenes(const BenchRun& run, Scenes& scenes) {
   } else {
     for (const std::string& p : {m1_ply, m1_obj, m4_ply}) make(p, [] {});
   }
+  // suz_L4's low-poly on UDIM tiles 1001, 1002, 1011 and 1012: each triangle's UVs in the quadrant
+  // of the unit square holding its UV centroid, scaled by 2 into that quadrant's tile (islands cut
+  // by a quadrant's edge reach a little beyond their tile: a warning, and the bake cuts them there).
+  scenes.udim_low = args.scratch + "/suz_L4_udim4.obj";
+  make(scenes.udim_low, [&] {
+    const Mesh low = load_mesh(scenes.s4 + "/low.obj", low_options);
+    Mesh tiled;
+    tiled.positions = low.positions;
+    tiled.position_index = low.position_index;
+    for (std::size_t t = 0; t < low.triangle_count(); ++t) {
+      const glm::vec2 c = (low.corner_uv(t, 0) + low.corner_uv(t, 1) + low.corner_uv(t, 2)) / 3.0f;
+      const glm::vec2 q(c.x >= 0.5f ? 1.0f : 0.0f, c.y >= 0.5f ? 1.0f : 0.0f);
+      for (int k = 0; k < 3; ++k) {
+        tiled.uv_index.push_back(std::uint32_t(tiled.uvs.size()));
+        tiled.uvs.push_back((low.corner_uv(t, k) - 0.5f * q) * 2.0f + q);
+      }
+    }
+    write_text_atomically(scenes.udim_low, obj_text(tiled, "suz_L4 low.obj, UV quadrants on UDIM tiles 1001 1002 1011 1012"));
+  });
   make(far_ply, [&] {
     write_binary_ply(far_ply, with_copies(t3_high, {glm::vec3(far_d), glm::vec3(-far_d), glm::vec3(far_d, -far_d, 0)}));
   });
   std::printf(
       "\nsuz_L4_x4 = suz_L4 high subdivided once (1 -> 4 triangles), suz_L4_x16 = twice; torus_s3_far4 = torus_s3 high "
-      "plus 3 copies translated by %.2f (4 scene diagonals) along (1,1,1), (-1,-1,-1), (1,-1,0).\n\n",
+      "plus 3 copies translated by %.2f (4 scene diagonals) along (1,1,1), (-1,-1,-1), (1,-1,0); suz_L4_udim4 = suz_L4 "
+      "low with each UV quadrant scaled onto its own UDIM tile (1001, 1002, 1011, 1012).\n\n",
       double(far_d));
   flush();
 }

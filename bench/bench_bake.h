@@ -48,6 +48,7 @@ struct BenchRun {
 struct Scenes {
   std::string t3, s3, s4;                       // sculpts/torus_s3, suz_L3, suz_L4 (low.obj, high.ply)
   std::string m1_ply, m1_obj, m4_ply, far_ply;  // suz_L4_x4 (1M triangles), suz_L4_x16 (4M), torus_s3_far4
+  std::string udim_low;                         // suz_L4's low-poly with its UV quadrants on 4 UDIM tiles
   Mesh t3_low, t3_high;                         // torus_s3, loaded once
 };
 

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -172,6 +173,19 @@ std::size_t high_tris(const CommandRun& r) {
 }
 
 std::string map_hash_of(const std::string& path) {
+  const std::string token = "<UDIM>";
+  const std::size_t at = path.find(token);
+  if (at != std::string::npos) {  // a map per tile: each tile's number and hash
+    std::string all;
+    for (int tile = 1001; tile <= 2000; ++tile) {
+      const std::string file = path.substr(0, at) + std::to_string(tile) + path.substr(at + token.size());
+      if (!std::filesystem::exists(file)) continue;
+      const std::string h = map_hash_of(file);
+      if (h.rfind("unreadable", 0) == 0) return h;
+      all += (all.empty() ? "" : " ") + std::to_string(tile) + ":" + h;
+    }
+    return all.empty() ? "unreadable: no tile of " + path : all;
+  }
   try {
     return hex(pixel_hash(read_image(path).pixels));
   } catch (const std::exception& e) {
