@@ -9,46 +9,62 @@
 
 using namespace nmbake;
 
+namespace {
+
+// Pads a W x H map of covered texels drawn with probability `density` (each holding its own index)
+// by `pad`, and checks every texel against a search of all covered texels: kept where covered,
+// filled from a covered texel at exactly the nearest distance where that is within `pad`, left
+// alone beyond it.
+void check_against_brute_force(std::mt19937& rng, int W, int H, double density, int pad) {
+  Image img(W, H, 1, -1.0f);
+  std::vector<std::uint8_t> cov(std::size_t(W) * H, 0);
+  std::bernoulli_distribution on(density);
+  std::vector<int> covered;
+  for (int i = 0; i < W * H; ++i)
+    if (on(rng)) {
+      cov[i] = 1;
+      img.pixels[i] = float(i);
+      covered.push_back(i);
+    }
+  Image out = img;
+  pad_islands(out, cov, pad);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const int i = y * W + x;
+      if (cov[i]) {
+        EXPECT_EQ(out.pixels[i], img.pixels[i]);
+        continue;
+      }
+      long best = -1;
+      for (int j : covered) {
+        const long dx = j % W - x, dy = j / W - y, d = dx * dx + dy * dy;
+        if (best < 0 || d < best) best = d;
+      }
+      if (best < 0 || best > long(pad) * pad) {
+        ASSERT_EQ(out.pixels[i], -1.0f) << "texel beyond the padding was filled, pad " << pad;
+      } else {
+        // Filled from some covered texel at exactly the nearest distance.
+        const int src = int(out.pixels[i]);
+        ASSERT_GE(src, 0) << "pad " << pad;
+        ASSERT_TRUE(cov[src]);
+        const long dx = src % W - x, dy = src / W - y;
+        ASSERT_EQ(dx * dx + dy * dy, best) << "pad " << pad;
+      }
+    }
+}
+
+}  // namespace
+
 TEST(Padding, MatchesBruteForceNearestTexel) {
   std::mt19937 rng(99);
-  for (int trial = 0; trial < 20; ++trial) {
-    const int W = 23 + trial, H = 17 + 2 * trial;
-    Image img(W, H, 1, -1.0f);
-    std::vector<std::uint8_t> cov(std::size_t(W) * H, 0);
-    std::bernoulli_distribution on(0.03);
-    for (int i = 0; i < W * H; ++i)
-      if (on(rng)) {
-        cov[i] = 1;
-        img.pixels[i] = float(i);
-      }
-    const int pad = 1 + trial % 7;
-    Image out = img;
-    pad_islands(out, cov, pad);
-    for (int y = 0; y < H; ++y)
-      for (int x = 0; x < W; ++x) {
-        const int i = y * W + x;
-        if (cov[i]) {
-          EXPECT_EQ(out.pixels[i], img.pixels[i]);
-          continue;
-        }
-        long best = -1;
-        for (int j = 0; j < W * H; ++j)
-          if (cov[j]) {
-            const long dx = j % W - x, dy = j / W - y, d = dx * dx + dy * dy;
-            if (best < 0 || d < best) best = d;
-          }
-        if (best < 0 || best > long(pad) * pad) {
-          EXPECT_EQ(out.pixels[i], -1.0f) << "texel beyond the padding was filled";
-        } else {
-          // Filled from some covered texel at exactly the nearest distance.
-          const int src = int(out.pixels[i]);
-          ASSERT_GE(src, 0);
-          ASSERT_TRUE(cov[src]);
-          const long dx = src % W - x, dy = src / W - y;
-          EXPECT_EQ(dx * dx + dy * dy, best);
-        }
-      }
-  }
+  for (int trial = 0; trial < 20; ++trial) check_against_brute_force(rng, 23 + trial, 17 + 2 * trial, 0.03, 1 + trial % 7);
+}
+
+// Paddings to 126 keep the column pass's offsets in a byte, larger ones in an int (padding.cpp):
+// both sides of that line, on sparse maps where covered texels lie hundreds of texels apart.
+TEST(Padding, MatchesBruteForceNearestTexelForPaddingsAroundAByte) {
+  std::mt19937 rng(7);
+  for (int pad : {100, 126, 127, 128, 200, 400}) check_against_brute_force(rng, 300, 260, 0.0002, pad);
 }
 
 // Within a column (a map one texel wide), a texel halfway between two covered ones takes the upper
