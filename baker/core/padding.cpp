@@ -71,12 +71,6 @@ std::size_t pad_with(const std::vector<Image*>& images, const std::vector<std::u
   const auto row = [](G o, int y) { return o == kNone ? -1 : y + int(o); };
   // Both passes split into independent parts (columns, then rows) shared out to the threads; each
   // part's result is the same whichever thread computes it.
-  auto parallel = [threads](int parts, auto&& part) {
-    std::atomic<int> next{0};
-    run_on_threads(threads, [&](int) {
-      for (int i; (i = next.fetch_add(1)) < parts;) part(i);
-    });
-  };
   // Pass 1, columns: the row of the nearest covered texel in the same column (its squared distance
   // follows from it, and is worked out row by row in pass 2: 8 bytes per texel fewer), as its offset
   // from the texel's row; none (kNone) when it lies more than `padding` rows away, as then every
@@ -135,26 +129,28 @@ std::size_t pad_with(const std::vector<Image*>& images, const std::vector<std::u
   const double limit = double(padding) * padding;
   constexpr int kRows = 16;
   std::vector<std::size_t> filled((h + kRows - 1) / kRows, 0);
-  parallel(int(filled.size()), [&](int part) {
-    std::vector<double> f(w), d(m), z(m + 1);
+  std::atomic<int> next{0};  // parts of kRows rows, each to the first thread free
+  run_on_threads(threads, [&](int) {
+    std::vector<double> f(w), d(m), z(m + 1);  // the thread's buffers, for every part it takes
     std::vector<int> arg(m), v(m);
-    for (int y = part * kRows; y < std::min(h, (part + 1) * kRows); ++y) {
-      for (int x = 0; x < w; ++x) {  // the column distances: squared, infinite where none
-        const int p = row(gy[std::size_t(y) * w + x], y);
-        f[std::size_t(x)] = p < 0 ? kInf : double(y - p) * (y - p);
-      }
-      distance_1d(f.data(), w, d.data(), arg.data(), v.data(), z.data());
-      for (int x = 0; x < w; ++x) {
-        if (covered[std::size_t(y) * w + x] || arg[x] < 0 || d[x] > limit) continue;
-        const int sx = arg[x], sy = row(gy[std::size_t(y) * w + sx], y);
-        for (Image* image : images) {
-          const float* src = image->at(sx, sy);
-          float* dst = image->at(x, y);
-          for (int c = 0; c < image->channels; ++c) dst[c] = src[c];
+    for (int part; (part = next.fetch_add(1)) < int(filled.size());)
+      for (int y = part * kRows; y < std::min(h, (part + 1) * kRows); ++y) {
+        for (int x = 0; x < w; ++x) {  // the column distances: squared, infinite where none
+          const int p = row(gy[std::size_t(y) * w + x], y);
+          f[std::size_t(x)] = p < 0 ? kInf : double(y - p) * (y - p);
         }
-        ++filled[std::size_t(part)];
+        distance_1d(f.data(), w, d.data(), arg.data(), v.data(), z.data());
+        for (int x = 0; x < w; ++x) {
+          if (covered[std::size_t(y) * w + x] || arg[x] < 0 || d[x] > limit) continue;
+          const int sx = arg[x], sy = row(gy[std::size_t(y) * w + sx], y);
+          for (Image* image : images) {
+            const float* src = image->at(sx, sy);
+            float* dst = image->at(x, y);
+            for (int c = 0; c < image->channels; ++c) dst[c] = src[c];
+          }
+          ++filled[std::size_t(part)];
+        }
       }
-    }
   });
   std::size_t total = 0;
   for (std::size_t f : filled) total += f;
