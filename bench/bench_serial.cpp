@@ -104,7 +104,7 @@ void run_serial_bake(BenchRun& run, const SerialBake& bake) {
     for (int t = 1; t <= 2; ++t) {
       maps[t - 1] = run.run_dir + "/serial_t" + std::to_string(t) + "_" + bake.map;
       const CommandRun r =
-          run_nmbake(run.args.exe, bake.inputs + " -o " + maps[t - 1] + " " + bake.options + " --threads " + std::to_string(t),
+          run_nmbake(run.args.exe, bake.inputs + " -o '" + maps[t - 1] + "' " + bake.options + " --threads " + std::to_string(t),
                      run.report, 1);
       if (!r.ok) {
         std::printf("A command failed (see stderr): no figures for this bake.\n\n");
