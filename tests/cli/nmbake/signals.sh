@@ -27,8 +27,13 @@ old=$(state)
 run_and_signal() {
   local sig=$1 when=$2
   # 2048^2 texels: the trace, padding and writes after the trace's first line take about 0.5 s
-  # (several times that under ASan), against the few milliseconds the signal takes to be sent.
-  "$nmbake" "$low" "$high" -o m.png --size 2048 --threads 2 --miss-mask miss.png --report r.json --progress \
+  # (several times that under ASan), against the few milliseconds the signal takes to be sent. The
+  # map's temporary lives from its write to the renaming of every output: about 20 ms at 2048^2 (the
+  # masks' encoders share the threads), which a poller sharing two cores with other tests can miss;
+  # the writes' cases bake 4096^2 (about 60 ms) and poll with shell builtins alone, no sleep.
+  local size=2048
+  [ "$when" = write ] && size=4096
+  "$nmbake" "$low" "$high" -o m.png --size "$size" --threads 2 --miss-mask miss.png --report r.json --progress \
     >"$log/stdout.txt" 2>"$log/stderr.txt" &
   pid=$!
   local seen=0 until=$((SECONDS + 120))
@@ -36,11 +41,11 @@ run_and_signal() {
     kill -0 "$pid" 2>/dev/null || break
     if [ "$when" = bake ]; then
       grep -q 'nmbake: tracing' "$log/stderr.txt" && { seen=1; break; }
+      sleep 0.005
     elif [ -e ".m.png.nmbake-tmp.$pid" ]; then
       seen=1
       break
     fi
-    sleep 0.005
   done
   [ "$seen" = 1 ] || bad "$sig during the $when: the moment never came"
   kill -s "$sig" "$pid" 2>/dev/null
