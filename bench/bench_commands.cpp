@@ -13,6 +13,7 @@
 #include "bench_bake.h"
 #include "bench_support.h"
 #include "io/image_io.h"
+#include "pipeline/udim.h"
 
 namespace nmbake::bench {
 
@@ -177,7 +178,7 @@ std::string map_hash_of(const std::string& path) {
   const std::size_t at = path.find(token);
   if (at != std::string::npos) {  // a map per tile: each tile's number and hash
     std::string all;
-    for (int tile = 1001; tile <= 2000; ++tile) {
+    for (int tile = kUdimFirst; tile <= udim_number(kUdimColumns - 1, kUdimRows - 1); ++tile) {
       const std::string file = path.substr(0, at) + std::to_string(tile) + path.substr(at + token.size());
       if (!std::filesystem::exists(file)) continue;
       const std::string h = map_hash_of(file);

@@ -62,15 +62,10 @@ void advise_huge_pages(void* p, std::size_t n) {
 void* operator new(std::size_t n) {
   for (;;) {
     void* p = nullptr;
-    if (n >= kLarge) {
-      if (::posix_memalign(&p, kHugePage, n) != 0) p = nullptr;
-    } else {
-      p = std::malloc(n ? n : 1);
-    }
-    if (p) {
-      if (n >= kLarge) advise_huge_pages(p, n);
-      return p;
-    }
+    if (n < kLarge) p = std::malloc(n ? n : 1);
+    else if (::posix_memalign(&p, kHugePage, n) == 0) advise_huge_pages(p, n);
+    else p = nullptr;
+    if (p) return p;
     const std::new_handler handler = std::get_new_handler();
     if (!handler) throw std::bad_alloc();
     handler();

@@ -71,6 +71,7 @@ std::size_t pad_with(const std::vector<Image*>& images, const std::vector<std::u
   const auto row = [](G o, int y) { return o == kNone ? -1 : y + int(o); };
   // Both passes split into independent parts (columns, then rows) shared out to the threads; each
   // part's result is the same whichever thread computes it.
+  //
   // Pass 1, columns: the row of the nearest covered texel in the same column (its squared distance
   // follows from it, and is worked out row by row in pass 2: 8 bytes per texel fewer), as its offset
   // from the texel's row; none (kNone) when it lies more than `padding` rows away, as then every
@@ -92,25 +93,22 @@ std::size_t pad_with(const std::vector<Image*>& images, const std::vector<std::u
   touch_storage(threads, storage_for(gy, n));
   gy.resize(n);
   const int m = std::max(w, h);
+  // One row further from the last covered texel: 0 on a covered one, else one more, saturating at kFar.
+  const auto step = [kFar](G rows, std::uint8_t covered_here) { return covered_here ? G(0) : rows < kFar ? G(rows + 1) : kFar; };
   const auto column_block = [&](int x0, int nb) {
     G near[kBlock];  // per column: rows to the nearest covered texel so far, kFar beyond `padding`
     std::fill(near, near + nb, kFar);
     for (int y = 0; y < h; ++y) {  // down: to the nearest at or above, in gy for now
       const std::uint8_t* c = &covered[std::size_t(y) * w + x0];
       G* g = &gy[std::size_t(y) * w + x0];
-      for (int j = 0; j < nb; ++j) {
-        const G next = near[j] < kFar ? G(near[j] + 1) : kFar;
-        near[j] = c[j] ? G(0) : next;
-        g[j] = near[j];
-      }
+      for (int j = 0; j < nb; ++j) g[j] = near[j] = step(near[j], c[j]);
     }
     std::fill(near, near + nb, kFar);
     for (int y = h - 1; y >= 0; --y) {  // up: to the nearest at or below, and the nearer of the two as an offset
       const std::uint8_t* c = &covered[std::size_t(y) * w + x0];
       G* g = &gy[std::size_t(y) * w + x0];
       for (int j = 0; j < nb; ++j) {
-        const G next = near[j] < kFar ? G(near[j] + 1) : kFar;
-        near[j] = c[j] ? G(0) : next;
+        near[j] = step(near[j], c[j]);
         const G above = g[j], below = near[j];
         g[j] = above <= below ? (above < kFar ? G(-above) : kNone) : below;
       }

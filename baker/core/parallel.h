@@ -4,7 +4,8 @@
 // fn(begin, end) for each chunk, in no particular order. threads <= 0: all cores.
 // fill_on_threads, mark_on_threads: a large array set on every core (its fresh pages first touched
 // there too).
-// touch_storage: the fresh pages of large arrays about to be sized, first touched on every core.
+// touch_storage, touch_pages: the fresh pages of large arrays (about to be sized, or left unset),
+// first touched on every core.
 #pragma once
 
 #include <algorithm>
@@ -109,11 +110,28 @@ void mark_on_threads(int threads, const Index& index, std::vector<std::uint8_t, 
   });
 }
 
+// Byte ranges whose pages are touched on `threads` threads, a byte written in every 4 KiB, in
+// chunks of 2 MiB: the system zeroes a fresh page at its first touch, on the touching thread, so
+// that work is shared out (touch_storage, touch_pages).
+struct PageRange {
+  unsigned char* begin;
+  std::size_t bytes;
+};
+inline void touch_ranges(int threads, const std::vector<PageRange>& ranges) {
+  constexpr std::size_t kPage = 4096, kStep = std::size_t(1) << 21;  // bytes per chunk
+  std::vector<std::size_t> first(ranges.size() + 1, 0);              // chunks before each range
+  for (std::size_t i = 0; i < ranges.size(); ++i) first[i + 1] = first[i] + (ranges[i].bytes + kStep - 1) / kStep;
+  parallel_chunks(threads, first.back(), 1, [&](std::size_t c, std::size_t) {
+    const std::size_t r = std::size_t(std::upper_bound(first.begin(), first.end(), c) - first.begin()) - 1;
+    const std::size_t at = (c - first[r]) * kStep, end = std::min(ranges[r].bytes, at + kStep);
+    for (std::size_t b = at; b < end; b += kPage) ranges[r].begin[b] = 0;
+  });
+}
+
 // Each vector given storage for its count of elements (reserve), and those pages touched on
-// `threads` threads (a byte written in every 4 KiB), before the caller sizes them. The system zeroes
-// a fresh page at its first touch, on the touching thread: a large std::vector sized on one thread
-// (which value-initializes it there) pays all of that on that thread; after this, the sizing only
-// writes to pages already there. For vectors of trivially copyable elements.
+// `threads` threads (touch_ranges), before the caller sizes them. A large std::vector sized on one
+// thread (which value-initializes it there) pays all of the zeroing on that thread; after this, the
+// sizing only writes to pages already there. For vectors of trivially copyable elements.
 template <typename T, typename A>
 struct StorageToTouch {
   std::vector<T, A>* v;
@@ -128,11 +146,7 @@ StorageToTouch<T, A> storage_for(std::vector<T, A>& v, std::size_t n) {
 
 template <typename... Vs>
 void touch_storage(int threads, Vs... vs) {
-  struct Range {
-    unsigned char* begin;
-    std::size_t bytes;
-  };
-  std::vector<Range> ranges;
+  std::vector<PageRange> ranges;
   const auto add = [&](auto s) {
     using T = typename std::remove_reference_t<decltype(*s.v)>::value_type;
     static_assert(std::is_trivially_copyable_v<T>);
@@ -142,24 +156,13 @@ void touch_storage(int threads, Vs... vs) {
     ranges.push_back({base + s.v->size() * sizeof(T), (s.n - s.v->size()) * sizeof(T)});
   };
   (add(vs), ...);
-  constexpr std::size_t kPage = 4096, kStep = std::size_t(1) << 21;  // bytes per chunk
-  std::vector<std::size_t> first(ranges.size() + 1, 0);              // chunks before each range
-  for (std::size_t i = 0; i < ranges.size(); ++i) first[i + 1] = first[i] + (ranges[i].bytes + kStep - 1) / kStep;
-  parallel_chunks(threads, first.back(), 1, [&](std::size_t c, std::size_t) {
-    const std::size_t r = std::size_t(std::upper_bound(first.begin(), first.end(), c) - first.begin()) - 1;
-    const std::size_t at = (c - first[r]) * kStep, end = std::min(ranges[r].bytes, at + kStep);
-    for (std::size_t b = at; b < end; b += kPage) ranges[r].begin[b] = 0;
-  });
+  touch_ranges(threads, ranges);
 }
 
 // The pages of a buffer whose values are not set yet (an Image made Unset) touched on `threads`
-// threads, a byte written in every 4 KiB, so that the system's zeroing of them is shared out.
+// threads (touch_ranges).
 inline void touch_pages(int threads, void* data, std::size_t bytes) {
-  constexpr std::size_t kPage = 4096, kStep = std::size_t(1) << 21;  // bytes per chunk
-  auto* const base = static_cast<unsigned char*>(data);
-  parallel_chunks(threads, (bytes + kStep - 1) / kStep, 1, [&](std::size_t c, std::size_t) {
-    for (std::size_t b = c * kStep; b < std::min(bytes, (c + 1) * kStep); b += kPage) base[b] = 0;
-  });
+  touch_ranges(threads, {{static_cast<unsigned char*>(data), bytes}});
 }
 
 }  // namespace nmbake
