@@ -18,6 +18,8 @@
 #include <type_traits>
 #include <vector>
 
+#include "core/thread_pool.h"
+
 namespace nmbake {
 
 // What "all cores" (a count <= 0) means in this process: the machine's cores, unless an AllCores
@@ -48,15 +50,20 @@ inline int worker_threads(int requested) {
   return set > 0 ? set : std::max(1, int(std::thread::hardware_concurrency()));
 }
 
-// Runs fn(id) for ids [0, count) on the caller's thread and up to count - 1 new ones, joined before
-// return. An exception in any of them (std::bad_alloc under a memory limit) is rethrown here once
-// all have ended, not std::terminate; ids whose thread could not be started (EAGAIN under
-// ulimit) run on the caller's thread.
+// Runs fn(id) for ids [0, count) on the caller's thread and count - 1 others of the process's pool
+// (thread_pool.h), each id on a thread of its own, all ended before return. An exception in any of
+// them (std::bad_alloc under a memory limit) is rethrown here once all have ended, not
+// std::terminate; ids whose thread could not be started (EAGAIN under ulimit) run on the caller's
+// thread.
 template <typename Fn>
 void run_on_threads(int count, Fn&& fn) {
+  if (count <= 1) {
+    fn(0);
+    return;
+  }
   std::exception_ptr error;
   std::mutex error_mutex;
-  auto guarded = [&](int id) {
+  auto guarded = [&](int id) noexcept {
     try {
       fn(id);
     } catch (...) {
@@ -64,16 +71,9 @@ void run_on_threads(int count, Fn&& fn) {
       if (!error) error = std::current_exception();
     }
   };
-  std::vector<std::thread> pool;
-  int started = 1;
-  try {
-    pool.reserve(std::size_t(std::max(0, count - 1)));
-    for (; started < count; ++started) pool.emplace_back(guarded, started);
-  } catch (...) {
-  }
-  guarded(0);
-  for (int id = started; id < count; ++id) guarded(id);
-  for (auto& t : pool) t.join();
+  using Guarded = decltype(guarded);
+  run_pooled(
+      count, [](void* context, int id) noexcept { (*static_cast<Guarded*>(context))(id); }, &guarded);
   if (error) std::rethrow_exception(error);
 }
 
