@@ -93,27 +93,35 @@ std::vector<std::uint32_t> triangles_near(const std::vector<Box>& regions, doubl
           if (marked[(std::size_t(z) * dim[1] + y) * dim[0] + x]) return true;
     return false;
   };
-  // In chunks on the threads, each chunk's triangles kept in order and the chunks joined in order:
-  // the answer does not depend on the threads.
+  // In chunks on the threads: per triangle whether it is near (a byte), per chunk how many; then,
+  // if they are to be listed, each chunk lists its own from where the chunks before it end: the
+  // answer does not depend on the threads. (Lists grown per chunk, as before, took four times the
+  // memory in small blocks, each page of them a fault.)
   const std::size_t count = candidates ? candidates->size() : tris;
   constexpr std::size_t kChunk = std::size_t(1) << 16;
-  std::vector<std::vector<std::uint32_t>> parts((count + kChunk - 1) / kChunk);
+  const std::size_t chunks = (count + kChunk - 1) / kChunk;
+  std::vector<std::uint8_t, DefaultInitAllocator<std::uint8_t>> is_near(count);  // written whole below
+  std::vector<std::size_t> at(chunks + 1, 0);
+  const auto triangle = [&](std::size_t i) { return candidates ? (*candidates)[i] : std::uint32_t(i); };
   parallel_chunks(threads, count, kChunk, [&](std::size_t begin, std::size_t end) {
-    std::vector<std::uint32_t>& part = parts[begin / kChunk];
+    std::size_t n = 0;
     for (std::size_t i = begin; i < end; ++i) {
-      const std::uint32_t t = candidates ? (*candidates)[i] : std::uint32_t(i);
-      if (near(t)) part.push_back(t);
+      const bool k = near(triangle(i));
+      is_near[i] = k;
+      n += k;
     }
+    at[begin / kChunk + 1] = n;
   });
-  std::vector<std::size_t> at(parts.size() + 1, 0);
-  for (std::size_t i = 0; i < parts.size(); ++i) at[i + 1] = at[i] + parts[i].size();
+  for (std::size_t c = 0; c < chunks; ++c) at[c + 1] += at[c];
   if (at.back() >= list_below) {  // the caller does not want so many listed
     if (not_listed) *not_listed = true;
     return kept;
   }
   kept.resize(at.back());
-  parallel_chunks(threads, parts.size(), 1, [&](std::size_t i, std::size_t) {
-    std::copy(parts[i].begin(), parts[i].end(), kept.begin() + std::ptrdiff_t(at[i]));
+  parallel_chunks(threads, count, kChunk, [&](std::size_t begin, std::size_t end) {
+    std::size_t to = at[begin / kChunk];
+    for (std::size_t i = begin; i < end; ++i)
+      if (is_near[i]) kept[to++] = triangle(i);
   });
   return kept;
 }
