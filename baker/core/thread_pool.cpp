@@ -5,6 +5,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <mutex>
+#include <new>
 #include <thread>
 #include <vector>
 
@@ -25,8 +26,9 @@ class Batch {
     done_cv_.notify_one();
   }
 
+  // Until the last id's finish_one has let go of this object (not merely counted down: it may
+  // still be about to take the lock).
   void wait() {
-    if (left_.load(std::memory_order_acquire) == 0) return;
     std::unique_lock<std::mutex> lock(mutex_);
     done_cv_.wait(lock, [this] { return done_; });
   }
@@ -63,26 +65,42 @@ class Pool {
     }
   }
 
-  void give_back(Worker* w) {
+  void give_back(Worker* w) noexcept {
     const std::lock_guard<std::mutex> lock(mutex_);
-    idle_.push_back(w);
+    idle_.push_back(w);  // within the room start() made
   }
 
-  // A new worker running `job` first; false when no thread could be started.
-  bool start(const Job& job) {
-    auto* w = new Worker;
-    w->job = job;
+  // A new worker running `job` first; false when no thread could be started (or no memory was
+  // left for one). The idle list's room for it is made first, so that a worker going back to the
+  // list never allocates.
+  bool start(const Job& job) noexcept {
+    Worker* w = nullptr;
+    bool counted = false;
     try {
+      {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        idle_.reserve(std::size_t(started_) + 1);
+        ++started_;
+        counted = true;
+      }
+      w = new Worker;
+      w->job = job;
       std::thread(&Pool::serve, this, w).detach();
     } catch (...) {
       delete w;
+      if (counted) {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        --started_;
+      }
       return false;
     }
-    started_.fetch_add(1, std::memory_order_relaxed);
     return true;
   }
 
-  int started() const { return started_.load(std::memory_order_relaxed); }
+  int started() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return started_;
+  }
 
  private:
   // A worker's life: its job, then back to the idle list, then the job's batch told; then the
@@ -103,8 +121,8 @@ class Pool {
   }
 
   std::mutex mutex_;
-  std::vector<Worker*> idle_;  // workers (never freed: they live as long as the process)
-  std::atomic<int> started_{0};
+  std::vector<Worker*> idle_;  // workers (never freed: they live as long as the process); room for all
+  int started_ = 0;            // threads started, or being started
 };
 
 std::atomic<Pool*>& pool_slot() {
@@ -112,30 +130,36 @@ std::atomic<Pool*>& pool_slot() {
   return slot;
 }
 
-// The process's pool. A forked child has only the forking thread: its pool starts empty (the
-// parent's, whose lists and locks may be mid-use, is left alone).
-Pool& pool() {
+// The process's pool (null when there was no memory for one). A forked child has only the forking
+// thread: its pool starts empty (the parent's, whose lists and locks may be mid-use, is left alone).
+Pool* pool() noexcept {
   static const bool registered = [] {
-    ::pthread_atfork(nullptr, nullptr, [] { pool_slot().store(new Pool); });
-    pool_slot().store(new Pool);
+    ::pthread_atfork(nullptr, nullptr, [] { pool_slot().store(new (std::nothrow) Pool); });
+    pool_slot().store(new (std::nothrow) Pool);
     return true;
   }();
   (void)registered;
-  return *pool_slot().load();
+  return pool_slot().load();
 }
 
 }  // namespace
 
 void run_pooled(int count, PooledTask task, void* context) {
-  if (count <= 1) {
-    task(context, 0);
+  Pool* p = count > 1 ? pool() : nullptr;
+  std::vector<Worker*> workers;
+  std::vector<int> here;  // ids no thread could be started for
+  try {
+    // Made before any id is handed out: nothing below allocates or throws.
+    if (p) workers.reserve(std::size_t(count - 1)), here.reserve(std::size_t(count - 1));
+  } catch (...) {
+    p = nullptr;
+  }
+  if (!p) {  // one id, or no memory: every id here
+    for (int id = 0; id < count || id == 0; ++id) task(context, id);
     return;
   }
-  Pool& p = pool();
   Batch batch(count - 1);
-  std::vector<Worker*> workers;
-  workers.reserve(std::size_t(count - 1));
-  p.take(workers, count - 1);
+  p->take(workers, count - 1);
   int id = 1;
   for (Worker* w : workers) {
     {
@@ -144,9 +168,8 @@ void run_pooled(int count, PooledTask task, void* context) {
     }
     w->wake.notify_one();
   }
-  std::vector<int> here;  // ids no thread could be started for
   for (; id < count; ++id)
-    if (!p.start({task, context, id, &batch})) here.push_back(id);
+    if (!p->start({task, context, id, &batch})) here.push_back(id);
   task(context, 0);
   for (int i : here) {
     task(context, i);
@@ -155,6 +178,9 @@ void run_pooled(int count, PooledTask task, void* context) {
   batch.wait();
 }
 
-int pooled_threads_started() { return pool().started(); }
+int pooled_threads_started() {
+  Pool* p = pool();
+  return p ? p->started() : 0;
+}
 
 }  // namespace nmbake
