@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "core/errors.h"
+#include "core/parallel.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;
@@ -286,4 +287,26 @@ TEST(ImageIo, UnreadableFilesAreInputErrors) {
       EXPECT_EQ(what.find('\n'), std::string::npos) << what;
     }
   }
+}
+
+// OpenImageIO's and OpenEXR's own thread pools follow the process's "all cores" (--threads), for
+// reads and writes alike: by default both take every core of the machine, so a `--threads 1` bake
+// to EXR compressed on all of them. The bytes do not depend on it.
+TEST(ImageIo, TheLibrariesThreadPoolsFollowTheThreadsSetting) {
+  const std::string dir = nmbake::test::scratch_dir();
+  Image img(64, 40, 3);
+  for (std::size_t i = 0; i < img.pixels.size(); ++i) img.pixels[i] = float(i % 97) / 97.0f;
+  std::string first;
+  for (const int threads : {1, 5, 2}) {
+    const nmbake::AllCores cores(threads);
+    const std::string path = dir + "/pools" + std::to_string(threads) + ".exr";
+    nmbake::write_image(path, img, {32, {}});
+    EXPECT_EQ(nmbake::image_library_threads(), std::make_pair(threads, threads)) << "write, " << threads << " threads";
+    const std::string bytes = slurp(path);
+    if (first.empty()) first = bytes;
+    EXPECT_EQ(bytes, first) << threads << " threads";
+  }
+  const nmbake::AllCores three(3);
+  EXPECT_EQ(nmbake::read_image(dir + "/pools5.exr").pixels, img.pixels);
+  EXPECT_EQ(nmbake::image_library_threads(), std::make_pair(3, 3)) << "read";
 }

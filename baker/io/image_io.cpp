@@ -228,4 +228,10 @@ std::map<std::string, std::string> read_image_metadata(const std::string& path) 
   return metadata;
 }
 
+std::pair<int, int> image_library_threads() {
+  std::pair<int, int> n{0, 0};
+  oiio_module::api("libnmbake-oiio.so", ExitCode::input).library_threads(&n.first, &n.second);
+  return n;
+}
+
 }  // namespace nmbake

@@ -72,6 +72,11 @@ Image read_image(const std::string& path);
 // be opened.
 std::map<std::string, std::string> read_image_metadata(const std::string& path);
 
+// OpenImageIO's and OpenEXR's own thread pools, as the last read or write set them: each sizes
+// both to the process's "all cores" (--threads), not the machine's. {OpenImageIO's "threads"
+// (its workers and the caller), OpenEXR's workers}. Loads the module (for tests).
+std::pair<int, int> image_library_threads();
+
 namespace image_io_detail {
 std::string lower_extension(const std::string& path);  // ".png" for "A/b.PNG"
 }

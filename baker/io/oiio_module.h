@@ -32,7 +32,7 @@ inline constexpr const char* kFileName = "libnmbake-oiio.so";
 
 // Raised when the calls below change their signature or meaning, so that a module of another
 // build is refused rather than called.
-inline constexpr int kAbi = 2;
+inline constexpr int kAbi = 3;
 
 // An error a call ended with: the ExitCode of the nmbake::Error it stands for (0: none) and its
 // message (one line, naming the file).
@@ -52,6 +52,8 @@ struct Api {
   void (*read)(const std::string& path, std::uint64_t file_size, int all_cores, Image* image, Failure* failure);  // read_image
   void (*read_metadata)(const std::string& path, std::map<std::string, std::string>* out,
                         Failure* failure);  // read_image_metadata
+  // The thread counts OpenImageIO's pool and OpenEXR's are set to now (image_library_threads).
+  void (*library_threads)(int* openimageio, int* openexr);
 };
 
 // The three calls as the module implements them (image_io_oiio.cpp, image_read.cpp); they throw
