@@ -2,6 +2,9 @@
 #include "io/image_io.h"
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <utility>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -309,4 +312,57 @@ TEST(ImageIo, TheLibrariesThreadPoolsFollowTheThreadsSetting) {
   const nmbake::AllCores three(3);
   EXPECT_EQ(nmbake::read_image(dir + "/pools5.exr").pixels, img.pixels);
   EXPECT_EQ(nmbake::image_library_threads(), std::make_pair(3, 3)) << "read";
+}
+
+// TIFF is written by tiff_write.cpp (strips compressed on every thread), read back by OpenImageIO
+// (libtiff): for 1 to 4 channels (grey, grey + alpha, RGB, RGBA), 8 and 16 bits (against the PNG
+// writer's values, dither included) and 32-bit float (bit for bit, NaN, infinities and -0 too), an
+// image whose last strip is short and one of a single row; the same bytes on 1 and 3 threads.
+TEST(ImageIo, TiffReadsBackAsWrittenForEveryLayout) {
+  const std::string dir = nmbake::test::scratch_dir();
+  for (const auto& [width, height] : {std::pair<int, int>{37, 70}, std::pair<int, int>{5, 1}}) {
+    for (int channels = 1; channels <= 4; ++channels) {
+      Image img(width, height, channels);
+      for (std::size_t i = 0; i < img.pixels.size(); ++i) img.pixels[i] = float((i * 7919) % 1009) / 1008.0f;
+      for (const int bits : {8, 16, 32}) {
+        for (const bool dither : {false, true}) {
+          if (dither && bits != 8) continue;
+          const std::string what = std::to_string(width) + "x" + std::to_string(height) + "x" + std::to_string(channels) + " " +
+                                   std::to_string(bits) + " bits" + (dither ? " dithered" : "");
+          Image in = img;
+          if (bits == 32 && in.pixels.size() >= 4) {
+            in.pixels[0] = std::numeric_limits<float>::quiet_NaN();
+            in.pixels[1] = std::numeric_limits<float>::infinity();
+            in.pixels[2] = -0.0f;
+            in.pixels[3] = -1e-40f;  // subnormal
+          }
+          nmbake::WriteOptions options;
+          options.bits = bits;
+          options.dither = dither;
+          std::string bytes[2];
+          for (const int threads : {1, 3}) {
+            options.threads = threads;
+            nmbake::write_image(dir + "/t.tif", in, options);
+            bytes[threads == 3] = slurp(dir + "/t.tif");
+          }
+          EXPECT_EQ(bytes[0], bytes[1]) << what;
+          const Image back = nmbake::read_image(dir + "/t.tif");
+          ASSERT_EQ(back.width, width) << what;
+          ASSERT_EQ(back.height, height) << what;
+          ASSERT_EQ(back.channels, channels) << what;
+          if (bits == 32) {
+            for (std::size_t i = 0; i < in.pixels.size(); ++i) {
+              std::uint32_t a, b;
+              std::memcpy(&a, &in.pixels[i], 4);
+              std::memcpy(&b, &back.pixels[i], 4);
+              ASSERT_EQ(a, b) << what << ", value " << i;
+            }
+            continue;
+          }
+          nmbake::write_image(dir + "/t.png", in, options);
+          EXPECT_EQ(back.pixels, nmbake::read_image(dir + "/t.png").pixels) << what;
+        }
+      }
+    }
+  }
 }

@@ -19,6 +19,7 @@
 #include "io/image_write.h"
 #include "io/oiio_module.h"
 #include "io/png_write.h"
+#include "io/tiff_write.h"
 
 namespace nmbake {
 namespace {
@@ -187,11 +188,13 @@ void oiio_module::preload() {
 }
 
 void prepare_write(const std::string& path) {
-  if (image_io_detail::lower_extension(path) == ".png") return;
+  const std::string ext = image_io_detail::lower_extension(path);
+  if (ext == ".png") return;
   // A missing module is known before the bake, not after it.
   std::string looked;
   if (find_module(&looked).empty()) throw OutputError(path + ": cannot write: " + not_found(looked));
-  if (worker_threads(0) > 1) oiio_module::preload();
+  // TIFF is written here (tiff_write.h); the module only for a file past 4 GiB.
+  if (ext != ".tif" && ext != ".tiff" && worker_threads(0) > 1) oiio_module::preload();
 }
 
 void write_image(const std::string& path, const Image& image, const WriteOptions& options) {
@@ -203,6 +206,7 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
     return write_image(path, expand_palette(image, options.palette), rgb);
   }
   const int bits = image_write::check_write(path, image, options);
+  if ((ext == ".tif" || ext == ".tiff") && write_tiff_image(path, image, options, bits)) return;
   oiio_module::Failure failure;
   oiio_module::api(path, ExitCode::output).write(path, image, options, bits, all_cores_setting().load(), &failure);
   rethrow(failure);

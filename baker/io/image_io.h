@@ -56,7 +56,7 @@ struct WriteOptions {
 void write_image(const std::string& path, const Image& image, const WriteOptions& options = {});
 
 // Starts loading what writing `path` needs, on a thread of its own, so that it runs beside the
-// caller's work (a bake): OpenImageIO's module for a format other than PNG, 0.3 s of one core.
+// caller's work (a bake): OpenImageIO's module for a format other than PNG and TIFF, 0.3 s of one core.
 // write_image waits for it. Does nothing for PNG; starts no thread when "all cores" is one thread
 // (nmbake --threads 1: no thread beside the stages). Throws OutputError naming `path` when the
 // module is not to be found, so that a command fails before its work rather than at the write.

@@ -1,4 +1,4 @@
-// write_image (image_io.h) for every format but PNG, through OpenImageIO: the writing half of
+// write_image (image_io.h) for every format but PNG and TIFF (tiff_write.h), through OpenImageIO: the writing half of
 // libnmbake-oiio.so (oiio_module.h).
 #include "io/oiio_module.h"
 

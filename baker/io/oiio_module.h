@@ -45,8 +45,8 @@ struct Failure {
 struct Api {
   int abi;
   std::size_t image_size, options_size;  // sizeof(Image), sizeof(WriteOptions) in the module's build
-  // write_image for a format other than PNG: `image` has no palette and passed check_write, which
-  // gave `bits`. `all_cores` is the loader's all_cores_setting().
+  // write_image for a format other than PNG and TIFF (and a TIFF past 4 GiB): `image` has no palette and passed check_write,
+  // which gave `bits`. `all_cores` is the loader's all_cores_setting().
   void (*write)(const std::string& path, const Image& image, const WriteOptions& options, int bits, int all_cores,
                 Failure* failure);
   void (*read)(const std::string& path, std::uint64_t file_size, int all_cores, Image* image, Failure* failure);  // read_image
