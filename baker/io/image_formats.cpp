@@ -30,6 +30,8 @@ std::string lower_extension(const std::string& path) {
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return ext;
 }
+
+bool is_tiff(const std::string& ext) { return ext == ".tif" || ext == ".tiff"; }
 }  // namespace image_io_detail
 
 namespace {
@@ -43,7 +45,7 @@ const FormatInfo* find_format(const std::string& ext) {
 
 int default_bits_for(const std::string& path) {
   const std::string ext = image_io_detail::lower_extension(path);
-  if (ext == ".tif" || ext == ".tiff") return 16;
+  if (image_io_detail::is_tiff(ext)) return 16;
   if (ext == ".exr") return 32;
   return 8;
 }

@@ -194,7 +194,7 @@ void prepare_write(const std::string& path) {
   std::string looked;
   if (find_module(&looked).empty()) throw OutputError(path + ": cannot write: " + not_found(looked));
   // TIFF is written here (tiff_write.h); the module only for a file past 4 GiB.
-  if (ext != ".tif" && ext != ".tiff" && worker_threads(0) > 1) oiio_module::preload();
+  if (!image_io_detail::is_tiff(ext) && worker_threads(0) > 1) oiio_module::preload();
 }
 
 void write_image(const std::string& path, const Image& image, const WriteOptions& options) {
@@ -206,7 +206,7 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
     return write_image(path, expand_palette(image, options.palette), rgb);
   }
   const int bits = image_write::check_write(path, image, options);
-  if ((ext == ".tif" || ext == ".tiff") && write_tiff_image(path, image, options, bits)) return;
+  if (image_io_detail::is_tiff(ext) && write_tiff_image(path, image, options, bits)) return;
   oiio_module::Failure failure;
   oiio_module::api(path, ExitCode::output).write(path, image, options, bits, all_cores_setting().load(), &failure);
   rethrow(failure);

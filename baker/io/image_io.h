@@ -79,6 +79,7 @@ std::pair<int, int> image_library_threads();
 
 namespace image_io_detail {
 std::string lower_extension(const std::string& path);  // ".png" for "A/b.PNG"
-}
+bool is_tiff(const std::string& ext);                  // ".tif" or ".tiff" (a lower_extension)
+}  // namespace image_io_detail
 
 }  // namespace nmbake

@@ -131,10 +131,8 @@ OIIO::ImageSpec output_spec(const Image& image, OIIO::TypeDesc stored, const std
   if (ext == ".exr") spec.attribute("compression", options.compression.empty() ? "zip" : options.compression);
   // The TIFF writer drops attributes it does not know; keep them readable (and parsable by
   // read_image_metadata) as "key=value" items after any given description in the description tag.
-  if (ext == ".tif" || ext == ".tiff") {
-    std::string description = spec.get_string_attribute("ImageDescription");
-    for (const auto& [key, value] : options.metadata)
-      if (key != "ImageDescription") description += (description.empty() ? "" : "; ") + key + "=" + value;
+  if (image_io_detail::is_tiff(ext)) {
+    const std::string description = image_write::tiff_description(options.metadata);
     if (!description.empty()) spec.attribute("ImageDescription", description);
   }
   return spec;

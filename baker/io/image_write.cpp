@@ -153,6 +153,15 @@ bool date_time_fields(const std::string& text, int fields[6]) {
   return std::sscanf(text.c_str(), "%d:%d:%d %d:%d:%d", &f[0], &f[1], &f[2], &f[3], &f[4], &f[5]) == 6;
 }
 
+std::string tiff_description(const std::vector<std::pair<std::string, std::string>>& metadata) {
+  std::string text;
+  for (const auto& [key, value] : metadata)
+    if (key == "ImageDescription") text = value;
+  for (const auto& [key, value] : metadata)
+    if (key != "ImageDescription") text += (text.empty() ? "" : "; ") + key + "=" + value;
+  return text;
+}
+
 std::string reproducible_date_time() {
   const char* epoch = std::getenv("SOURCE_DATE_EPOCH");
   if (!epoch || !*epoch) return "";

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/image.h"
@@ -28,6 +29,10 @@ Samples<std::uint16_t> quantize16(const Image::Pixels& values, int threads = 1);
 // seed): what quantize8 and quantize16 give those values.
 void quantize8_run(const float* values, std::size_t first, std::size_t n, bool dither, std::uint8_t* out);
 void quantize16_run(const float* values, std::size_t n, std::uint16_t* out);
+
+// A TIFF's description tag: the given ImageDescription, then every other item as "key=value",
+// "; " between them (the TIFF format has no place for them; read_image_metadata reads them back).
+std::string tiff_description(const std::vector<std::pair<std::string, std::string>>& metadata);
 
 // "YYYY:MM:DD HH:MM:SS" (UTC) of SOURCE_DATE_EPOCH, or "" when it is unset or malformed.
 std::string reproducible_date_time();

@@ -65,20 +65,30 @@ void put32(std::vector<unsigned char>& out, std::size_t at, std::uint32_t v) {
   put16(out, at + 2, v >> 16);
 }
 
+// The bytes of a value that does not fit in its entry: its own, then one to keep the next even
+// (value offsets are).
+std::size_t out_of_line_bytes(const Entry& e) { return e.value.size() > 4 ? (e.value.size() + 1) & ~std::size_t(1) : 0; }
+
+// Where the IFD of n entries ends: the 8-byte header, its count, its entries, the next IFD's offset.
+std::size_t ifd_end(std::size_t n) { return 8 + 2 + 12 * n + 4; }
+
+// How many bytes header_and_ifd makes of `entries`: where the strips follow.
+std::size_t header_bytes(const std::vector<Entry>& entries) {
+  std::size_t size = ifd_end(entries.size());
+  for (const Entry& e : entries) size += out_of_line_bytes(e);
+  return size;
+}
+
 // The header, the one IFD (entries in tag order) and the values that do not fit in their entries,
-// as the file's first bytes; `strips_at` is where the strips follow (even, as value offsets are).
-std::vector<unsigned char> header_and_ifd(std::vector<Entry> entries, std::uint32_t* strips_at) {
+// as the file's first bytes.
+std::vector<unsigned char> header_and_ifd(std::vector<Entry> entries) {
   std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) { return a.tag < b.tag; });
-  const std::size_t ifd_end = 8 + 2 + 12 * entries.size() + 4;
-  std::size_t size = ifd_end;
-  for (const Entry& e : entries)
-    if (e.value.size() > 4) size += (e.value.size() + 1) & ~std::size_t(1);
-  std::vector<unsigned char> out(size, 0);
+  std::vector<unsigned char> out(header_bytes(entries), 0);
   out[0] = out[1] = 'I';
   put16(out, 2, 42);
   put32(out, 4, 8);
   put16(out, 8, std::uint32_t(entries.size()));
-  std::size_t at = 10, values = ifd_end;
+  std::size_t at = 10, values = ifd_end(entries.size());
   for (const Entry& e : entries) {
     put16(out, at, e.tag);
     put16(out, at + 2, e.type);
@@ -88,12 +98,11 @@ std::vector<unsigned char> header_and_ifd(std::vector<Entry> entries, std::uint3
     } else {
       put32(out, at + 8, std::uint32_t(values));
       std::copy(e.value.begin(), e.value.end(), out.begin() + std::ptrdiff_t(values));
-      values += (e.value.size() + 1) & ~std::size_t(1);
+      values += out_of_line_bytes(e);
     }
     at += 12;
   }
   // The next IFD's offset (none) is already 0.
-  *strips_at = std::uint32_t(size);
   return out;
 }
 
@@ -167,17 +176,6 @@ class StripEncoder {
   Bytes raw_, scratch_, packed_;  // a strip's samples, a row's bytes, a strip compressed
 };
 
-// The description tag's text: the given description, then every other item as "key=value" (the
-// tags the TIFF format has no place for, read back by read_image_metadata).
-std::string description_of(const std::vector<std::pair<std::string, std::string>>& metadata) {
-  std::string text;
-  for (const auto& [key, value] : metadata)
-    if (key == "ImageDescription") text = value;
-  for (const auto& [key, value] : metadata)
-    if (key != "ImageDescription") text += (text.empty() ? "" : "; ") + key + "=" + value;
-  return text;
-}
-
 }  // namespace
 
 bool write_tiff_image(const std::string& path, const Image& image, const WriteOptions& options, int bits) {
@@ -226,8 +224,8 @@ bool write_tiff_image(const std::string& path, const Image& image, const WriteOp
   entries.push_back(shorts(317, {std::uint16_t(bits == 32 ? 3 : 2)}));  // floating-point, or horizontal, predictor
   if (channels == 2 || channels == 4) entries.push_back(shorts(338, {std::uint16_t(2)}));              // unassociated alpha
   entries.push_back(shorts(339, std::vector<std::uint16_t>(spp, std::uint16_t(bits == 32 ? 3 : 1))));  // float, or unsigned
-  std::vector<std::pair<std::string, std::string>> metadata = options.metadata;
-  const std::string description = description_of(metadata);
+  const std::vector<std::pair<std::string, std::string>>& metadata = options.metadata;
+  const std::string description = image_write::tiff_description(metadata);
   if (!description.empty()) entries.push_back(ascii(270, description));
   std::string date = image_write::reproducible_date_time();
   constexpr std::pair<std::uint16_t, const char*> kTextTags[] = {
@@ -240,10 +238,9 @@ bool write_tiff_image(const std::string& path, const Image& image, const WriteOp
   int fields[6];
   if (image_write::date_time_fields(date, fields)) entries.push_back(ascii(306, date));
 
-  // Where each strip goes; a file past a classic TIFF's 4 GiB is OpenImageIO's (BigTIFF).
-  std::uint32_t strips_at = 0;
-  std::vector<unsigned char> head = header_and_ifd(entries, &strips_at);
-  std::uint64_t at = strips_at;
+  // Where each strip goes (after the header, whose size the offsets' values do not change); a file
+  // past a classic TIFF's 4 GiB is OpenImageIO's (BigTIFF).
+  std::uint64_t at = header_bytes(entries);
   std::vector<std::uint32_t> offsets(static_cast<std::size_t>(strips));
   for (std::size_t s = 0; s < offsets.size(); ++s) {
     offsets[s] = std::uint32_t(at);
@@ -252,7 +249,7 @@ bool write_tiff_image(const std::string& path, const Image& image, const WriteOp
   if (at > std::numeric_limits<std::uint32_t>::max()) return false;
   for (Entry& e : entries)
     if (e.tag == 273) e = longs(273, offsets);
-  head = header_and_ifd(std::move(entries), &strips_at);
+  const std::vector<unsigned char> head = header_and_ifd(std::move(entries));
 
   std::vector<ByteSpan> spans{{head.data(), head.size()}};
   for (const auto& d : data) spans.push_back({d.data(), d.size()});
