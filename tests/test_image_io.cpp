@@ -211,25 +211,30 @@ TEST(ImageIo, SuccessfulWriteReplacesTheFileAndLeavesNoTemporary) {
   EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);
 }
 
+// PNG and TIFF, each written by nmbake's own encoders (png_write.h, tiff_write.h).
 TEST(ImageIo, MissingFolderIsAnOutputError) {
-  const std::string path = nmbake::test::scratch_dir() + "/no/such/folder/out.png";
-  try {
-    nmbake::write_image(path, Image(2, 2, 3, 0.5f));
-    FAIL() << "no exception";
-  } catch (const nmbake::OutputError& e) {
-    EXPECT_EQ(std::string(e.what()).rfind(path + ": cannot write: ", 0), 0u) << e.what();
-    EXPECT_EQ(e.code(), nmbake::ExitCode::output);
+  for (const std::string name : {"out.png", "out.tif"}) {
+    const std::string path = nmbake::test::scratch_dir() + "/no/such/folder/" + name;
+    try {
+      nmbake::write_image(path, Image(2, 2, 3, 0.5f));
+      FAIL() << "no exception, " << name;
+    } catch (const nmbake::OutputError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind(path + ": cannot write: ", 0), 0u) << e.what();
+      EXPECT_EQ(e.code(), nmbake::ExitCode::output);
+    }
   }
 }
 
 TEST(ImageIo, FolderAtThePathIsAnOutputErrorAndTheTemporaryIsRemoved) {
-  const std::string dir = nmbake::test::scratch_dir();
-  const std::string path = dir + "/taken.png";
-  fs::create_directory(path);
-  EXPECT_THROW(nmbake::write_image(path, Image(2, 2, 3, 0.5f)), nmbake::OutputError);
-  EXPECT_TRUE(fs::is_directory(path));
-  EXPECT_EQ(leftover_temp_files(dir), 0);
-  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);
+  for (const std::string name : {"taken.png", "taken.tif"}) {
+    const std::string dir = nmbake::test::scratch_dir();
+    const std::string path = dir + "/" + name;
+    fs::create_directory(path);
+    EXPECT_THROW(nmbake::write_image(path, Image(2, 2, 3, 0.5f)), nmbake::OutputError) << name;
+    EXPECT_TRUE(fs::is_directory(path));
+    EXPECT_EQ(leftover_temp_files(dir), 0) << name;
+    EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1) << name;
+  }
 }
 
 // White box: the temporary file is ".<name>.tmp-<pid>-<n><ext>"; folders of those names make the
